@@ -1,0 +1,148 @@
+//! Moves and tool paths, with path length and cutting-time estimates.
+
+use crate::{CamError, CutterLocation};
+use serde::{Deserialize, Serialize};
+
+/// What a move does; decides the rate it runs at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MoveKind {
+    /// Positioning at rapid rate, never in contact with material.
+    Rapid,
+    /// Entry into material along (or close to) the tool axis, at plunge feed.
+    Plunge,
+    /// Cutting move at the programmed feed.
+    Feed,
+    /// Exit from material along the tool axis.
+    Retract,
+}
+
+/// One move of a tool path: the target cutter location and how to get there from the
+/// previous one.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Move {
+    /// Kind of move.
+    pub kind: MoveKind,
+    /// Target cutter location.
+    pub cl: CutterLocation,
+    /// Feed rate (mm/min) for non-rapid moves; `None` keeps the previous/default feed.
+    pub feed_mm_per_min: Option<f64>,
+}
+
+impl Move {
+    /// A rapid move to `cl`.
+    pub fn rapid(cl: CutterLocation) -> Self {
+        Self {
+            kind: MoveKind::Rapid,
+            cl,
+            feed_mm_per_min: None,
+        }
+    }
+    /// A cutting move to `cl` at the default feed.
+    pub fn feed(cl: CutterLocation) -> Self {
+        Self {
+            kind: MoveKind::Feed,
+            cl,
+            feed_mm_per_min: None,
+        }
+    }
+}
+
+/// Feed and rapid rates used to estimate cutting time (mm/min).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Rates {
+    /// Default cutting feed (mm/min).
+    pub feed_mm_per_min: f64,
+    /// Plunge feed (mm/min).
+    pub plunge_mm_per_min: f64,
+    /// Rapid traverse rate (mm/min).
+    pub rapid_mm_per_min: f64,
+}
+
+impl Default for Rates {
+    fn default() -> Self {
+        Self {
+            feed_mm_per_min: 1000.0,
+            plunge_mm_per_min: 300.0,
+            rapid_mm_per_min: 10000.0,
+        }
+    }
+}
+
+impl Rates {
+    /// Checks that all rates are finite and > 0.
+    pub fn validate(&self) -> Result<(), CamError> {
+        for (field, value) in [
+            ("feed_mm_per_min", self.feed_mm_per_min),
+            ("plunge_mm_per_min", self.plunge_mm_per_min),
+            ("rapid_mm_per_min", self.rapid_mm_per_min),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(CamError::NonPositive { field, value });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The tool path of one operation: an ordered list of moves made with one cutter.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ToolPath {
+    /// Operation name (e.g. `plunge_rough`).
+    pub name: String,
+    /// Name of the cutter (key into the job's tool list).
+    pub tool: String,
+    /// Moves in execution order; the first move starts from wherever the tool is.
+    pub moves: Vec<Move>,
+}
+
+impl ToolPath {
+    /// An empty path for operation `name` made with `tool`.
+    pub fn new(name: impl Into<String>, tool: impl Into<String>) -> Self {
+        Self {
+            name: name.into(),
+            tool: tool.into(),
+            moves: Vec::new(),
+        }
+    }
+
+    /// Total tool-tip travel (mm) over all moves, rapid ones included, measured as straight
+    /// segments between consecutive tip points. O(n).
+    pub fn path_length_mm(&self) -> f64 {
+        self.segments().map(|(_, len, _)| len).sum()
+    }
+
+    /// Tool-tip travel (mm) of the non-rapid moves only.
+    pub fn cutting_length_mm(&self) -> f64 {
+        self.segments()
+            .filter(|(kind, _, _)| *kind != MoveKind::Rapid)
+            .map(|(_, len, _)| len)
+            .sum()
+    }
+
+    /// Estimated machining time (s): each segment's length over its rate (the move's own feed
+    /// if given, else the default for its kind). Ignores acceleration. O(n).
+    pub fn cutting_time_s(&self, rates: &Rates) -> f64 {
+        self.segments()
+            .map(|(kind, len, feed)| {
+                let rate = match kind {
+                    MoveKind::Rapid => rates.rapid_mm_per_min,
+                    MoveKind::Plunge => feed.unwrap_or(rates.plunge_mm_per_min),
+                    MoveKind::Feed | MoveKind::Retract => feed.unwrap_or(rates.feed_mm_per_min),
+                };
+                if rate > 0.0 {
+                    60.0 * len / rate
+                } else {
+                    0.0
+                }
+            })
+            .sum()
+    }
+
+    /// (kind, length, feed) of each move after the first.
+    fn segments(&self) -> impl Iterator<Item = (MoveKind, f64, Option<f64>)> + '_ {
+        self.moves
+            .windows(2)
+            .map(|w| (w[1].kind, (w[1].cl.tip - w[0].cl.tip).norm(), w[1].feed_mm_per_min))
+    }
+}

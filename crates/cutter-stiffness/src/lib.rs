@@ -1,0 +1,1 @@
+//! Rayleigh-Ritz stiffness indicator of tapered (conical) cutters and its gradient.

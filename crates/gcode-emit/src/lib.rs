@@ -1,0 +1,1 @@
+//! G-code dialects (LinuxCNC, Fanuc, Sinumerik 840D, Heidenhain) and APT CLDATA read/write.

@@ -1,0 +1,46 @@
+//! `impeller-cam`: the command line of the impeller five-axis CAM toolkit.
+//!
+//! Every subcommand exits 0 on success and 1 on a user error with one clear line on stderr
+//! (see `../shared/DESIGN.md` §4). Subcommands live in `cmd/`, one module each.
+
+mod cmd;
+mod error;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Turn impeller design geometry into verified five-axis NC programs.
+#[derive(Debug, Parser)]
+#[command(name = "impeller-cam", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run the whole pipeline on a job file (or the embedded default job).
+    Run(cmd::run::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // clap prints help/version on stdout and usage errors on stderr.
+            let code = if e.use_stderr() { 1 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    let result = match cli.command {
+        Command::Run(args) => cmd::run::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! Centrifugal impeller geometry as exact NURBS: hub, shroud, main and splitter blades, channels; builders, importers, ruled approximations.

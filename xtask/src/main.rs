@@ -1,0 +1,4 @@
+//! Project automation (`cargo xtask regress`, `cargo xtask bench`).
+fn main() {
+    println!("xtask: not yet wired");
+}
