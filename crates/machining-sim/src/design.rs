@@ -192,7 +192,8 @@ impl DesignModel for CylinderDesign {
             let r = self.radius * (j as f64 + 0.5) / nr as f64;
             for i in 0..nu {
                 let t = std::f64::consts::TAU * i as f64 / nu as f64;
-                top.points.push(Point3::new(r * t.cos(), r * t.sin(), self.z1));
+                top.points
+                    .push(Point3::new(r * t.cos(), r * t.sin(), self.z1));
                 top.normals.push(Vector3::z());
             }
         }

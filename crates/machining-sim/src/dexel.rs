@@ -75,10 +75,7 @@ impl Segments {
 
     /// Total material length on the ray.
     pub fn length(&self) -> f64 {
-        self.as_slice()
-            .iter()
-            .map(|s| f64::from(s[1] - s[0]))
-            .sum()
+        self.as_slice().iter().map(|s| f64::from(s[1] - s[0])).sum()
     }
 
     /// Length of material inside `[a, b]`.
@@ -214,7 +211,11 @@ impl DexelGrid {
     /// with `v = true`); `None` when empty.
     #[inline]
     pub fn index_range(&self, lo: f64, hi: f64, v: bool) -> Option<(usize, usize)> {
-        let (o, n) = if v { (self.v0, self.nv) } else { (self.u0, self.nu) };
+        let (o, n) = if v {
+            (self.v0, self.nv)
+        } else {
+            (self.u0, self.nu)
+        };
         let a = ((lo - o) / self.cell - 0.5).ceil().max(0.0);
         let b = ((hi - o) / self.cell - 0.5).floor();
         if n == 0 || !(a.is_finite() && b.is_finite()) || b < a || a >= n as f64 || b < 0.0 {
@@ -273,7 +274,9 @@ impl TriDexel {
         let mut n = [0usize; 3];
         for k in 0..3 {
             if !(lo[k].is_finite() && hi[k].is_finite() && hi[k] >= lo[k]) {
-                return Err(SimError::InvalidStock("bounding box is empty or not finite".into()));
+                return Err(SimError::InvalidStock(
+                    "bounding box is empty or not finite".into(),
+                ));
             }
             min[k] = lo[k] - cell;
             let cells = ((hi[k] + cell - min[k]) / cell).ceil();

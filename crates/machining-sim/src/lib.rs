@@ -13,12 +13,14 @@
 //! Dependencies: parry3d-f64 (workspace choice) for the BVH over the design mesh; rayon for
 //! the per-row parallelism.
 
+pub mod collision;
 pub mod design;
 pub mod dexel;
 pub mod error;
 pub mod measure;
 pub mod motion;
 pub mod removal;
+pub mod simulate;
 pub mod stock_shape;
 pub mod tool_solid;
 
@@ -27,4 +29,8 @@ pub use dexel::{DexelGrid, Segments, TriDexel};
 pub use error::SimError;
 pub use measure::{Extremum, SurfaceMap};
 pub use motion::Interpolation;
+pub use removal::PartKind;
+pub use simulate::{
+    cut, simulate, Collision, CollisionTarget, CutOutcome, Metrics, Report, SimOptions, SimStats,
+};
 pub use stock_shape::{BoxStock, RevolvedStock, StockShape};

@@ -68,7 +68,14 @@ pub struct Probe {
 }
 
 /// Measures overcut and residual at `p` with outward unit normal `n`, up to `max_depth` mm.
-pub fn probe(stock: &TriDexel, design: &dyn DesignModel, p: &Point3, n: &Vector3, max_depth: f64) -> Probe {
+pub fn probe(
+    stock: &TriDexel,
+    initial: &TriDexel,
+    design: &dyn DesignModel,
+    p: &Point3,
+    n: &Vector3,
+    max_depth: f64,
+) -> Probe {
     let d = (0..3)
         .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
         .unwrap_or(2);
@@ -76,13 +83,19 @@ pub fn probe(stock: &TriDexel, design: &dyn DesignModel, p: &Point3, n: &Vector3
         let x = p + n * t;
         stock.contains_via(d, &[x.x, x.y, x.z])
     };
+    // "Not removed": material now, or never material (outside the blank).
+    let kept = |t: f64| {
+        let x = p + n * t;
+        let x = [x.x, x.y, x.z];
+        stock.contains_via(d, &x) || !initial.contains_via(d, &x)
+    };
     let h = stock.cell();
     let step = 0.5 * h;
-    let refine = |mut a: f64, mut b: f64, occ_a: bool| {
-        // Transition lies between a (state occ_a) and b (the other state).
+    let refine = |mut a: f64, mut b: f64, occ_a: bool, f: &dyn Fn(f64) -> bool| {
+        // Transition of `f` lies between a (state occ_a) and b (the other state).
         while (b - a).abs() > h / 64.0 {
             let m = 0.5 * (a + b);
-            if occ(m) == occ_a {
+            if f(m) == occ_a {
                 a = m;
             } else {
                 b = m;
@@ -91,10 +104,20 @@ pub fn probe(stock: &TriDexel, design: &dyn DesignModel, p: &Point3, n: &Vector3
         0.5 * (a + b)
     };
     let sd = |t: f64| design.signed_distance(&(p + n * t));
+    if kept(0.0) && !occ(0.0) {
+        return Probe {
+            overcut: 0.0,
+            residual: 0.0,
+        };
+    }
+    // A line point within `h` of another part of the design boundary is ambiguous (the
+    // nearest ray may lie on either side): the march stops once the design distance falls
+    // below min(t, h)/2 and reports the last unambiguous depth.
+    let margin = |t: f64| 0.5 * t.min(h);
     if occ(0.0) {
-        // Residual: march outward while in material, stop when re-entering the design.
+        // Residual: march outward while in material, stop near/inside the design again.
         let mut t = 0.0;
-        let mut safe = 0.0; // design-free up to this t
+        let mut safe = 0.0;
         loop {
             let next = t + step;
             if next > max_depth {
@@ -105,58 +128,62 @@ pub fn probe(stock: &TriDexel, design: &dyn DesignModel, p: &Point3, n: &Vector3
             }
             if next > safe {
                 let s = sd(next);
-                if s < 0.0 && next > step {
+                if s < margin(next) {
                     return Probe {
                         overcut: 0.0,
-                        residual: next,
+                        residual: t,
                     };
                 }
-                safe = next + s.max(0.0);
+                safe = next + (s - 0.5 * h).max(0.0) / 1.5;
             }
             if !occ(next) {
                 return Probe {
                     overcut: 0.0,
-                    residual: refine(t, next, true),
+                    residual: refine(t, next, true, &occ),
                 };
             }
             t = next;
         }
     } else {
-        // Overcut: march inward while empty, stop when leaving the design.
+        // Overcut: march inward while removed; the value is the deepest removed point's
+        // distance inside the design, −sd (= t on a flat face).
         let mut t = 0.0;
-        let mut safe = 0.0;
+        let mut best: f64 = 0.0;
         loop {
             let next = t + step;
             if next > max_depth {
                 return Probe {
-                    overcut: max_depth,
+                    overcut: best,
                     residual: 0.0,
                 };
             }
-            if next > safe {
-                let s = sd(-next);
-                if s > 0.0 && next > step {
-                    return Probe {
-                        overcut: next,
-                        residual: 0.0,
-                    };
-                }
-                safe = next + (-s).max(0.0);
-            }
-            if occ(-next) {
+            if kept(-next) {
+                let tt = refine(-t, -next, false, &kept).abs();
+                best = best.max(-sd(-tt));
                 return Probe {
-                    overcut: refine(-t, -next, false).abs(),
+                    overcut: best,
                     residual: 0.0,
                 };
             }
+            let s = sd(-next);
+            if s > 0.0 {
+                // Left the design (cut through a wall).
+                return Probe {
+                    overcut: best,
+                    residual: 0.0,
+                };
+            }
+            best = best.max(-s);
             t = next;
         }
     }
 }
 
-/// Measures every sample of every grid (parallel over samples).
+/// Measures every sample of every grid (parallel over samples); `initial` is the blank
+/// before machining (removed = material in `initial`, none in `stock`).
 pub fn measure_maps(
     stock: &TriDexel,
+    initial: &TriDexel,
     design: &dyn DesignModel,
     grids: &[SurfaceGrid],
     max_depth: f64,
@@ -171,7 +198,7 @@ pub fn measure_maps(
                 .map(|(p, n)| {
                     let len = n.norm();
                     if len > 1e-12 && len.is_finite() {
-                        Some(probe(stock, design, p, &(n / len), max_depth))
+                        Some(probe(stock, initial, design, p, &(n / len), max_depth))
                     } else {
                         None
                     }
@@ -193,7 +220,11 @@ pub fn measure_maps(
 pub fn extremum(maps: &[SurfaceMap], residual: bool, max_depth: f64) -> Option<Extremum> {
     let mut best: Option<Extremum> = None;
     for m in maps {
-        let vals = if residual { &m.residual_mm } else { &m.overcut_mm };
+        let vals = if residual {
+            &m.residual_mm
+        } else {
+            &m.overcut_mm
+        };
         for (k, v) in vals.iter().enumerate() {
             let Some(v) = *v else { continue };
             if best.as_ref().is_none_or(|b| v > b.value_mm) {

@@ -115,7 +115,8 @@ pub fn positions_for_move(
     let mut prev = *from;
     for k in 1..=sub {
         let cur = interp.at(op, index, from, to, k as f64 / sub as f64);
-        disp += (cur.tip - prev.tip).norm() + h * (cur.axis.into_inner() - prev.axis.into_inner()).norm();
+        disp += (cur.tip - prev.tip).norm()
+            + h * (cur.axis.into_inner() - prev.axis.into_inner()).norm();
         prev = cur;
     }
     if !(disp.is_finite()) || disp <= 0.0 {
@@ -152,7 +153,10 @@ mod tests {
         let a = CutterLocation::vertical(Point3::new(0.0, 0.0, 0.0));
         let b = CutterLocation::vertical(Point3::new(10.0, 0.0, 0.0));
         // sqrt(8·2·0.01) = 0.4 mm → 25 positions for 10 mm.
-        assert_eq!(positions_for_move(&ball, &Interpolation::Tcp, 0, 0, &a, &b, 0.01), 25);
+        assert_eq!(
+            positions_for_move(&ball, &Interpolation::Tcp, 0, 0, &a, &b, 0.01),
+            25
+        );
         let flat = Cutter::new("f", CutterShape::FlatEnd { radius: 2.0 }, 10.0, 2.0, 30.0).unwrap();
         let c = CutterLocation::vertical(Point3::new(10.0, 0.0, 10.0));
         // 45° ramp: factor 1/2 → step 0.02, displacement 14.14 → 708 positions.
@@ -160,9 +164,13 @@ mod tests {
         assert_eq!(n, (200f64.sqrt() / 0.02).ceil() as usize);
         // Pure plunge along the axis: no stair, scallop bound only.
         let d = CutterLocation::vertical(Point3::new(0.0, 0.0, -4.0));
-        assert_eq!(positions_for_move(&flat, &Interpolation::Tcp, 0, 0, &a, &d, 0.01), 10);
+        assert_eq!(
+            positions_for_move(&flat, &Interpolation::Tcp, 0, 0, &a, &d, 0.01),
+            10
+        );
         // Axis rotation counts with the flute length.
-        let e = CutterLocation::new(Point3::new(0.0, 0.0, 0.0), Vector3::new(0.1, 0.0, 1.0)).unwrap();
+        let e =
+            CutterLocation::new(Point3::new(0.0, 0.0, 0.0), Vector3::new(0.1, 0.0, 1.0)).unwrap();
         assert!(positions_for_move(&ball, &Interpolation::Tcp, 0, 0, &a, &e, 0.01) >= 3);
     }
 }

@@ -113,7 +113,13 @@ impl Range2 {
 
 /// Clips a piece of a solid placed at (tip, axis) to the box `[lo, hi]` inflated by the
 /// piece's radius; returns the clipped piece as a frustum/sphere/torus slab.
-fn clip_piece(p: &Piece, tip: &[f64; 3], axis: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3]) -> Option<Piece> {
+fn clip_piece(
+    p: &Piece,
+    tip: &[f64; 3],
+    axis: &[f64; 3],
+    lo: &[f64; 3],
+    hi: &[f64; 3],
+) -> Option<Piece> {
     let (mut h0, mut h1) = p.heights();
     let r = p.max_radius();
     for k in 0..3 {
@@ -308,8 +314,7 @@ pub fn apply_batch(
                                         PartKind::Holder => 1,
                                         PartKind::RapidMove => 2,
                                     };
-                                    if ov > collision_tol
-                                        && best[slot].is_none_or(|h| h.depth < ov)
+                                    if ov > collision_tol && best[slot].is_none_or(|h| h.depth < ov)
                                     {
                                         let mut point = [0.0; 3];
                                         point[ua] = u;

@@ -110,7 +110,11 @@ impl RevolvedStock {
 impl StockShape for RevolvedStock {
     fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
         let rmax = self.profile.iter().map(|p| p.1).fold(0.0, f64::max);
-        let zmin = self.profile.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+        let zmin = self
+            .profile
+            .iter()
+            .map(|p| p.0)
+            .fold(f64::INFINITY, f64::min);
         let zmax = self
             .profile
             .iter()

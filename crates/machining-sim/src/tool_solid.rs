@@ -613,7 +613,13 @@ fn segments_for(radius: f64, span: f64, chord_tol: f64) -> usize {
 mod tests {
     use super::*;
 
-    fn brute(solid: &RevolvedSolid, d: usize, du: f64, dv: f64, axis: [f64; 3]) -> Option<(f64, f64)> {
+    fn brute(
+        solid: &RevolvedSolid,
+        d: usize,
+        du: f64,
+        dv: f64,
+        axis: [f64; 3],
+    ) -> Option<(f64, f64)> {
         let mut first = None;
         let mut last = None;
         let n = 40_000;
@@ -674,7 +680,8 @@ mod tests {
                         match (got, want) {
                             (Some(g), Some(w)) => {
                                 assert!(
-                                    (g.0 - w.0).abs() <= 1.5 * step && (g.1 - w.1).abs() <= 1.5 * step,
+                                    (g.0 - w.0).abs() <= 1.5 * step
+                                        && (g.1 - w.1).abs() <= 1.5 * step,
                                     "{:?} axis {axis:?} d {d} ({du},{dv}): {g:?} vs {w:?}",
                                     c.shape
                                 );
