@@ -17,12 +17,14 @@ pub mod collision;
 pub mod design;
 pub mod dexel;
 pub mod error;
+pub mod export;
 pub mod impeller_design;
 pub mod measure;
 pub mod motion;
 pub mod removal;
 pub mod simulate;
 pub mod stock_shape;
+pub mod surface_mesh;
 pub mod tool_solid;
 
 pub use design::{BoxDesign, CylinderDesign, DesignModel, SurfaceGrid, TriangleMesh, UnionDesign};
@@ -36,3 +38,4 @@ pub use simulate::{
     cut, simulate, Collision, CollisionTarget, CutOutcome, Metrics, Report, SimOptions, SimStats,
 };
 pub use stock_shape::{BoxStock, RevolvedStock, StockShape};
+pub use surface_mesh::{extract_surface, write_stl, StockMesh};
