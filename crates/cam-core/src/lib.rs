@@ -5,16 +5,24 @@
 //! `f64` throughout. A cutter location is the tool *tip* (lowest point of the cutter on its
 //! axis) plus the unit tool axis pointing from the tip toward the spindle (APT convention).
 
+pub mod apt;
+pub mod assembly;
 pub mod cutter;
 pub mod error;
+pub mod guide;
 pub mod location;
 pub mod path;
+pub mod sphere_family;
 pub mod tolerance;
 
+pub use apt::{AptCutter, APT_CONSISTENCY_TOL};
+pub use assembly::Frustum;
 pub use cutter::{Cutter, CutterShape, HolderSegment};
 pub use error::CamError;
+pub use guide::{GuideCurve, GuideEval, MAX_GUIDE_DEGREE};
 pub use location::CutterLocation;
 pub use path::{Move, MoveKind, Rates, ToolPath};
+pub use sphere_family::{SphereFamily, SpherePiece, SweptSphere};
 pub use tolerance::Tolerances;
 
 /// Point in the workpiece frame (mm).
