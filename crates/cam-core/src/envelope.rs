@@ -60,7 +60,9 @@
 //! - plain sphere: `G_v = v/|v|` (the unit normal `n`), `G_a = 0`;
 //! - beyond a disc rim (`w > e`, `g = w − e`, `Q = √(z² + g²)`):
 //!   `G_v = (z·a + g·(v − z a)/w)/Q`, `G_a = z(1 − g/w)·v/Q`, `∂F/∂e = −g/Q`;
-//! - over a disc (`w <= e`): `G_v = sign(z)·a`, `G_a = sign(z)·v`, `∂F/∂e = 0`;
+//! - over a disc (`w <= e`): `G_v = σ·a`, `G_a = σ·v`, `∂F/∂e = 0`, with `σ = sign(z)`, except
+//!   at the kink `z = 0` where the minimising member's centre plane passes through `p`: there
+//!   the value is `−ρ(t*)` with `c(t*) = z`, which gives `σ = −ρ'/c'` (0 for a bull nose);
 //! - point: `∂d/∂p = G_v` (the unit outward normal of the envelope at the foot point);
 //! - axis: `∂F/∂a = G_a − m·G_v`, projected on the sphere of unit vectors,
 //!   `∂F/∂D = (I − a aᵀ)·∂F/∂a / ℓ`;
@@ -79,6 +81,10 @@ use crate::guide::GuideEval;
 use crate::{CamError, CutterLocation, GuideCurve, Point3, SphereFamily, Vector3};
 
 const NB: usize = crate::guide::MAX_GUIDE_DEGREE + 1;
+
+/// A point whose height above a disc member's centre plane is below this (mm) is treated as
+/// lying in that plane (the kink of `|z − c(t)|` where the exact `t`-minimisation puts it).
+pub const KINK_TOL_MM: f64 = 1e-9;
 
 /// Named numerical settings of [`SweptEnvelope`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -165,8 +171,9 @@ impl ControlPointGradient {
 /// First-order change of the signed distance (envelope theorem; see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnvelopeGradient {
-    /// `∂d/∂p`: unit normal of the envelope at the foot point, pointing toward `p` from
-    /// outside.
+    /// `∂d/∂p`: outside the swept volume the unit normal of the envelope at the foot point
+    /// (pointing toward `p`); inside, the gradient of the deepest-member depth (a unit vector
+    /// too, except at the kink over a disc, see the module docs).
     pub point: Vector3,
     /// Sensitivity to the control points of `P0` (the lower guide).
     pub guide0: ControlPointGradient,
@@ -200,6 +207,8 @@ struct Frame {
 /// `F` and its first and second derivatives in `(s, τ)`, plus the pieces needed later.
 #[derive(Debug, Clone, Copy)]
 struct Local {
+    /// `F` itself (the Newton loop takes it from the exact `t`-minimisation instead).
+    #[cfg_attr(not(test), allow(dead_code))]
     f: f64,
     g: [f64; 2],
     h: [[f64; 2]; 2],
@@ -315,7 +324,7 @@ impl SweptEnvelope {
         let p0 = self.guide0.point(s);
         let d = self.guide1.point(s) - p0;
         let ell = d.norm();
-        if !(ell >= self.opts.min_axis_length) {
+        if ell.is_nan() || ell < self.opts.min_axis_length {
             return Err(CamError::DegenerateAxis { s });
         }
         let a = d / ell;
@@ -344,7 +353,7 @@ impl SweptEnvelope {
         let d1 = e1.d[1] - e0.d[1];
         let d2 = e1.d[2] - e0.d[2];
         let ell = d.norm();
-        if !(ell >= self.opts.min_axis_length) {
+        if ell.is_nan() || ell < self.opts.min_axis_length {
             return Err(CamError::DegenerateAxis { s });
         }
         let a = d / ell;
@@ -432,7 +441,7 @@ impl SweptEnvelope {
                 q_i = qi;
                 q_ij = [[h(0, 0), h(0, 1)], [h(0, 1), h(1, 1)]];
             } else {
-                let sg = if z < 0.0 { -1.0 } else { 1.0 };
+                let sg = flat_sign(z, piece);
                 q = z.abs();
                 q_i = [sg * z_i[0], sg * z_i[1]];
                 q_ij = [[sg * zz(0, 0), sg * zz(0, 1)], [sg * zz(0, 1), 0.0]];
@@ -626,7 +635,7 @@ impl SweptEnvelope {
                     (radial_or_axis(&v, &a, w), Vector3::zeros(), -1.0)
                 }
             } else {
-                let sg = if z < 0.0 { -1.0 } else { 1.0 };
+                let sg = flat_sign(z, piece);
                 (a * sg, v * sg, 0.0)
             }
         };
@@ -673,6 +682,21 @@ impl SweptEnvelope {
     }
 }
 
+/// `∂|z|/∂z` over a disc, where `z` is the height of `p` above the member's centre plane. At
+/// the kink `z = 0` reached by the exact `t`-minimisation (p lies in the centre plane of a
+/// member containing it) the value is `min_t (|z − c(t)| − ρ(t)) = −ρ(t*)` with `c(t*) = z`, so
+/// its derivative follows `t*`: the effective slope is `−ρ'/c'` (0 for a bull nose: the depth
+/// `−ρ` is locally constant).
+fn flat_sign(z: f64, piece: &crate::SpherePiece) -> f64 {
+    if z.abs() <= KINK_TOL_MM && piece.height[1] != 0.0 {
+        -piece.radius[1] / piece.height[1]
+    } else if z < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
 /// Unit radial direction of `v` (or the axis when `v` is on it).
 fn radial_or_axis(v: &Vector3, a: &Vector3, w: f64) -> Vector3 {
     if w > 0.0 {
@@ -706,6 +730,7 @@ mod tests {
 
     /// `local` derivatives against central differences of `F`, for sphere and disc pieces.
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn local_derivatives_match_finite_differences() {
         let g0 = guide(&[
             [0.0, 0.0, 0.0],

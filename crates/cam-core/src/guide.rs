@@ -93,6 +93,34 @@ impl GuideCurve {
         })
     }
 
+    /// Copies a `nurbs` space curve (rational or not) into a guide.
+    pub fn from_curve(curve: &nurbs::Curve3) -> Result<Self, CamError> {
+        let ctrl = curve
+            .control_points()
+            .iter()
+            .map(|q| Vector3::new(q[0], q[1], q[2]))
+            .collect();
+        Self::new(
+            curve.degree(),
+            curve.knots().knots().to_vec(),
+            ctrl,
+            curve.weights().map(<[f64]>::to_vec),
+        )
+    }
+
+    /// The guide as a `nurbs` curve (e.g. after an optimiser moved its control points).
+    pub fn to_curve(&self) -> Result<nurbs::Curve3, CamError> {
+        nurbs::Curve3::new(
+            self.degree,
+            self.knots.clone(),
+            self.ctrl.clone(),
+            self.weights.clone(),
+        )
+        .map_err(|_| CamError::InvalidGuide {
+            reason: "rejected by nurbs::NurbsCurve::new",
+        })
+    }
+
     /// Degree.
     pub fn degree(&self) -> usize {
         self.degree
@@ -226,13 +254,12 @@ impl GuideCurve {
         let mut basis = [0.0; NB];
         match &self.weights {
             None => {
-                for j in 0..=p {
-                    let q = &self.ctrl[first + j];
+                for (j, q) in self.ctrl[first..=first + p].iter().enumerate() {
                     d[0] += q * n[0][j];
                     d[1] += q * n[1][j];
                     d[2] += q * n[2][j];
-                    basis[j] = n[0][j];
                 }
+                basis[..=p].copy_from_slice(&n[0][..=p]);
             }
             Some(w) => {
                 let mut aw = [Vector3::zeros(); 3];
@@ -358,6 +385,23 @@ mod tests {
                 .map(|i| c.control_points()[e.first + i] * e.basis[i])
                 .sum();
             assert!((q - e.d[0]).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)]
+    fn agrees_with_the_nurbs_crate() {
+        let c = cubic();
+        let n = c.to_curve().unwrap();
+        let back = GuideCurve::from_curve(&n).unwrap();
+        assert_eq!(back, c);
+        for &u in &[0.0, 0.2, 0.5, 0.8, 1.0] {
+            let d = n.derivs(u, 2);
+            let e = c.eval2(u);
+            for k in 0..3 {
+                let dk = Vector3::new(d[k][0], d[k][1], d[k][2]);
+                assert!((dk - e.d[k]).norm() < 1e-9 * (1.0 + dk.norm()), "{u} {k}");
+            }
         }
     }
 
