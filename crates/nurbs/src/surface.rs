@@ -5,6 +5,7 @@
 use nalgebra::Vector3;
 
 use crate::error::{Direction, NurbsError};
+use crate::homogeneous::HSpline;
 use crate::knots::{basis_funs_fixed, clamp_param, ders_basis_fixed, find_span, KnotVector};
 use crate::util::binomial;
 use crate::MAX_ORDER;
@@ -511,8 +512,64 @@ impl NurbsSurface {
         self.derivs2(u, v).normal()
     }
 
+    /// Applies a knot algorithm to every control line running along `dir` (columns for
+    /// `U`, rows for `V`) in homogeneous space and reassembles the surface. All lines get
+    /// the same new knot vector because the algorithms depend on the knots only.
+    pub(crate) fn map_lines(
+        &self,
+        dir: Direction,
+        f: impl Fn(&HSpline) -> HSpline,
+    ) -> Result<NurbsSurface, NurbsError> {
+        let (kv, count) = match dir {
+            Direction::U => (&self.knots_u, self.n_v),
+            Direction::V => (&self.knots_v, self.n_u),
+        };
+        let dim = if self.weights.is_some() { 4 } else { 3 };
+        let lines: Vec<HSpline> = (0..count)
+            .map(|idx| {
+                f(&HSpline {
+                    p: kv.degree(),
+                    knots: kv.knots().to_vec(),
+                    pts: self.homogeneous_line(dir, idx),
+                    dim,
+                })
+            })
+            .collect();
+        let Some(first) = lines.first() else {
+            return Ok(self.clone());
+        };
+        let new_kv =
+            KnotVector::new(first.p, first.knots.clone()).map_err(|e| e.in_direction(dir))?;
+        let len = first.n_ctrl();
+        let (n_u, n_v) = match dir {
+            Direction::U => (len, self.n_v),
+            Direction::V => (self.n_u, len),
+        };
+        let mut ctrl = vec![Vector3::zeros(); n_u * n_v];
+        let mut weights = self.weights.as_ref().map(|_| vec![1.0; n_u * n_v]);
+        for (line_idx, line) in lines.iter().enumerate() {
+            for (k, c) in line.pts.chunks_exact(dim).enumerate() {
+                let idx = match dir {
+                    Direction::U => k * n_v + line_idx,
+                    Direction::V => line_idx * n_v + k,
+                };
+                match weights.as_mut() {
+                    None => ctrl[idx] = Vector3::new(c[0], c[1], c[2]),
+                    Some(w) => {
+                        ctrl[idx] = Vector3::new(c[0] / c[3], c[1] / c[3], c[2] / c[3]);
+                        w[idx] = c[3];
+                    }
+                }
+            }
+        }
+        let (ku, kv) = match dir {
+            Direction::U => (new_kv, self.knots_v.clone()),
+            Direction::V => (self.knots_u.clone(), new_kv),
+        };
+        NurbsSurface::from_flat_checked(ku, kv, n_u, n_v, ctrl, weights)
+    }
+
     /// Homogeneous data of column `j` (points along `u`) or row `i` (along `v`).
-    #[allow(dead_code)]
     pub(crate) fn homogeneous_line(&self, dir: Direction, index: usize) -> Vec<f64> {
         let (count, stride, start) = match dir {
             Direction::U => (self.n_u, self.n_v, index),
