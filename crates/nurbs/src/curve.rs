@@ -149,6 +149,19 @@ impl<const D: usize> NurbsCurve<D> {
         Self::from_homogeneous(kv, &h.pts, rational)
     }
 
+    /// Same knots and weights, control points mapped by `f` (callers guarantee `f`
+    /// keeps finite points finite, e.g. a rigid motion).
+    pub(crate) fn map_control_points(
+        &self,
+        f: impl Fn(SVector<f64, D>) -> SVector<f64, D>,
+    ) -> Self {
+        NurbsCurve {
+            knots: self.knots.clone(),
+            ctrl: self.ctrl.iter().map(|p| f(*p)).collect(),
+            weights: self.weights.clone(),
+        }
+    }
+
     /// Parameter domain `[u_p, u_{m-p}]`.
     #[inline]
     pub fn domain(&self) -> (f64, f64) {

@@ -261,7 +261,11 @@ impl HSpline {
             let oldr = r;
             r = p as isize - mul as isize;
             let lbz = if oldr > 0 { (oldr as usize + 2) / 2 } else { 1 };
-            let rbz = if r > 0 { ph - (r as usize).div_ceil(2) } else { ph };
+            let rbz = if r > 0 {
+                ph - (r as usize).div_ceil(2)
+            } else {
+                ph
+            };
             if r > 0 {
                 // insert knot u(b) r times to get the Bézier segment
                 let numer = ub - ua;

@@ -47,13 +47,15 @@ pub struct SurfaceDerivs2 {
 }
 
 impl SurfaceDerivs2 {
-    /// Unit normal `su × sv / |su × sv|`, or `None` where the surface is singular
-    /// (`|su × sv| <= 1e-14 · |su| |sv|`, or either tangent vanishes, e.g. at a pole).
+    /// Unit normal `su × sv / |su × sv|`, or `None` where the parametrisation is singular:
+    /// `|su × sv| <= 1e-12 · max(|su|, |sv|)²` (parallel tangents, or one tangent vanishing
+    /// relative to the other as at the pole of a surface of revolution, where rounding
+    /// leaves `|su| ≈ 1e-16 |sv|`), or non-finite derivatives.
     pub fn normal(&self) -> Option<Vector3<f64>> {
         let n = self.su.cross(&self.sv);
         let len = n.norm();
-        let scale = self.su.norm() * self.sv.norm();
-        if len > 0.0 && len > 1e-14 * scale {
+        let big = self.su.norm().max(self.sv.norm());
+        if len > 0.0 && len > 1e-12 * big * big {
             Some(n / len)
         } else {
             None
@@ -237,6 +239,19 @@ impl NurbsSurface {
             ctrl,
             weights,
         })
+    }
+
+    /// Same knots and weights, control points mapped by `f` (callers guarantee `f`
+    /// keeps finite points finite, e.g. a rigid motion).
+    pub(crate) fn map_control_points(&self, f: impl Fn(Vector3<f64>) -> Vector3<f64>) -> Self {
+        NurbsSurface {
+            knots_u: self.knots_u.clone(),
+            knots_v: self.knots_v.clone(),
+            n_u: self.n_u,
+            n_v: self.n_v,
+            ctrl: self.ctrl.iter().map(|p| f(*p)).collect(),
+            weights: self.weights.clone(),
+        }
     }
 
     /// Parameter domain `((u_min, u_max), (v_min, v_max))`.
