@@ -456,16 +456,26 @@ impl SweptEnvelope {
         }
     }
 
+    /// `min_t F(s, t)` at a frame: (value, global t).
+    fn g_frame(&self, p: &Vector3, fr: &Frame) -> (f64, f64) {
+        let v = p - (fr.p0[0] - fr.a * self.guide_height);
+        let z = v.dot(&fr.a);
+        let w = (v.norm_squared() - z * z).max(0.0).sqrt();
+        self.family.signed_distance(w, z)
+    }
+
     /// Newton on `g(s) = min_t F(s, t)` from `s`; returns (value, s, t, iterations).
+    /// Each iteration evaluates both guides once (with two derivatives) at the trial point,
+    /// which is reused as the next iterate when the full step is accepted.
     fn polish(&self, p: &Vector3, s_start: f64) -> Result<(f64, f64, f64, usize), CamError> {
         let (lo, hi) = self.domain;
         let mut s = s_start.clamp(lo, hi);
-        let (mut f, mut t) = self.g_at(p, s)?;
+        let mut fr = self.frame(s)?;
+        let (mut f, mut t) = self.g_frame(p, &fr);
         let n_pieces = self.family.pieces().len() as f64;
         let mut iters = 0;
         while iters < self.opts.max_iterations {
             iters += 1;
-            let fr = self.frame(s)?;
             let loc = self.local(p, &fr, t);
             let gs = loc.g[0];
             if (s <= lo && gs >= 0.0) || (s >= hi && gs <= 0.0) {
@@ -478,28 +488,39 @@ impl SweptEnvelope {
             if t_interior && loc.h[1][1] > 1e-12 * (loc.h[0][0].abs() + 1.0) {
                 gss -= loc.h[0][1] * loc.h[0][1] / loc.h[1][1];
             }
-            let range = hi - lo;
             let step = if gss > 0.0 {
                 -gs / gss
             } else {
-                -gs.signum() * 0.05 * range
+                -gs.signum() * 0.05 * (hi - lo)
             };
+            // Converged when the (projected) Newton step would move the centre less than
+            // step_tol, or would lower F by less than its rounding noise (the line search
+            // could not see the decrease; the remaining error is below that noise).
+            if gss > 0.0 {
+                let ds = (s + step).clamp(lo, hi) - s;
+                let noise = 64.0 * f64::EPSILON * (1.0 + p.amax() + fr.p0[0].amax());
+                if ds.abs() * loc.speed[0] < self.opts.step_tol || -gs * ds < noise {
+                    break;
+                }
+            }
             let mut alpha = 1.0;
             let mut accepted = None;
             while alpha > 1e-12 {
                 let s_new = (s + alpha * step).clamp(lo, hi);
-                let (f_new, t_new) = self.g_at(p, s_new)?;
+                let fr_new = self.frame(s_new)?;
+                let (f_new, t_new) = self.g_frame(p, &fr_new);
                 if f_new <= f + 1e-4 * gs * (s_new - s) {
-                    accepted = Some((s_new, f_new, t_new));
+                    accepted = Some((s_new, fr_new, f_new, t_new));
                     break;
                 }
                 alpha *= 0.5;
             }
-            let Some((s_new, f_new, t_new)) = accepted else {
+            let Some((s_new, fr_new, f_new, t_new)) = accepted else {
                 break; // no decrease possible at this resolution: converged
             };
             let moved = (s_new - s).abs() * loc.speed[0];
             s = s_new;
+            fr = fr_new;
             f = f_new;
             t = t_new;
             if moved < self.opts.step_tol {
