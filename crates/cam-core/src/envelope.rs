@@ -337,15 +337,6 @@ impl SweptEnvelope {
         CutterLocation::new(Point3::from(tip), axis)
     }
 
-    /// `min_t F(s, t)` at `s`: (value, global t).
-    fn g_at(&self, p: &Vector3, s: f64) -> Result<(f64, f64), CamError> {
-        let (tip, a) = self.tip_axis(s)?;
-        let v = p - tip;
-        let z = v.dot(&a);
-        let w = (v.norm_squared() - z * z).max(0.0).sqrt();
-        Ok(self.family.signed_distance(w, z))
-    }
-
     fn frame(&self, s: f64) -> Result<Frame, CamError> {
         let e0 = self.guide0.eval2(s);
         let e1 = self.guide1.eval2(s);
