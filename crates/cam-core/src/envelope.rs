@@ -77,6 +77,31 @@
 //! minimum (e.g. a point below a flat bottom, equidistant from several members) it is one
 //! valid one-sided derivative.
 
+//!
+//! # Example
+//!
+//! ```
+//! use cam_core::{CutterShape, EnvelopeOptions, GuideCurve, Point3, SphereFamily,
+//!                SweptEnvelope, Vector3};
+//! // A 3 mm ball, 3° taper, moving 50 mm along +x with a vertical axis.
+//! let shape = CutterShape::TaperedBallEnd { ball_radius: 3.0, half_angle: 3f64.to_radians() };
+//! let family = SphereFamily::from_shape(&shape, 25.0)?;
+//! let line = |z: f64| GuideCurve::new(1, vec![0.0, 0.0, 1.0, 1.0],
+//!     vec![Vector3::new(0.0, 0.0, z), Vector3::new(50.0, 0.0, z)], None);
+//! let env = SweptEnvelope::new(family, line(0.0)?, line(10.0)?, 0.0,
+//!                              EnvelopeOptions::default())?;
+//! // 1 mm below the tip line: outside, 1 mm away.
+//! let (d, grad) = env.signed_distance_with_gradient(&Point3::new(25.0, 0.0, -1.0), None)?;
+//! assert!((d.distance - 1.0).abs() < 1e-12);
+//! assert!((grad.point - Vector3::new(0.0, 0.0, -1.0)).norm() < 1e-9);
+//! // ∂d/∂(ball radius) = 0 here: the tip (lowest point) stays on the guide when r grows.
+//! assert!(grad.shape[0].abs() < 1e-9);
+//! // Warm start for the next point along the path.
+//! let next = env.signed_distance(&Point3::new(26.0, 0.0, -1.0), Some(d.param))?;
+//! assert!((next.distance - 1.0).abs() < 1e-12);
+//! # Ok::<(), cam_core::CamError>(())
+//! ```
+
 use crate::guide::GuideEval;
 use crate::{CamError, CutterLocation, GuideCurve, Point3, SphereFamily, Vector3};
 
@@ -291,6 +316,23 @@ impl SweptEnvelope {
         seeds.push(env.seed_at(d0.1)?);
         env.seeds = seeds;
         Ok(env)
+    }
+
+    /// Convenience: the envelope of `cutter`'s fluted part moving along two `nurbs` guides.
+    pub fn for_cutter(
+        cutter: &crate::Cutter,
+        guide0: &nurbs::Curve3,
+        guide1: &nurbs::Curve3,
+        guide_height: f64,
+        opts: EnvelopeOptions,
+    ) -> Result<Self, CamError> {
+        Self::new(
+            SphereFamily::from_cutter(cutter)?,
+            GuideCurve::from_curve(guide0)?,
+            GuideCurve::from_curve(guide1)?,
+            guide_height,
+            opts,
+        )
     }
 
     fn seed_at(&self, s: f64) -> Result<Seed, CamError> {

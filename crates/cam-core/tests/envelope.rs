@@ -359,6 +359,36 @@ fn tapered_flat_derivatives_match_central_differences() {
 }
 
 #[test]
+fn builds_from_a_cutter_and_nurbs_guides() {
+    let cutter = cam_core::Cutter::new(
+        "tb",
+        CutterShape::TaperedBallEnd {
+            ball_radius: 3.0,
+            half_angle: 0.05,
+        },
+        25.0,
+        5.0,
+        60.0,
+    )
+    .unwrap();
+    let (g0, g1) = flank_guides(0.0);
+    let env = SweptEnvelope::for_cutter(
+        &cutter,
+        &g0.to_curve().unwrap(),
+        &g1.to_curve().unwrap(),
+        0.0,
+        EnvelopeOptions::default(),
+    )
+    .unwrap();
+    let reference = envelope(cutter.shape, 25.0, g0, g1, 0.0);
+    let p = Point3::new(30.0, 4.0, 6.0);
+    assert_eq!(
+        env.signed_distance(&p, None).unwrap(),
+        reference.signed_distance(&p, None).unwrap()
+    );
+}
+
+#[test]
 fn invalid_inputs_are_typed_errors() {
     let (g0, g1) = flank_guides(0.0);
     let fam = SphereFamily::from_shape(&CutterShape::BallEnd { radius: 3.0 }, 20.0).unwrap();
