@@ -251,6 +251,8 @@ pub struct SweptEnvelope {
     domain: (f64, f64),
     seeds: Vec<Seed>,
     opts: EnvelopeOptions,
+    /// Both guides have the same degree and knots: one basis evaluation per frame.
+    shared_basis: bool,
 }
 
 impl SweptEnvelope {
@@ -297,7 +299,9 @@ impl SweptEnvelope {
         breaks.extend(guide1.breakpoints());
         breaks.sort_by(f64::total_cmp);
         breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * scale);
+        let shared_basis = guide0.shares_basis_with(&guide1);
         let mut env = Self {
+            shared_basis,
             family,
             guide0,
             guide1,
@@ -380,8 +384,15 @@ impl SweptEnvelope {
     }
 
     fn frame(&self, s: f64) -> Result<Frame, CamError> {
-        let e0 = self.guide0.eval2(s);
-        let e1 = self.guide1.eval2(s);
+        let (e0, e1) = if self.shared_basis {
+            let (span, n) = self.guide0.basis2(s);
+            (
+                self.guide0.combine2(span, &n),
+                self.guide1.combine2(span, &n),
+            )
+        } else {
+            (self.guide0.eval2(s), self.guide1.eval2(s))
+        };
         let d = e1.d[0] - e0.d[0];
         let d1 = e1.d[1] - e0.d[1];
         let d2 = e1.d[2] - e0.d[2];

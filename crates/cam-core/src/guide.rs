@@ -243,12 +243,29 @@ impl GuideCurve {
     /// Point and first two derivatives at `u` (clamped to the domain), with the rational basis.
     /// No allocation; O(p²).
     pub fn eval2(&self, u: f64) -> GuideEval {
-        let p = self.degree;
+        let (span, n) = self.basis2(u);
+        self.combine2(span, &n)
+    }
+
+    /// True when `other` has the same degree and knots, so one basis evaluation serves both
+    /// ([`Self::basis2`] / [`Self::combine2`]; weights may differ).
+    pub fn shares_basis_with(&self, other: &GuideCurve) -> bool {
+        self.degree == other.degree && self.knots == other.knots
+    }
+
+    /// Knot span and non-rational basis functions with two derivatives at `u` (clamped).
+    pub(crate) fn basis2(&self, u: f64) -> (usize, [[f64; NB]; 3]) {
         let span = self.find_span(u);
         let (lo, hi) = self.domain();
-        let u = u.clamp(lo, hi);
         let mut n = [[0.0; NB]; 3];
-        self.ders_basis(span, u, &mut n);
+        self.ders_basis(span, u.clamp(lo, hi), &mut n);
+        (span, n)
+    }
+
+    /// Point and derivatives from a span and basis computed by [`Self::basis2`] of this
+    /// curve or of one that [shares its basis](Self::shares_basis_with).
+    pub(crate) fn combine2(&self, span: usize, n: &[[f64; NB]; 3]) -> GuideEval {
+        let p = self.degree;
         let first = span - p;
         let mut d = [Vector3::zeros(); 3];
         let mut basis = [0.0; NB];
