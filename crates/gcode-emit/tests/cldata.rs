@@ -1,3 +1,4 @@
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 //! APT CLDATA reader and writer: a realistic file, round trips, errors with file/line/field,
 //! and a never-panic property over random and mutated files.
 
