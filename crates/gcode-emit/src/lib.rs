@@ -6,7 +6,7 @@ pub mod cldata;
 mod error;
 mod number;
 
-pub use apt_cutter::{AptCutter, APT_SHAPE_REL_TOL};
+pub use apt_cutter::{apt_from_cl_params, apt_to_cl_params};
 pub use atomic_write::write_atomic;
 pub use cldata::{
     read_cl, read_cl_file, write_cl, write_cl_file, ClOperation, ClProgram, ClReadOptions,

@@ -257,7 +257,7 @@ fn unsupported_cutter_is_a_warning_and_keeps_the_apt_numbers() {
     let p = read("CUTTER/10,1,2,1,0,5,20\nGOTO/0,0,0\n").unwrap();
     let op = &p.operations[0];
     assert!(op.cutter.is_none());
-    assert_eq!(op.apt_cutter.unwrap().b_deg, 5.0);
+    assert!((op.apt_cutter.unwrap().beta - 5f64.to_radians()).abs() < 1e-15);
     assert!(p
         .warnings
         .iter()

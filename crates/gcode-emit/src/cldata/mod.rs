@@ -13,8 +13,7 @@ mod write;
 pub use read::{read_cl, read_cl_file, ClReadOptions};
 pub use write::{write_cl, write_cl_file, ClWriteOptions};
 
-use crate::AptCutter;
-use cam_core::{Cutter, ToolPath};
+use cam_core::{AptCutter, Cutter, ToolPath};
 use serde::{Deserialize, Serialize};
 
 /// Spindle state of an operation.

@@ -7,8 +7,10 @@
 //! the record's first line, the record word and the 1-based parameter index.
 
 use super::{ClOperation, ClProgram, ClWarning, Coolant, Spindle};
-use crate::{AptCutter, GcodeError};
-use cam_core::{Cutter, CutterLocation, Move, MoveKind, Point3, ToolPath, UnitVector3, Vector3};
+use crate::{apt_from_cl_params, GcodeError};
+use cam_core::{
+    AptCutter, Cutter, CutterLocation, Move, MoveKind, Point3, ToolPath, UnitVector3, Vector3,
+};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -342,7 +344,7 @@ impl<'a> Reader<'a> {
                 for i in 0..params.len() {
                     vals.push(self.num(line, w, &params, i)?);
                 }
-                let apt = AptCutter::from_params(&vals).ok_or_else(|| {
+                let mut apt = apt_from_cl_params(&vals, self.scale).ok_or_else(|| {
                     self.err(
                         line,
                         w,
@@ -350,18 +352,11 @@ impl<'a> Reader<'a> {
                         format!("expected 1 to 7 numbers, found {}", vals.len()),
                     )
                 })?;
-                let apt = AptCutter {
-                    d: apt.d * self.scale,
-                    r: apt.r * self.scale,
-                    e: apt.e * self.scale,
-                    f: apt.f * self.scale,
-                    h: apt.h * self.scale,
-                    ..apt
-                };
                 if apt.d <= 0.0 {
                     return Err(self.err(line, w, 1, "diameter must be > 0"));
                 }
                 if apt.h <= 0.0 {
+                    apt.h = self.options.default_flute_length_per_diameter * apt.d;
                     self.warn(
                         line,
                         format!(
@@ -370,8 +365,13 @@ impl<'a> Reader<'a> {
                         ),
                     );
                 }
-                let default_h = self.options.default_flute_length_per_diameter * apt.d;
-                match apt.to_cutter(&self.tool_name(), default_h) {
+                let name = self.tool_name();
+                let cutter = apt.to_shape().and_then(|(shape, h)| {
+                    // Shank continues the flute profile; stick-out = flute length (the CL
+                    // file carries no holder data).
+                    Cutter::new(name, shape, h, shape.radius_at(h), h)
+                });
+                match cutter {
                     Ok(c) => self.cutter = Some(c),
                     Err(reason) => {
                         self.warn(

@@ -12,7 +12,8 @@
 //! read back bit for bit (axes that are unit to rounding are kept as written).
 
 use super::{ClProgram, Coolant};
-use crate::{write_atomic, AptCutter, GcodeError, NumberFormat};
+use crate::{apt_to_cl_params, write_atomic, GcodeError, NumberFormat};
+use cam_core::AptCutter;
 use cam_core::MoveKind;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -84,7 +85,7 @@ pub fn write_cl(program: &ClProgram, options: &ClWriteOptions) -> Result<String,
         });
         if let Some(apt) = apt {
             let mut s = String::from("CUTTER/");
-            for (i, v) in apt.params().iter().enumerate() {
+            for (i, v) in apt_to_cl_params(&apt).iter().enumerate() {
                 if i > 0 {
                     s.push(',');
                 }
