@@ -54,6 +54,14 @@ pub enum GcodeError {
         /// What was asked for.
         what: String,
     },
+    /// A tool-vector operation has a block without a tool vector.
+    #[error("operation `{operation}` block {block}: tool-vector output needs a tool vector")]
+    MissingToolVector {
+        /// Operation name.
+        operation: String,
+        /// 0-based block index.
+        block: usize,
+    },
     /// A value to be written is NaN or infinite.
     #[error("operation `{operation}` block {block}: word {word} has non-finite value {value}")]
     NonFinite {
