@@ -217,7 +217,7 @@ mod tests {
         assert_eq!(b[2].feed, Some(GcodeFeed::InverseTime(20.0)));
         assert_eq!(b[3].feed, Some(GcodeFeed::PerMinute(500.0)));
         assert!(b[4].machine_coordinates && b[4].motion == GcodeMotion::Rapid);
-        assert_eq!(b[4].line, 9);
+        assert_eq!(b[4].line, 8);
     }
 
     #[test]
