@@ -73,7 +73,7 @@ pub fn read_gcode(text: &str, file: &str) -> Result<Vec<GcodeBlock>, GcodeError>
         if body.is_empty() || body.starts_with('%') {
             continue;
         }
-        let words = tokenize(&body).map_err(|(w, r)| err(&w, r))?;
+        let words = tokenize(body).map_err(|(w, r)| err(&w, r))?;
         let mut new_axes = axes;
         let mut has_axis = false;
         let mut g53 = false;
@@ -117,13 +117,13 @@ pub fn read_gcode(text: &str, file: &str) -> Result<Vec<GcodeBlock>, GcodeError>
         }
         if has_axis {
             let Some(m) = motion else {
-                return Err(err(&body, "axis words without G0 or G1 in effect"));
+                return Err(err(body, "axis words without G0 or G1 in effect"));
             };
             let f = match m {
                 GcodeMotion::Rapid => None,
                 GcodeMotion::Linear if inverse => match block_feed {
                     Some(f) => Some(GcodeFeed::InverseTime(f)),
-                    None => return Err(err(&body, "inverse-time move without F")),
+                    None => return Err(err(body, "inverse-time move without F")),
                 },
                 GcodeMotion::Linear => feed.map(GcodeFeed::PerMinute),
             };
@@ -161,7 +161,10 @@ fn strip_comments(s: &str) -> Result<String, &'static str> {
 }
 
 /// Splits a block into (letter, value, word text).
-fn tokenize(s: &str) -> Result<Vec<(char, f64, String)>, (String, &'static str)> {
+/// A word: letter, value, text as written.
+type Word = (char, f64, String);
+
+fn tokenize(s: &str) -> Result<Vec<Word>, (String, &'static str)> {
     let chars: Vec<char> = s.chars().filter(|c| !c.is_whitespace()).collect();
     let mut out = Vec::new();
     let mut i = 0;

@@ -7,11 +7,13 @@
 //!   or tool-tip coordinates — that a [`Dialect`] formats.
 //! - [`dialect`]: the [`Dialect`] trait, [`dialect_by_name`] and [`write_program_file`]
 //!   (temporary file + rename).
+//! - [`assemble`]: CL operations + a `postproc-kinematics` machine → [`NcProgram`].
 //! - [`NumberFormat`]: fixed decimals, never an exponent, `-0` printed as `0`.
 //! - [`gcode_read`]: a small LinuxCNC G-code reader returning joint blocks, for verification
 //!   by forward kinematics.
 
 mod apt_cutter;
+pub mod assemble;
 mod atomic_write;
 pub mod cldata;
 pub mod dialect;
@@ -23,6 +25,7 @@ pub mod program;
 pub mod tilted_plane;
 
 pub use apt_cutter::{apt_from_cl_params, apt_to_cl_params};
+pub use assemble::{assemble_program, AssembleOptions, AssembledProgram};
 pub use atomic_write::write_atomic;
 pub use cldata::{
     read_cl, read_cl_file, write_cl, write_cl_file, ClOperation, ClProgram, ClReadOptions,

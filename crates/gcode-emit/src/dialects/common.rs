@@ -90,3 +90,13 @@ pub fn tip_move(xyz: [f64; 3], feed: Feed) -> NcMove {
         feed,
     }
 }
+
+/// `name - T<n>` (plus the tool name when it says more than the number).
+pub fn op_comment(op: &NcOperation) -> String {
+    let t = format!("T{}", op.tool.number);
+    if op.tool.name.is_empty() || op.tool.name == t {
+        format!("{} - {t}", op.name)
+    } else {
+        format!("{} - {t} {}", op.name, op.tool.name)
+    }
+}

@@ -14,7 +14,9 @@
 //! - `G49` cancels compensation / TCP at the end of each operation, then `G53 G0 Z<safe>`
 //!   retracts in machine coordinates before any tool change or reorientation.
 
-use super::common::{coolant_word, rotary_words, simultaneous, spindle_words, write_moves};
+use super::common::{
+    coolant_word, op_comment, rotary_words, simultaneous, spindle_words, write_moves,
+};
 use crate::dialect::{
     num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
 };
@@ -99,13 +101,7 @@ impl Dialect for Fanuc {
                 block: 0,
             };
             if o.comments {
-                w.raw(&format!(
-                    "({})",
-                    sanitize(
-                        &format!("{} - T{} {}", op.name, op.tool.number, op.tool.name),
-                        true
-                    )
-                ));
+                w.raw(&format!("({})", sanitize(&op_comment(op), true)));
             }
             w.block(&safe);
             if tool != Some(op.tool.number) {

@@ -16,7 +16,7 @@
 //! - Joint (inverse-time) output is not offered: TNC feeds rotary moves in deg/min or
 //!   through M116/M128, not `G93`.
 
-use super::common::{coolant_word, rotary_words, tip_move, write_moves};
+use super::common::{coolant_word, op_comment, rotary_words, tip_move, write_moves};
 use crate::dialect::{
     num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
 };
@@ -84,13 +84,7 @@ impl Dialect for HeidenhainIso {
                 block: 0,
             };
             if o.comments {
-                w.raw(&format!(
-                    ";{}",
-                    sanitize(
-                        &format!("{} - T{} {}", op.name, op.tool.number, op.tool.name),
-                        true
-                    )
-                ));
+                w.raw(&format!(";{}", sanitize(&op_comment(op), true)));
             }
             w.block(&safe);
             if tool != Some(op.tool.number) {

@@ -13,7 +13,9 @@
 //!   pre-positioned alone before X Y, program end `M2` (or `M30`), `%` delimiters.
 //! - Checked by running LinuxCNC's own interpreter `rs274` on our output (tests/rs274.rs).
 
-use super::common::{coolant_word, rotary_words, simultaneous, spindle_words, write_moves};
+use super::common::{
+    coolant_word, op_comment, rotary_words, simultaneous, spindle_words, write_moves,
+};
 use crate::dialect::{
     num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
 };
@@ -97,13 +99,7 @@ impl Dialect for LinuxCnc {
                 block: 0,
             };
             if o.comments {
-                w.raw(&format!(
-                    "({})",
-                    sanitize(
-                        &format!("{} - T{} {}", op.name, op.tool.number, op.tool.name),
-                        false
-                    )
-                ));
+                w.raw(&format!("({})", sanitize(&op_comment(op), false)));
             }
             w.block(&safe);
             if tool != Some(op.tool.number) {

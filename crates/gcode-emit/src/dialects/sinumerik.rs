@@ -17,7 +17,7 @@
 //!   first rotary angle; tips are written in the tilted frame; `CYCLE800()` resets the
 //!   plane at the operation's end.
 
-use super::common::{coolant_word, rotary_words, spindle_words, tip_move, write_moves};
+use super::common::{coolant_word, op_comment, rotary_words, spindle_words, tip_move, write_moves};
 use crate::dialect::{
     num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
 };
@@ -85,13 +85,7 @@ impl Dialect for Sinumerik {
                 block: 0,
             };
             if o.comments {
-                w.raw(&format!(
-                    "; {}",
-                    sanitize(
-                        &format!("{} - T{} {}", op.name, op.tool.number, op.tool.name),
-                        false
-                    )
-                ));
+                w.raw(&format!("; {}", sanitize(&op_comment(op), false)));
             }
             w.block(&safe);
             // D0 above cleared the offset; the tool is (re)selected with its edge every time.
