@@ -296,3 +296,23 @@ fn rs274_rejects_what_it_should_so_the_check_is_live() {
     assert!(!out.status.success());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn rs274_accepts_the_linuxcnc_golden_program() {
+    let Some(rs) = require_rs274() else { return };
+    let text = std::fs::read_to_string(format!(
+        "{}/tests/golden/linuxcnc_joint.ngc",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let dir = scratch("golden");
+    let stdout = run(&rs, &dir, &text, None);
+    let canon = canonical_moves(&stdout);
+    let blocks = read_gcode(&text, "linuxcnc_joint.ngc").unwrap();
+    assert_eq!(canon.len(), blocks.len());
+    // The inverse-time block N110 (F66.6667 over its XYZ length) is executed as written.
+    assert!(canon
+        .iter()
+        .any(|(n, c)| n == "STRAIGHT_FEED" && c == &[12.5, -5.0, 1.25, -15.0, 0.0, 30.5]));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
