@@ -72,7 +72,11 @@ fn run(rs: &Path, dir: &Path, program: &str, ini: Option<&Path>) -> String {
     let file = dir.join("prog.ngc");
     std::fs::write(&file, program).unwrap();
     let tbl = dir.join("tool.tbl");
-    std::fs::write(&tbl, "T1 P1 Z0 D10 ;rough\nT2 P2 Z0 D6 ;finish\nT3 P3 Z0 D6 ;flank\nT4 P4 Z0 D8 ;pocket\n").unwrap();
+    std::fs::write(
+        &tbl,
+        "T1 P1 Z0 D10 ;rough\nT2 P2 Z0 D6 ;finish\nT3 P3 Z0 D6 ;flank\nT4 P4 Z0 D8 ;pocket\n",
+    )
+    .unwrap();
     let mut cmd = Command::new(rs);
     cmd.arg("-t").arg(&tbl);
     if let Some(ini) = ini {
