@@ -39,12 +39,14 @@
 //! assert_eq!(posted.blocks.len(), 1);
 //! ```
 
+pub mod bspline_fit;
 pub mod error;
 pub mod feed;
 pub mod joints;
 pub mod kinematics;
 pub mod linearise;
 pub mod machine;
+pub mod plot;
 pub mod post;
 pub mod reverse_motion;
 
@@ -57,4 +59,7 @@ pub use machine::{
 pub use post::{
     post_locations, post_path, post_tool_path, LimitPolicy, PostMetrics, PostOptions, PostedBlock,
     PostedPath,
+};
+pub use reverse_motion::{
+    AccessibilityChecker, DisplacementCurves, ReverseMotionOptions, ReverseMotionReport,
 };

@@ -8,7 +8,10 @@ use crate::joints::AxisId;
 use crate::joints::Joints;
 use crate::linearise::{subdivide, LinearisationSettings};
 use crate::machine::{Machine, RotaryMode};
-use crate::reverse_motion::count_path_reverse_motions;
+use crate::reverse_motion::{
+    count_path_reverse_motions, remove_reverse_motions, AccessibilityChecker, ReverseMotionOptions,
+    ReverseMotionReport,
+};
 use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
 use serde::{Deserialize, Serialize};
 
@@ -46,6 +49,8 @@ pub struct PostOptions {
     pub default_feed_mm_per_min: f64,
     /// Posture before the first block (default: the machine's home position).
     pub initial: Option<Joints>,
+    /// Reverse-motion removal on the rotary axes (default `None`: only count them).
+    pub reverse_motion: Option<ReverseMotionOptions>,
 }
 
 impl Default for PostOptions {
@@ -60,6 +65,7 @@ impl Default for PostOptions {
             unwind_on_rapid: true,
             default_feed_mm_per_min: 1000.0,
             initial: None,
+            reverse_motion: None,
         }
     }
 }
@@ -85,6 +91,9 @@ impl PostOptions {
         }
         if self.max_subdivision_depth > 30 {
             return bad("max_subdivision_depth", "must be <= 30");
+        }
+        if let Some(r) = &self.reverse_motion {
+            r.validate()?;
         }
         if !(self.default_feed_mm_per_min.is_finite() && self.default_feed_mm_per_min > 0.0) {
             return bad("default_feed_mm_per_min", "must be finite and > 0");
@@ -153,6 +162,8 @@ pub struct PostedPath {
     pub blocks: Vec<PostedBlock>,
     /// Metrics.
     pub metrics: PostMetrics,
+    /// Reverse-motion removal details (when it ran), with the displacement curves.
+    pub reverse_motion: Option<ReverseMotionReport>,
 }
 
 /// Posts a tool path (see [`post_path`]).
@@ -179,7 +190,8 @@ pub fn post_locations(
 /// 1. inverse kinematics block by block, each choosing the solution nearest the previous
 ///    block (continuity) within the limits ([`Machine::inverse`]); continuous axes are
 ///    unwound on rapids when asked;
-/// 2. reverse motions of the rotary axes are counted ([`crate::reverse_motion`]);
+/// 2. reverse motions of the rotary axes are counted and, with
+///    [`PostOptions::reverse_motion`], removed ([`crate::reverse_motion`]);
 /// 3. linearisation control inserts blocks until the joint-interpolated tip deviates at most
 ///    the tolerance ([`crate::linearise`]);
 /// 4. tool-tip and inverse-time feeds ([`crate::feed`]).
@@ -191,6 +203,17 @@ pub fn post_path(
     machine: &Machine,
     moves: &[Move],
     options: &PostOptions,
+) -> Result<PostedPath, PostError> {
+    post_path_checked(machine, moves, options, None)
+}
+
+/// [`post_path`] with a caller-supplied accessibility checker (gouge and collision) that
+/// reverse-motion removal uses to re-check changed postures.
+pub fn post_path_checked(
+    machine: &Machine,
+    moves: &[Move],
+    options: &PostOptions,
+    checker: Option<&dyn AccessibilityChecker>,
 ) -> Result<PostedPath, PostError> {
     options.validate()?;
     let tl = options.tool_length;
@@ -242,7 +265,17 @@ pub fn post_path(
     }
 
     let reverse_motions_before = count_path_reverse_motions(&blocks);
-    let reverse_motions_after = reverse_motions_before;
+    let reverse_report = match &options.reverse_motion {
+        Some(rm) => Some(remove_reverse_motions(
+            machine,
+            &mut blocks,
+            tl,
+            rm,
+            checker,
+        )?),
+        None => None,
+    };
+    let reverse_motions_after = count_path_reverse_motions(&blocks);
 
     // Linearisation control and feeds.
     let mut out: Vec<PostedBlock> = Vec::with_capacity(blocks.len());
@@ -333,6 +366,7 @@ pub fn post_path(
         tool_length: tl,
         blocks: out,
         metrics,
+        reverse_motion: reverse_report,
     })
 }
 
