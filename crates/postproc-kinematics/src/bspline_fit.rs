@@ -139,3 +139,45 @@ pub fn fit_least_squares(t: &[f64], y: &[f64], n_ctrl: usize) -> Option<ScalarBS
         ctrl: x.iter().copied().collect(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reproduces_a_cubic_exactly() {
+        // a cubic polynomial lies in the span of any clamped cubic B-spline basis
+        let f = |t: f64| 2.0 - 3.0 * t + 5.0 * t * t - 4.0 * t * t * t;
+        let t: Vec<f64> = (0..40).map(|i| (i as f64 / 39.0).powf(1.3)).collect();
+        let y: Vec<f64> = t.iter().map(|&x| f(x)).collect();
+        for n in [4, 6, 9] {
+            let s = fit_least_squares(&t, &y, n).unwrap();
+            assert_eq!(s.degree(), 3);
+            for k in 0..=100 {
+                let x = k as f64 / 100.0;
+                assert!((s.eval(x) - f(x)).abs() < 1e-10, "n={n} x={x}");
+            }
+        }
+    }
+
+    #[test]
+    fn monotone_projection_gives_monotone_curve() {
+        let t: Vec<f64> = (0..50).map(|i| i as f64 / 49.0).collect();
+        let y: Vec<f64> = t.iter().map(|&x| x + 0.3 * (9.0 * x).sin()).collect();
+        let s = fit_least_squares(&t, &y, 8).unwrap().monotone(1.0);
+        let v: Vec<f64> = (0..=500).map(|k| s.eval(k as f64 / 500.0)).collect();
+        assert!(v.windows(2).all(|w| w[1] >= w[0] - 1e-12));
+        let s = fit_least_squares(&t, &y, 8).unwrap().monotone(-1.0);
+        let v: Vec<f64> = (0..=500).map(|k| s.eval(k as f64 / 500.0)).collect();
+        assert!(v.windows(2).all(|w| w[1] <= w[0] + 1e-12));
+    }
+
+    #[test]
+    fn rank_deficient_fit_is_refused() {
+        // all samples at one parameter cannot determine four control values
+        let t = vec![0.5; 10];
+        let y = vec![1.0; 10];
+        assert!(fit_least_squares(&t, &y, 4).is_none());
+        assert!(fit_least_squares(&[], &[], 4).is_none());
+    }
+}

@@ -6,7 +6,7 @@ use crate::error::{KinematicsError, PostError};
 use crate::feed::inverse_time_feed;
 use crate::joints::AxisId;
 use crate::joints::Joints;
-use crate::linearise::{subdivide, LinearisationSettings};
+use crate::linearise::{segment_deviation, subdivide, LinearisationSettings};
 use crate::machine::{Machine, RotaryMode};
 use crate::reverse_motion::{
     count_path_reverse_motions, remove_reverse_motions, AccessibilityChecker, ReverseMotionOptions,
@@ -297,11 +297,15 @@ pub fn post_path_checked(
             continue;
         };
         let _ = i;
-        let linearise = (b.kind != MoveKind::Rapid || options.linearise_rapids) && !b.unwound;
+        // Segments touching a block outside the limits (Report policy) are not subdivided.
+        let linearise = (b.kind != MoveKind::Rapid || options.linearise_rapids)
+            && !b.unwound
+            && b.limit_violation.is_none()
+            && p.limit_violation.is_none();
         let mut b = b;
         if linearise {
             scratch.clear();
-            let last = subdivide(
+            let sub = subdivide(
                 machine,
                 &p.cl,
                 &p.joints,
@@ -310,11 +314,32 @@ pub fn post_path_checked(
                 tl,
                 &settings,
                 &mut scratch,
-            )
-            .map_err(|source| PostError::Block {
-                index: b.source_index,
-                source,
-            })?;
+            );
+            let last = match sub {
+                Ok(last) => last,
+                Err(e @ KinematicsError::OutOfLimits { .. })
+                    if options.limit_policy == LimitPolicy::Report =>
+                {
+                    // an intermediate posture leaves the travel: keep the block unsubdivided
+                    scratch.clear();
+                    b.limit_violation = Some(e);
+                    segment_deviation(
+                        machine,
+                        &p.joints,
+                        &b.joints,
+                        &p.cl.tip,
+                        &b.cl.tip,
+                        tl,
+                        options.linearisation_samples,
+                    )
+                }
+                Err(source) => {
+                    return Err(PostError::Block {
+                        index: b.source_index,
+                        source,
+                    })
+                }
+            };
             let mut from = p.clone();
             for (cl, j, err) in scratch.drain(..) {
                 let mut nb = PostedBlock {

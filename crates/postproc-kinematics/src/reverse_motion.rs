@@ -202,9 +202,12 @@ pub struct ReverseMotionReport {
     pub iterations: usize,
     /// Runs × axes that needed the monotone projection of the control values.
     pub projections: usize,
-    /// Blocks repaired by stepping C.
-    pub c_repaired_blocks: usize,
-    /// Source indices of blocks that stayed inaccessible (their run was kept unchanged).
+    /// Runs whose C was turned by a multiple of `c_step` to restore accessibility.
+    pub c_repaired_runs: usize,
+    /// The C offsets applied to those runs (deg).
+    pub c_offsets_deg: Vec<f64>,
+    /// Source index of the first inaccessible (or out-of-limits) posture of each run that
+    /// could not be repaired (the run was kept unchanged).
     pub inaccessible_blocks: Vec<usize>,
     /// Largest angle change applied (deg).
     pub max_angle_change_deg: f64,
@@ -301,14 +304,15 @@ pub fn smooth_monotone(
 
 /// Removes reverse motions of the rotary axes run by run (paper 004 procedure steps 2–7):
 /// shift-and-smooth each reversing axis ([`smooth_monotone`]); recompute the linear axes for
-/// the changed postures keeping the tool tips ([`Machine::joints_for_angles`]); check limits;
-/// re-check every changed posture with `checker` and, where it fails, step C by `c_step` (in
-/// both senses, smallest first) up to `c_max`; a run that cannot be repaired, leaves the
-/// limits or changes an angle by more than `max_angle_change` keeps its original angles.
+/// the changed postures keeping the tool tips ([`Machine::joints_for_angles`]); check limits
+/// and re-check every changed posture with `checker`; where one fails, turn C of the whole run
+/// by `±k·c_step` (smallest first, up to `c_max`; a constant offset keeps the run monotone)
+/// and re-check. A run that cannot be repaired, or whose smoothing changes an angle by more
+/// than `max_angle_change`, keeps its original angles.
 /// Blocks' `cl.axis` becomes the smoothed tool axis.
 ///
 /// Cost: O(m·n²) per run for the fit (n control points), plus `c_max / c_step` checker calls
-/// per failing block.
+/// per run whose smoothed postures fail.
 pub fn remove_reverse_motions(
     machine: &Machine,
     blocks: &mut [PostedBlock],
@@ -358,55 +362,64 @@ pub fn remove_reverse_motions(
             changed = true;
         }
         if ok && changed {
-            let mut repaired = 0;
-            for (b, (oj, _)) in run.iter_mut().zip(&original) {
-                let moved = (b.joints.tilt - oj.tilt).abs() > 0.0
-                    || (b.joints.rotate - oj.rotate).abs() > 0.0;
-                if !moved {
-                    continue;
-                }
-                let (tilt, rot) = (b.joints.tilt, b.joints.rotate);
-                let place = |rot: f64| -> Option<(Joints, CutterLocation)> {
-                    let j = machine.joints_for_angles(&b.cl.tip, tool_length, tilt, rot);
-                    machine.check_limits(&j, LIMIT_SLACK).ok()?;
+            // Recompute the positions for the changed postures and re-check them; when a
+            // posture is not accessible, turn C of the whole run by ±k·ΔC (k = 1, 2, … up to
+            // C_max) — a constant offset keeps the run free of reverse motions.
+            let smoothed: Vec<(f64, f64)> = run
+                .iter()
+                .map(|b| (b.joints.tilt, b.joints.rotate))
+                .collect();
+            let steps = (opts.c_max / opts.c_step).floor() as usize;
+            let offsets = std::iter::once(0.0).chain((1..=steps).flat_map(|k| {
+                let d = k as f64 * opts.c_step;
+                [d, -d]
+            }));
+            let mut accepted: Option<(f64, Vec<(Joints, CutterLocation)>)> = None;
+            let mut first_failure: Option<usize> = None;
+            'offsets: for off in offsets {
+                let mut placed = Vec::with_capacity(run.len());
+                for (b, ((tilt, rot), (oj, ocl))) in run.iter().zip(smoothed.iter().zip(&original))
+                {
+                    let rot = rot + off;
+                    if *tilt == oj.tilt && rot == oj.rotate {
+                        placed.push((*oj, *ocl));
+                        continue;
+                    }
+                    let j = machine.joints_for_angles(&b.cl.tip, tool_length, *tilt, rot);
                     let cl = CutterLocation {
                         tip: b.cl.tip,
-                        axis: machine.tool_axis(tilt, rot),
+                        axis: machine.tool_axis(*tilt, rot),
                     };
-                    Some((j, cl))
-                };
-                let accessible = |cl: &CutterLocation| checker.is_none_or(|c| c.is_accessible(cl));
-                let mut placed = place(rot).filter(|(_, cl)| accessible(cl));
-                if placed.is_none() {
-                    let steps = (opts.c_max / opts.c_step).floor() as usize;
-                    'search: for k in 1..=steps {
-                        for sgn in [1.0, -1.0] {
-                            if let Some(p) = place(rot + sgn * k as f64 * opts.c_step)
-                                .filter(|(_, cl)| accessible(cl))
-                            {
-                                placed = Some(p);
-                                repaired += 1;
-                                break 'search;
-                            }
+                    let fits = machine.check_limits(&j, LIMIT_SLACK).is_ok();
+                    if !fits || !checker.is_none_or(|c| c.is_accessible(&cl)) {
+                        if first_failure.is_none() {
+                            first_failure = Some(b.source_index);
                         }
+                        continue 'offsets;
                     }
+                    placed.push((j, cl));
                 }
-                match placed {
-                    Some((j, cl)) => {
+                accepted = Some((off, placed));
+                break;
+            }
+            match accepted {
+                Some((off, placed)) => {
+                    for (b, (j, cl)) in run.iter_mut().zip(placed) {
                         b.joints = j;
                         b.cl = cl;
                     }
-                    None => {
-                        rep.inaccessible_blocks.push(b.source_index);
-                        ok = false;
+                    rep.runs_changed += 1;
+                    if off != 0.0 {
+                        rep.c_repaired_runs += 1;
+                        rep.c_offsets_deg.push(off.to_degrees());
                     }
+                    let change = run_max_change + off.abs();
+                    rep.max_angle_change_deg = rep.max_angle_change_deg.max(change.to_degrees());
                 }
-            }
-            if ok {
-                rep.runs_changed += 1;
-                rep.c_repaired_blocks += repaired;
-                rep.max_angle_change_deg =
-                    rep.max_angle_change_deg.max(run_max_change.to_degrees());
+                None => {
+                    rep.inaccessible_blocks.extend(first_failure);
+                    ok = false;
+                }
             }
         }
         if !ok {
@@ -421,4 +434,37 @@ pub fn remove_reverse_motions(
     rep.rotate_after = count_axis_reverse_motions(blocks, AxisId::Rotate);
     rep.after = DisplacementCurves::of_blocks(machine, blocks);
     Ok(rep)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_direction_changes() {
+        assert_eq!(count_reverse_motions(&[0.0, 1.0, 2.0, 3.0], 1e-9), 0);
+        assert_eq!(count_reverse_motions(&[0.0, 1.0, 0.5, 2.0], 1e-9), 2);
+        // standing still does not count, nor does a step within the dead band
+        assert_eq!(
+            count_reverse_motions(&[0.0, 1.0, 1.0, 1.0 - 1e-12, 2.0], 1e-9),
+            0
+        );
+        assert_eq!(
+            count_reverse_motions(&[3.0, 2.0, 2.5, 1.0, 0.0, 0.2], 1e-9),
+            3
+        );
+    }
+
+    #[test]
+    fn smoothing_removes_a_swing() {
+        let t: Vec<f64> = (0..100).map(|i| i as f64 / 99.0).collect();
+        let a: Vec<f64> = t
+            .iter()
+            .map(|&x| x - 0.15 * (-((x - 0.5) / 0.05f64).powi(2)).exp() * (x - 0.5) / 0.05)
+            .collect();
+        assert!(count_reverse_motions(&a, REVERSE_DEAD_BAND_RAD) >= 2);
+        let (s, _, _) = smooth_monotone(&t, &a, &ReverseMotionOptions::default()).unwrap();
+        assert_eq!(count_reverse_motions(&s, REVERSE_DEAD_BAND_RAD), 0);
+        assert!((s[0] - a[0]).abs() < 0.2 && (s[99] - a[99]).abs() < 0.2);
+    }
 }
