@@ -149,6 +149,9 @@ pub struct PostMetrics {
     pub inserted_blocks: usize,
     /// Blocks unwound.
     pub unwound_blocks: usize,
+    /// Non-rapid blocks whose rotary step exceeds [`RECONFIGURATION_STEP_RAD`] (a forced
+    /// change of solution branch, e.g. at a travel limit, that look-ahead could not avoid).
+    pub reconfigurations: usize,
 }
 
 /// Result of [`post_path`].
@@ -189,7 +192,10 @@ pub fn post_locations(
 ///
 /// 1. inverse kinematics block by block, each choosing the solution nearest the previous
 ///    block (continuity) within the limits ([`Machine::inverse`]); continuous axes are
-///    unwound on rapids when asked;
+///    unwound on rapids when asked. The path is split into groups (a move and the non-rapid
+///    moves after it); when the greedy choice inside a group meets a limit or needs a
+///    reconfiguration, every posture of the group's first move
+///    ([`Machine::inverse_candidates`]) is tried and the one with the fewest problems kept;
 /// 2. reverse motions of the rotary axes are counted and, with
 ///    [`PostOptions::reverse_motion`], removed ([`crate::reverse_motion`]);
 /// 3. linearisation control inserts blocks until the joint-interpolated tip deviates at most
@@ -220,48 +226,75 @@ pub fn post_path_checked(
     let mut blocks: Vec<PostedBlock> = Vec::with_capacity(moves.len());
     let mut prev = options.initial.unwrap_or(machine.home());
     let mut last_feed = options.default_feed_mm_per_min;
-    let continuous = matches!(machine.axis(AxisId::Rotate).mode, RotaryMode::Continuous)
-        || matches!(machine.axis(AxisId::Tilt).mode, RotaryMode::Continuous);
-    for (index, m) in moves.iter().enumerate() {
-        let (mut j, violation) = machine
-            .inverse_best_effort(&m.cl, tl, Some(&prev))
-            .map_err(|source| PostError::Block { index, source })?;
-        if let Some(source) = &violation {
-            if options.limit_policy == LimitPolicy::Error {
-                return Err(PostError::Block {
-                    index,
-                    source: source.clone(),
-                });
+    let mut start = 0;
+    while start < moves.len() {
+        // A group: one move (typically a rapid) and the non-rapid moves that follow it.
+        let mut end = start + 1;
+        while end < moves.len() && moves[end].kind != MoveKind::Rapid {
+            end += 1;
+        }
+        let (mut solved, mut problems) =
+            solve_group(machine, moves, start..end, &prev, None, options)?;
+        if problems > 0 {
+            // Look ahead: the greedy start ran into a limit or a reconfiguration; try every
+            // posture of the first move and keep the one with the fewest problems, then the
+            // least travel from the previous posture.
+            let first = &moves[start];
+            let candidates =
+                machine
+                    .inverse_candidates(&first.cl, tl, &prev)
+                    .map_err(|source| PostError::Block {
+                        index: start,
+                        source,
+                    })?;
+            let mut best_travel = f64::INFINITY;
+            for c in candidates {
+                let (sol, p) = solve_group(machine, moves, start..end, &prev, Some(c), options)?;
+                let travel = (c.tilt - prev.tilt).abs() + (c.rotate - prev.rotate).abs();
+                if p < problems || (p == problems && p > 0 && travel < best_travel) {
+                    best_travel = travel;
+                    solved = sol;
+                    problems = p;
+                }
+                if problems == 0 {
+                    break;
+                }
             }
         }
-        let mut unwound = false;
-        if options.unwind_on_rapid && continuous && m.kind == MoveKind::Rapid {
-            unwound = machine.unwind(&mut j);
-            if unwound {
-                j = machine.joints_for_angles(&m.cl.tip, tl, j.tilt, j.rotate);
+        for (k, (j, violation, unwound)) in solved.into_iter().enumerate() {
+            let index = start + k;
+            let m = &moves[index];
+            if let Some(source) = &violation {
+                if options.limit_policy == LimitPolicy::Error {
+                    return Err(PostError::Block {
+                        index,
+                        source: source.clone(),
+                    });
+                }
             }
+            let feed = if m.kind == MoveKind::Rapid {
+                None
+            } else {
+                if let Some(f) = m.feed_mm_per_min.filter(|f| f.is_finite() && *f > 0.0) {
+                    last_feed = f;
+                }
+                Some(last_feed)
+            };
+            blocks.push(PostedBlock {
+                joints: j,
+                cl: m.cl,
+                kind: m.kind,
+                feed_mm_per_min: feed,
+                inverse_time_feed: None,
+                source_index: index,
+                inserted: false,
+                unwound,
+                linearisation_error_mm: 0.0,
+                limit_violation: violation,
+            });
+            prev = j;
         }
-        let feed = if m.kind == MoveKind::Rapid {
-            None
-        } else {
-            if let Some(f) = m.feed_mm_per_min.filter(|f| f.is_finite() && *f > 0.0) {
-                last_feed = f;
-            }
-            Some(last_feed)
-        };
-        blocks.push(PostedBlock {
-            joints: j,
-            cl: m.cl,
-            kind: m.kind,
-            feed_mm_per_min: feed,
-            inverse_time_feed: None,
-            source_index: index,
-            inserted: false,
-            unwound,
-            linearisation_error_mm: 0.0,
-            limit_violation: violation,
-        });
-        prev = j;
+        start = end;
     }
 
     let reverse_motions_before = count_path_reverse_motions(&blocks);
@@ -385,6 +418,15 @@ pub fn post_path_checked(
         blocks: out.len(),
         inserted_blocks,
         unwound_blocks: out.iter().filter(|b| b.unwound).count(),
+        reconfigurations: out
+            .windows(2)
+            .filter(|w| {
+                w[1].kind != MoveKind::Rapid
+                    && ((w[1].joints.tilt - w[0].joints.tilt).abs() > RECONFIGURATION_STEP_RAD
+                        || (w[1].joints.rotate - w[0].joints.rotate).abs()
+                            > RECONFIGURATION_STEP_RAD)
+            })
+            .count(),
     };
     Ok(PostedPath {
         machine: machine.name().to_string(),
@@ -400,4 +442,55 @@ fn set_feed(machine: &Machine, from: &PostedBlock, b: &mut PostedBlock) {
         let len = (b.cl.tip - from.cl.tip).norm();
         b.inverse_time_feed = Some(inverse_time_feed(machine, &from.joints, &b.joints, len, f));
     }
+}
+
+/// A rotary step larger than this (rad) inside a group counts as a reconfiguration (the
+/// machine would swing the table or head around between two neighbouring cutter locations).
+pub const RECONFIGURATION_STEP_RAD: f64 = std::f64::consts::FRAC_PI_2;
+
+type Solved = (Joints, Option<KinematicsError>, bool);
+
+/// Inverse kinematics of `moves[range]` with continuity from `prev` (the first posture may be
+/// forced); returns the postures and the number of problems (blocks outside the limits plus
+/// reconfiguration steps).
+fn solve_group(
+    machine: &Machine,
+    moves: &[Move],
+    range: std::ops::Range<usize>,
+    prev: &Joints,
+    first: Option<Joints>,
+    options: &PostOptions,
+) -> Result<(Vec<Solved>, usize), PostError> {
+    let tl = options.tool_length;
+    let continuous = matches!(machine.axis(AxisId::Rotate).mode, RotaryMode::Continuous)
+        || matches!(machine.axis(AxisId::Tilt).mode, RotaryMode::Continuous);
+    let mut out: Vec<Solved> = Vec::with_capacity(range.len());
+    let mut problems = 0;
+    let mut prev = *prev;
+    for index in range.clone() {
+        let m = &moves[index];
+        let (mut j, violation) = match (index == range.start, first) {
+            (true, Some(f)) => (f, None),
+            _ => machine
+                .inverse_best_effort(&m.cl, tl, Some(&prev))
+                .map_err(|source| PostError::Block { index, source })?,
+        };
+        let mut unwound = false;
+        if options.unwind_on_rapid && continuous && m.kind == MoveKind::Rapid {
+            unwound = machine.unwind(&mut j);
+            if unwound {
+                j = machine.joints_for_angles(&m.cl.tip, tl, j.tilt, j.rotate);
+            }
+        }
+        problems += usize::from(violation.is_some());
+        if index > range.start
+            && ((j.tilt - prev.tilt).abs() > RECONFIGURATION_STEP_RAD
+                || (j.rotate - prev.rotate).abs() > RECONFIGURATION_STEP_RAD)
+        {
+            problems += 1;
+        }
+        out.push((j, violation, unwound));
+        prev = j;
+    }
+    Ok((out, problems))
 }

@@ -2,7 +2,7 @@
 //! linearisation control checked by dense sampling, feeds, metrics.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use cam_core::{CutterLocation, Move, MoveKind, Point3, Vector3};
+use cam_core::{CutterLocation, Move, Point3, Vector3};
 use postproc_kinematics::linearise::point_segment_distance;
 use postproc_kinematics::plot::displacement_svg;
 use postproc_kinematics::{
@@ -335,4 +335,40 @@ fn rapid_unwinds_continuous_axis() {
     assert!(after.unwound && after.joints.rotate.abs() <= std::f64::consts::PI);
     assert!((m.forward(&after.joints, 0.0).tip - after.cl.tip).norm() < 1e-9);
     assert_eq!(p.metrics.unwound_blocks, 1);
+}
+
+#[test]
+fn look_ahead_avoids_forced_reconfiguration() {
+    // C runs from −240° to +240° while A swings in [−59°, 9°]: starting greedily from home
+    // (C = 0) picks the mirrored branch (A > 0), which later runs into A's +50° limit and
+    // would force a 180° C swing inside the cut. Look-ahead starts on the right branch.
+    for name in ["xyzac-trt", "turnmill-bc"] {
+        let m = fixture(name);
+        let (tlo, thi) = m.axis(AxisId::Tilt).limits();
+        let (tmid, tamp) = (0.5 * (tlo + thi), 0.3 * (thi - tlo).min(2.0));
+        let n = 3000;
+        let moves: Vec<Move> = (0..n)
+            .map(|i| {
+                let s = i as f64 / (n - 1) as f64;
+                let tilt = tmid + tamp * (6.0 * std::f64::consts::PI * s).sin();
+                let rotate = (-240.0 + 480.0 * s).to_radians();
+                let (r, a) = (20.0 + 15.0 * s, 40.0 * std::f64::consts::PI * s);
+                Move::feed(CutterLocation {
+                    tip: Point3::new(r * a.cos(), r * a.sin(), 10.0 + 20.0 * s),
+                    axis: m.tool_axis(tilt, rotate),
+                })
+            })
+            .collect();
+        let opts = PostOptions {
+            tool_length: 60.0,
+            ..Default::default()
+        };
+        let p = post_path(&m, &moves, &opts).unwrap();
+        assert_eq!(p.metrics.reconfigurations, 0, "{name}");
+        assert!(
+            p.metrics.max_linearisation_error_mm <= 0.005,
+            "{name}: {:?}",
+            p.metrics
+        );
+    }
 }
