@@ -273,6 +273,48 @@ impl Machine {
         }
     }
 
+    /// All postures that reach `cl` within the limits: both tilt signs and, for each, the
+    /// 2π-equivalents of the rotary angles next to the one nearest `reference` (at most three
+    /// per axis). Used to look ahead along a path when the greedy choice runs into a limit.
+    pub fn inverse_candidates(
+        &self,
+        cl: &CutterLocation,
+        tool_length: f64,
+        reference: &Joints,
+    ) -> Result<Vec<Joints>, KinematicsError> {
+        let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
+        let tilt_spec = self.axis(AxisId::Tilt);
+        let rot_spec = self.axis(AxisId::Rotate);
+        let mut out = Vec::new();
+        for (t, c) in sols {
+            let (t0, _) = equivalent_angle(t, tilt_spec, reference.tilt);
+            let (c0, _) = equivalent_angle(c, rot_spec, reference.rotate);
+            for dt in [-TAU, 0.0, TAU] {
+                for dc in [-TAU, 0.0, TAU] {
+                    let (tt, cc) = (t0 + dt, c0 + dc);
+                    if !tilt_spec.contains(tt, LIMIT_SLACK) || !rot_spec.contains(cc, LIMIT_SLACK) {
+                        continue;
+                    }
+                    if matches!(tilt_spec.mode, RotaryMode::Continuous) && dt != 0.0 {
+                        continue;
+                    }
+                    if matches!(rot_spec.mode, RotaryMode::Continuous) && dc != 0.0 {
+                        continue;
+                    }
+                    let j = self.joints_for_angles(&cl.tip, tool_length, tt, cc);
+                    if self.check_limits(&j, LIMIT_SLACK).is_ok()
+                        && !out.iter().any(|o: &Joints| {
+                            (o.tilt - tt).abs() < 1e-12 && (o.rotate - cc).abs() < 1e-12
+                        })
+                    {
+                        out.push(j);
+                    }
+                }
+            }
+        }
+        Ok(out)
+    }
+
     /// Reduces continuous rotary axes to the equivalent angle in (−π, π] and recomputes the
     /// linear axes (unchanged for a pure 2π shift). Returns `true` when a value changed.
     pub fn unwind(&self, j: &mut Joints) -> bool {

@@ -39,12 +39,14 @@
 //! assert_eq!(posted.blocks.len(), 1);
 //! ```
 
+pub mod bspline_fit;
 pub mod error;
 pub mod feed;
 pub mod joints;
 pub mod kinematics;
 pub mod linearise;
 pub mod machine;
+pub mod plot;
 pub mod post;
 pub mod reverse_motion;
 
@@ -55,6 +57,9 @@ pub use machine::{
     AxisSpec, HeadHead, HeadTable, Kinematics, Machine, RotaryMode, TableTable, TiltAxis,
 };
 pub use post::{
-    post_locations, post_path, post_tool_path, LimitPolicy, PostMetrics, PostOptions, PostedBlock,
-    PostedPath,
+    post_locations, post_path, post_path_checked, post_tool_path, LimitPolicy, PostMetrics,
+    PostOptions, PostedBlock, PostedPath,
+};
+pub use reverse_motion::{
+    AccessibilityChecker, DisplacementCurves, ReverseMotionOptions, ReverseMotionReport,
 };

@@ -49,8 +49,9 @@ pub fn point_segment_distance(p: &Point3, a: &Point3, b: &Point3) -> f64 {
 }
 
 /// Largest distance (mm) of the tool tip from the intended segment `[p0, p1]` while the
-/// joints move linearly from `j0` to `j1`, sampled at `samples` interior parameters
-/// `s = i/(samples+1)`.
+/// joints move linearly from `j0` to `j1`: sampled at `samples` interior parameters
+/// `s = i/(samples+1)`, then refined by the vertex of the parabola through the largest sample
+/// and its neighbours (the deviation vanishes at both ends and is smooth in `s`).
 pub fn segment_deviation(
     machine: &Machine,
     j0: &Joints,
@@ -61,11 +62,35 @@ pub fn segment_deviation(
     samples: usize,
 ) -> f64 {
     let n = samples.max(1);
-    let mut worst: f64 = 0.0;
+    let h = 1.0 / (n + 1) as f64;
+    let dev =
+        |s: f64| point_segment_distance(&machine.forward(&j0.lerp(j1, s), tool_length).tip, p0, p1);
+    let (mut worst, mut at, mut prev, mut left, mut right) =
+        (0.0f64, 0usize, 0.0f64, 0.0f64, 0.0f64);
     for i in 1..=n {
-        let s = i as f64 / (n + 1) as f64;
-        let tip = machine.forward(&j0.lerp(j1, s), tool_length).tip;
-        worst = worst.max(point_segment_distance(&tip, p0, p1));
+        let d = dev(i as f64 * h);
+        if d > worst {
+            worst = d;
+            at = i;
+            left = prev;
+            right = f64::NAN;
+        } else if i == at + 1 {
+            right = d;
+        }
+        prev = d;
+    }
+    if at == 0 {
+        return 0.0;
+    }
+    if right.is_nan() {
+        right = 0.0; // the neighbour after the last sample is the end point (deviation 0)
+    }
+    let den = left - 2.0 * worst + right;
+    if den < 0.0 {
+        let off = 0.5 * (left - right) / den; // in units of h, within (−1, 1)
+        if off.abs() < 1.0 {
+            worst = worst.max(dev(((at as f64) + off) * h));
+        }
     }
     worst
 }

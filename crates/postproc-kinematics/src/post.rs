@@ -6,9 +6,12 @@ use crate::error::{KinematicsError, PostError};
 use crate::feed::inverse_time_feed;
 use crate::joints::AxisId;
 use crate::joints::Joints;
-use crate::linearise::{subdivide, LinearisationSettings};
+use crate::linearise::{segment_deviation, subdivide, LinearisationSettings};
 use crate::machine::{Machine, RotaryMode};
-use crate::reverse_motion::count_path_reverse_motions;
+use crate::reverse_motion::{
+    count_path_reverse_motions, remove_reverse_motions, AccessibilityChecker, ReverseMotionOptions,
+    ReverseMotionReport,
+};
 use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
 use serde::{Deserialize, Serialize};
 
@@ -46,6 +49,8 @@ pub struct PostOptions {
     pub default_feed_mm_per_min: f64,
     /// Posture before the first block (default: the machine's home position).
     pub initial: Option<Joints>,
+    /// Reverse-motion removal on the rotary axes (default `None`: only count them).
+    pub reverse_motion: Option<ReverseMotionOptions>,
 }
 
 impl Default for PostOptions {
@@ -60,6 +65,7 @@ impl Default for PostOptions {
             unwind_on_rapid: true,
             default_feed_mm_per_min: 1000.0,
             initial: None,
+            reverse_motion: None,
         }
     }
 }
@@ -85,6 +91,9 @@ impl PostOptions {
         }
         if self.max_subdivision_depth > 30 {
             return bad("max_subdivision_depth", "must be <= 30");
+        }
+        if let Some(r) = &self.reverse_motion {
+            r.validate()?;
         }
         if !(self.default_feed_mm_per_min.is_finite() && self.default_feed_mm_per_min > 0.0) {
             return bad("default_feed_mm_per_min", "must be finite and > 0");
@@ -140,6 +149,9 @@ pub struct PostMetrics {
     pub inserted_blocks: usize,
     /// Blocks unwound.
     pub unwound_blocks: usize,
+    /// Non-rapid blocks whose rotary step exceeds [`RECONFIGURATION_STEP_RAD`] (a forced
+    /// change of solution branch, e.g. at a travel limit, that look-ahead could not avoid).
+    pub reconfigurations: usize,
 }
 
 /// Result of [`post_path`].
@@ -153,6 +165,8 @@ pub struct PostedPath {
     pub blocks: Vec<PostedBlock>,
     /// Metrics.
     pub metrics: PostMetrics,
+    /// Reverse-motion removal details (when it ran), with the displacement curves.
+    pub reverse_motion: Option<ReverseMotionReport>,
 }
 
 /// Posts a tool path (see [`post_path`]).
@@ -178,8 +192,12 @@ pub fn post_locations(
 ///
 /// 1. inverse kinematics block by block, each choosing the solution nearest the previous
 ///    block (continuity) within the limits ([`Machine::inverse`]); continuous axes are
-///    unwound on rapids when asked;
-/// 2. reverse motions of the rotary axes are counted ([`crate::reverse_motion`]);
+///    unwound on rapids when asked. The path is split into groups (a move and the non-rapid
+///    moves after it); when the greedy choice inside a group meets a limit or needs a
+///    reconfiguration, every posture of the group's first move
+///    ([`Machine::inverse_candidates`]) is tried and the one with the fewest problems kept;
+/// 2. reverse motions of the rotary axes are counted and, with
+///    [`PostOptions::reverse_motion`], removed ([`crate::reverse_motion`]);
 /// 3. linearisation control inserts blocks until the joint-interpolated tip deviates at most
 ///    the tolerance ([`crate::linearise`]);
 /// 4. tool-tip and inverse-time feeds ([`crate::feed`]).
@@ -192,57 +210,105 @@ pub fn post_path(
     moves: &[Move],
     options: &PostOptions,
 ) -> Result<PostedPath, PostError> {
+    post_path_checked(machine, moves, options, None)
+}
+
+/// [`post_path`] with a caller-supplied accessibility checker (gouge and collision) that
+/// reverse-motion removal uses to re-check changed postures.
+pub fn post_path_checked(
+    machine: &Machine,
+    moves: &[Move],
+    options: &PostOptions,
+    checker: Option<&dyn AccessibilityChecker>,
+) -> Result<PostedPath, PostError> {
     options.validate()?;
     let tl = options.tool_length;
     let mut blocks: Vec<PostedBlock> = Vec::with_capacity(moves.len());
     let mut prev = options.initial.unwrap_or(machine.home());
     let mut last_feed = options.default_feed_mm_per_min;
-    let continuous = matches!(machine.axis(AxisId::Rotate).mode, RotaryMode::Continuous)
-        || matches!(machine.axis(AxisId::Tilt).mode, RotaryMode::Continuous);
-    for (index, m) in moves.iter().enumerate() {
-        let (mut j, violation) = machine
-            .inverse_best_effort(&m.cl, tl, Some(&prev))
-            .map_err(|source| PostError::Block { index, source })?;
-        if let Some(source) = &violation {
-            if options.limit_policy == LimitPolicy::Error {
-                return Err(PostError::Block {
-                    index,
-                    source: source.clone(),
-                });
+    let mut start = 0;
+    while start < moves.len() {
+        // A group: one move (typically a rapid) and the non-rapid moves that follow it.
+        let mut end = start + 1;
+        while end < moves.len() && moves[end].kind != MoveKind::Rapid {
+            end += 1;
+        }
+        let (mut solved, mut problems) =
+            solve_group(machine, moves, start..end, &prev, None, options)?;
+        if problems > 0 {
+            // Look ahead: the greedy start ran into a limit or a reconfiguration; try every
+            // posture of the first move and keep the one with the fewest problems, then the
+            // least travel from the previous posture.
+            let first = &moves[start];
+            let candidates =
+                machine
+                    .inverse_candidates(&first.cl, tl, &prev)
+                    .map_err(|source| PostError::Block {
+                        index: start,
+                        source,
+                    })?;
+            let mut best_travel = f64::INFINITY;
+            for c in candidates {
+                let (sol, p) = solve_group(machine, moves, start..end, &prev, Some(c), options)?;
+                let travel = (c.tilt - prev.tilt).abs() + (c.rotate - prev.rotate).abs();
+                if p < problems || (p == problems && p > 0 && travel < best_travel) {
+                    best_travel = travel;
+                    solved = sol;
+                    problems = p;
+                }
+                if problems == 0 {
+                    break;
+                }
             }
         }
-        let mut unwound = false;
-        if options.unwind_on_rapid && continuous && m.kind == MoveKind::Rapid {
-            unwound = machine.unwind(&mut j);
-            if unwound {
-                j = machine.joints_for_angles(&m.cl.tip, tl, j.tilt, j.rotate);
+        for (k, (j, violation, unwound)) in solved.into_iter().enumerate() {
+            let index = start + k;
+            let m = &moves[index];
+            if let Some(source) = &violation {
+                if options.limit_policy == LimitPolicy::Error {
+                    return Err(PostError::Block {
+                        index,
+                        source: source.clone(),
+                    });
+                }
             }
+            let feed = if m.kind == MoveKind::Rapid {
+                None
+            } else {
+                if let Some(f) = m.feed_mm_per_min.filter(|f| f.is_finite() && *f > 0.0) {
+                    last_feed = f;
+                }
+                Some(last_feed)
+            };
+            blocks.push(PostedBlock {
+                joints: j,
+                cl: m.cl,
+                kind: m.kind,
+                feed_mm_per_min: feed,
+                inverse_time_feed: None,
+                source_index: index,
+                inserted: false,
+                unwound,
+                linearisation_error_mm: 0.0,
+                limit_violation: violation,
+            });
+            prev = j;
         }
-        let feed = if m.kind == MoveKind::Rapid {
-            None
-        } else {
-            if let Some(f) = m.feed_mm_per_min.filter(|f| f.is_finite() && *f > 0.0) {
-                last_feed = f;
-            }
-            Some(last_feed)
-        };
-        blocks.push(PostedBlock {
-            joints: j,
-            cl: m.cl,
-            kind: m.kind,
-            feed_mm_per_min: feed,
-            inverse_time_feed: None,
-            source_index: index,
-            inserted: false,
-            unwound,
-            linearisation_error_mm: 0.0,
-            limit_violation: violation,
-        });
-        prev = j;
+        start = end;
     }
 
     let reverse_motions_before = count_path_reverse_motions(&blocks);
-    let reverse_motions_after = reverse_motions_before;
+    let reverse_report = match &options.reverse_motion {
+        Some(rm) => Some(remove_reverse_motions(
+            machine,
+            &mut blocks,
+            tl,
+            rm,
+            checker,
+        )?),
+        None => None,
+    };
+    let reverse_motions_after = count_path_reverse_motions(&blocks);
 
     // Linearisation control and feeds.
     let mut out: Vec<PostedBlock> = Vec::with_capacity(blocks.len());
@@ -264,11 +330,15 @@ pub fn post_path(
             continue;
         };
         let _ = i;
-        let linearise = (b.kind != MoveKind::Rapid || options.linearise_rapids) && !b.unwound;
+        // Segments touching a block outside the limits (Report policy) are not subdivided.
+        let linearise = (b.kind != MoveKind::Rapid || options.linearise_rapids)
+            && !b.unwound
+            && b.limit_violation.is_none()
+            && p.limit_violation.is_none();
         let mut b = b;
         if linearise {
             scratch.clear();
-            let last = subdivide(
+            let sub = subdivide(
                 machine,
                 &p.cl,
                 &p.joints,
@@ -277,11 +347,32 @@ pub fn post_path(
                 tl,
                 &settings,
                 &mut scratch,
-            )
-            .map_err(|source| PostError::Block {
-                index: b.source_index,
-                source,
-            })?;
+            );
+            let last = match sub {
+                Ok(last) => last,
+                Err(e @ KinematicsError::OutOfLimits { .. })
+                    if options.limit_policy == LimitPolicy::Report =>
+                {
+                    // an intermediate posture leaves the travel: keep the block unsubdivided
+                    scratch.clear();
+                    b.limit_violation = Some(e);
+                    segment_deviation(
+                        machine,
+                        &p.joints,
+                        &b.joints,
+                        &p.cl.tip,
+                        &b.cl.tip,
+                        tl,
+                        options.linearisation_samples,
+                    )
+                }
+                Err(source) => {
+                    return Err(PostError::Block {
+                        index: b.source_index,
+                        source,
+                    })
+                }
+            };
             let mut from = p.clone();
             for (cl, j, err) in scratch.drain(..) {
                 let mut nb = PostedBlock {
@@ -327,12 +418,22 @@ pub fn post_path(
         blocks: out.len(),
         inserted_blocks,
         unwound_blocks: out.iter().filter(|b| b.unwound).count(),
+        reconfigurations: out
+            .windows(2)
+            .filter(|w| {
+                w[1].kind != MoveKind::Rapid
+                    && ((w[1].joints.tilt - w[0].joints.tilt).abs() > RECONFIGURATION_STEP_RAD
+                        || (w[1].joints.rotate - w[0].joints.rotate).abs()
+                            > RECONFIGURATION_STEP_RAD)
+            })
+            .count(),
     };
     Ok(PostedPath {
         machine: machine.name().to_string(),
         tool_length: tl,
         blocks: out,
         metrics,
+        reverse_motion: reverse_report,
     })
 }
 
@@ -341,4 +442,55 @@ fn set_feed(machine: &Machine, from: &PostedBlock, b: &mut PostedBlock) {
         let len = (b.cl.tip - from.cl.tip).norm();
         b.inverse_time_feed = Some(inverse_time_feed(machine, &from.joints, &b.joints, len, f));
     }
+}
+
+/// A rotary step larger than this (rad) inside a group counts as a reconfiguration (the
+/// machine would swing the table or head around between two neighbouring cutter locations).
+pub const RECONFIGURATION_STEP_RAD: f64 = std::f64::consts::FRAC_PI_2;
+
+type Solved = (Joints, Option<KinematicsError>, bool);
+
+/// Inverse kinematics of `moves[range]` with continuity from `prev` (the first posture may be
+/// forced); returns the postures and the number of problems (blocks outside the limits plus
+/// reconfiguration steps).
+fn solve_group(
+    machine: &Machine,
+    moves: &[Move],
+    range: std::ops::Range<usize>,
+    prev: &Joints,
+    first: Option<Joints>,
+    options: &PostOptions,
+) -> Result<(Vec<Solved>, usize), PostError> {
+    let tl = options.tool_length;
+    let continuous = matches!(machine.axis(AxisId::Rotate).mode, RotaryMode::Continuous)
+        || matches!(machine.axis(AxisId::Tilt).mode, RotaryMode::Continuous);
+    let mut out: Vec<Solved> = Vec::with_capacity(range.len());
+    let mut problems = 0;
+    let mut prev = *prev;
+    for index in range.clone() {
+        let m = &moves[index];
+        let (mut j, violation) = match (index == range.start, first) {
+            (true, Some(f)) => (f, None),
+            _ => machine
+                .inverse_best_effort(&m.cl, tl, Some(&prev))
+                .map_err(|source| PostError::Block { index, source })?,
+        };
+        let mut unwound = false;
+        if options.unwind_on_rapid && continuous && m.kind == MoveKind::Rapid {
+            unwound = machine.unwind(&mut j);
+            if unwound {
+                j = machine.joints_for_angles(&m.cl.tip, tl, j.tilt, j.rotate);
+            }
+        }
+        problems += usize::from(violation.is_some());
+        if index > range.start
+            && ((j.tilt - prev.tilt).abs() > RECONFIGURATION_STEP_RAD
+                || (j.rotate - prev.rotate).abs() > RECONFIGURATION_STEP_RAD)
+        {
+            problems += 1;
+        }
+        out.push((j, violation, unwound));
+        prev = j;
+    }
+    Ok((out, problems))
 }
