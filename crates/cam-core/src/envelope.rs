@@ -60,7 +60,9 @@
 //! - plain sphere: `G_v = v/|v|` (the unit normal `n`), `G_a = 0`;
 //! - beyond a disc rim (`w > e`, `g = w − e`, `Q = √(z² + g²)`):
 //!   `G_v = (z·a + g·(v − z a)/w)/Q`, `G_a = z(1 − g/w)·v/Q`, `∂F/∂e = −g/Q`;
-//! - over a disc (`w <= e`): `G_v = sign(z)·a`, `G_a = sign(z)·v`, `∂F/∂e = 0`;
+//! - over a disc (`w <= e`): `G_v = σ·a`, `G_a = σ·v`, `∂F/∂e = 0`, with `σ = sign(z)`, except
+//!   at the kink `z = 0` where the minimising member's centre plane passes through `p`: there
+//!   the value is `−ρ(t*)` with `c(t*) = z`, which gives `σ = −ρ'/c'` (0 for a bull nose);
 //! - point: `∂d/∂p = G_v` (the unit outward normal of the envelope at the foot point);
 //! - axis: `∂F/∂a = G_a − m·G_v`, projected on the sphere of unit vectors,
 //!   `∂F/∂D = (I − a aᵀ)·∂F/∂a / ℓ`;
@@ -75,10 +77,39 @@
 //! minimum (e.g. a point below a flat bottom, equidistant from several members) it is one
 //! valid one-sided derivative.
 
+//!
+//! # Example
+//!
+//! ```
+//! use cam_core::{CutterShape, EnvelopeOptions, GuideCurve, Point3, SphereFamily,
+//!                SweptEnvelope, Vector3};
+//! // A 3 mm ball, 3° taper, moving 50 mm along +x with a vertical axis.
+//! let shape = CutterShape::TaperedBallEnd { ball_radius: 3.0, half_angle: 3f64.to_radians() };
+//! let family = SphereFamily::from_shape(&shape, 25.0)?;
+//! let line = |z: f64| GuideCurve::new(1, vec![0.0, 0.0, 1.0, 1.0],
+//!     vec![Vector3::new(0.0, 0.0, z), Vector3::new(50.0, 0.0, z)], None);
+//! let env = SweptEnvelope::new(family, line(0.0)?, line(10.0)?, 0.0,
+//!                              EnvelopeOptions::default())?;
+//! // 1 mm below the tip line: outside, 1 mm away.
+//! let (d, grad) = env.signed_distance_with_gradient(&Point3::new(25.0, 0.0, -1.0), None)?;
+//! assert!((d.distance - 1.0).abs() < 1e-12);
+//! assert!((grad.point - Vector3::new(0.0, 0.0, -1.0)).norm() < 1e-9);
+//! // ∂d/∂(ball radius) = 0 here: the tip (lowest point) stays on the guide when r grows.
+//! assert!(grad.shape[0].abs() < 1e-9);
+//! // Warm start for the next point along the path.
+//! let next = env.signed_distance(&Point3::new(26.0, 0.0, -1.0), Some(d.param))?;
+//! assert!((next.distance - 1.0).abs() < 1e-12);
+//! # Ok::<(), cam_core::CamError>(())
+//! ```
+
 use crate::guide::GuideEval;
 use crate::{CamError, CutterLocation, GuideCurve, Point3, SphereFamily, Vector3};
 
 const NB: usize = crate::guide::MAX_GUIDE_DEGREE + 1;
+
+/// A point whose height above a disc member's centre plane is below this (mm) is treated as
+/// lying in that plane (the kink of `|z − c(t)|` where the exact `t`-minimisation puts it).
+pub const KINK_TOL_MM: f64 = 1e-9;
 
 /// Named numerical settings of [`SweptEnvelope`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -165,8 +196,9 @@ impl ControlPointGradient {
 /// First-order change of the signed distance (envelope theorem; see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnvelopeGradient {
-    /// `∂d/∂p`: unit normal of the envelope at the foot point, pointing toward `p` from
-    /// outside.
+    /// `∂d/∂p`: outside the swept volume the unit normal of the envelope at the foot point
+    /// (pointing toward `p`); inside, the gradient of the deepest-member depth (a unit vector
+    /// too, except at the kink over a disc, see the module docs).
     pub point: Vector3,
     /// Sensitivity to the control points of `P0` (the lower guide).
     pub guide0: ControlPointGradient,
@@ -200,6 +232,8 @@ struct Frame {
 /// `F` and its first and second derivatives in `(s, τ)`, plus the pieces needed later.
 #[derive(Debug, Clone, Copy)]
 struct Local {
+    /// `F` itself (the Newton loop takes it from the exact `t`-minimisation instead).
+    #[cfg_attr(not(test), allow(dead_code))]
     f: f64,
     g: [f64; 2],
     h: [[f64; 2]; 2],
@@ -217,6 +251,8 @@ pub struct SweptEnvelope {
     domain: (f64, f64),
     seeds: Vec<Seed>,
     opts: EnvelopeOptions,
+    /// Both guides have the same degree and knots: one basis evaluation per frame.
+    shared_basis: bool,
 }
 
 impl SweptEnvelope {
@@ -263,7 +299,9 @@ impl SweptEnvelope {
         breaks.extend(guide1.breakpoints());
         breaks.sort_by(f64::total_cmp);
         breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * scale);
+        let shared_basis = guide0.shares_basis_with(&guide1);
         let mut env = Self {
+            shared_basis,
             family,
             guide0,
             guide1,
@@ -282,6 +320,23 @@ impl SweptEnvelope {
         seeds.push(env.seed_at(d0.1)?);
         env.seeds = seeds;
         Ok(env)
+    }
+
+    /// Convenience: the envelope of `cutter`'s fluted part moving along two `nurbs` guides.
+    pub fn for_cutter(
+        cutter: &crate::Cutter,
+        guide0: &nurbs::Curve3,
+        guide1: &nurbs::Curve3,
+        guide_height: f64,
+        opts: EnvelopeOptions,
+    ) -> Result<Self, CamError> {
+        Self::new(
+            SphereFamily::from_cutter(cutter)?,
+            GuideCurve::from_curve(guide0)?,
+            GuideCurve::from_curve(guide1)?,
+            guide_height,
+            opts,
+        )
     }
 
     fn seed_at(&self, s: f64) -> Result<Seed, CamError> {
@@ -315,7 +370,7 @@ impl SweptEnvelope {
         let p0 = self.guide0.point(s);
         let d = self.guide1.point(s) - p0;
         let ell = d.norm();
-        if !(ell >= self.opts.min_axis_length) {
+        if ell.is_nan() || ell < self.opts.min_axis_length {
             return Err(CamError::DegenerateAxis { s });
         }
         let a = d / ell;
@@ -328,23 +383,21 @@ impl SweptEnvelope {
         CutterLocation::new(Point3::from(tip), axis)
     }
 
-    /// `min_t F(s, t)` at `s`: (value, global t).
-    fn g_at(&self, p: &Vector3, s: f64) -> Result<(f64, f64), CamError> {
-        let (tip, a) = self.tip_axis(s)?;
-        let v = p - tip;
-        let z = v.dot(&a);
-        let w = (v.norm_squared() - z * z).max(0.0).sqrt();
-        Ok(self.family.signed_distance(w, z))
-    }
-
     fn frame(&self, s: f64) -> Result<Frame, CamError> {
-        let e0 = self.guide0.eval2(s);
-        let e1 = self.guide1.eval2(s);
+        let (e0, e1) = if self.shared_basis {
+            let (span, n) = self.guide0.basis2(s);
+            (
+                self.guide0.combine2(span, &n),
+                self.guide1.combine2(span, &n),
+            )
+        } else {
+            (self.guide0.eval2(s), self.guide1.eval2(s))
+        };
         let d = e1.d[0] - e0.d[0];
         let d1 = e1.d[1] - e0.d[1];
         let d2 = e1.d[2] - e0.d[2];
         let ell = d.norm();
-        if !(ell >= self.opts.min_axis_length) {
+        if ell.is_nan() || ell < self.opts.min_axis_length {
             return Err(CamError::DegenerateAxis { s });
         }
         let a = d / ell;
@@ -432,7 +485,7 @@ impl SweptEnvelope {
                 q_i = qi;
                 q_ij = [[h(0, 0), h(0, 1)], [h(0, 1), h(1, 1)]];
             } else {
-                let sg = if z < 0.0 { -1.0 } else { 1.0 };
+                let sg = flat_sign(z, piece);
                 q = z.abs();
                 q_i = [sg * z_i[0], sg * z_i[1]];
                 q_ij = [[sg * zz(0, 0), sg * zz(0, 1)], [sg * zz(0, 1), 0.0]];
@@ -447,16 +500,26 @@ impl SweptEnvelope {
         }
     }
 
+    /// `min_t F(s, t)` at a frame: (value, global t).
+    fn g_frame(&self, p: &Vector3, fr: &Frame) -> (f64, f64) {
+        let v = p - (fr.p0[0] - fr.a * self.guide_height);
+        let z = v.dot(&fr.a);
+        let w = (v.norm_squared() - z * z).max(0.0).sqrt();
+        self.family.signed_distance(w, z)
+    }
+
     /// Newton on `g(s) = min_t F(s, t)` from `s`; returns (value, s, t, iterations).
+    /// Each iteration evaluates both guides once (with two derivatives) at the trial point,
+    /// which is reused as the next iterate when the full step is accepted.
     fn polish(&self, p: &Vector3, s_start: f64) -> Result<(f64, f64, f64, usize), CamError> {
         let (lo, hi) = self.domain;
         let mut s = s_start.clamp(lo, hi);
-        let (mut f, mut t) = self.g_at(p, s)?;
+        let mut fr = self.frame(s)?;
+        let (mut f, mut t) = self.g_frame(p, &fr);
         let n_pieces = self.family.pieces().len() as f64;
         let mut iters = 0;
         while iters < self.opts.max_iterations {
             iters += 1;
-            let fr = self.frame(s)?;
             let loc = self.local(p, &fr, t);
             let gs = loc.g[0];
             if (s <= lo && gs >= 0.0) || (s >= hi && gs <= 0.0) {
@@ -469,28 +532,39 @@ impl SweptEnvelope {
             if t_interior && loc.h[1][1] > 1e-12 * (loc.h[0][0].abs() + 1.0) {
                 gss -= loc.h[0][1] * loc.h[0][1] / loc.h[1][1];
             }
-            let range = hi - lo;
             let step = if gss > 0.0 {
                 -gs / gss
             } else {
-                -gs.signum() * 0.05 * range
+                -gs.signum() * 0.05 * (hi - lo)
             };
+            // Converged when the (projected) Newton step would move the centre less than
+            // step_tol, or would lower F by less than its rounding noise (the line search
+            // could not see the decrease; the remaining error is below that noise).
+            if gss > 0.0 {
+                let ds = (s + step).clamp(lo, hi) - s;
+                let noise = 64.0 * f64::EPSILON * (1.0 + p.amax() + fr.p0[0].amax());
+                if ds.abs() * loc.speed[0] < self.opts.step_tol || -gs * ds < noise {
+                    break;
+                }
+            }
             let mut alpha = 1.0;
             let mut accepted = None;
             while alpha > 1e-12 {
                 let s_new = (s + alpha * step).clamp(lo, hi);
-                let (f_new, t_new) = self.g_at(p, s_new)?;
+                let fr_new = self.frame(s_new)?;
+                let (f_new, t_new) = self.g_frame(p, &fr_new);
                 if f_new <= f + 1e-4 * gs * (s_new - s) {
-                    accepted = Some((s_new, f_new, t_new));
+                    accepted = Some((s_new, fr_new, f_new, t_new));
                     break;
                 }
                 alpha *= 0.5;
             }
-            let Some((s_new, f_new, t_new)) = accepted else {
+            let Some((s_new, fr_new, f_new, t_new)) = accepted else {
                 break; // no decrease possible at this resolution: converged
             };
             let moved = (s_new - s).abs() * loc.speed[0];
             s = s_new;
+            fr = fr_new;
             f = f_new;
             t = t_new;
             if moved < self.opts.step_tol {
@@ -626,7 +700,7 @@ impl SweptEnvelope {
                     (radial_or_axis(&v, &a, w), Vector3::zeros(), -1.0)
                 }
             } else {
-                let sg = if z < 0.0 { -1.0 } else { 1.0 };
+                let sg = flat_sign(z, piece);
                 (a * sg, v * sg, 0.0)
             }
         };
@@ -673,6 +747,21 @@ impl SweptEnvelope {
     }
 }
 
+/// `∂|z|/∂z` over a disc, where `z` is the height of `p` above the member's centre plane. At
+/// the kink `z = 0` reached by the exact `t`-minimisation (p lies in the centre plane of a
+/// member containing it) the value is `min_t (|z − c(t)| − ρ(t)) = −ρ(t*)` with `c(t*) = z`, so
+/// its derivative follows `t*`: the effective slope is `−ρ'/c'` (0 for a bull nose: the depth
+/// `−ρ` is locally constant).
+fn flat_sign(z: f64, piece: &crate::SpherePiece) -> f64 {
+    if z.abs() <= KINK_TOL_MM && piece.height[1] != 0.0 {
+        -piece.radius[1] / piece.height[1]
+    } else if z < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
 /// Unit radial direction of `v` (or the axis when `v` is on it).
 fn radial_or_axis(v: &Vector3, a: &Vector3, w: f64) -> Vector3 {
     if w > 0.0 {
@@ -706,6 +795,7 @@ mod tests {
 
     /// `local` derivatives against central differences of `F`, for sphere and disc pieces.
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn local_derivatives_match_finite_differences() {
         let g0 = guide(&[
             [0.0, 0.0, 0.0],

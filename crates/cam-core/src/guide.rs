@@ -93,6 +93,34 @@ impl GuideCurve {
         })
     }
 
+    /// Copies a `nurbs` space curve (rational or not) into a guide.
+    pub fn from_curve(curve: &nurbs::Curve3) -> Result<Self, CamError> {
+        let ctrl = curve
+            .control_points()
+            .iter()
+            .map(|q| Vector3::new(q[0], q[1], q[2]))
+            .collect();
+        Self::new(
+            curve.degree(),
+            curve.knots().knots().to_vec(),
+            ctrl,
+            curve.weights().map(<[f64]>::to_vec),
+        )
+    }
+
+    /// The guide as a `nurbs` curve (e.g. after an optimiser moved its control points).
+    pub fn to_curve(&self) -> Result<nurbs::Curve3, CamError> {
+        nurbs::Curve3::new(
+            self.degree,
+            self.knots.clone(),
+            self.ctrl.clone(),
+            self.weights.clone(),
+        )
+        .map_err(|_| CamError::InvalidGuide {
+            reason: "rejected by nurbs::NurbsCurve::new",
+        })
+    }
+
     /// Degree.
     pub fn degree(&self) -> usize {
         self.degree
@@ -215,24 +243,40 @@ impl GuideCurve {
     /// Point and first two derivatives at `u` (clamped to the domain), with the rational basis.
     /// No allocation; O(p²).
     pub fn eval2(&self, u: f64) -> GuideEval {
-        let p = self.degree;
+        let (span, n) = self.basis2(u);
+        self.combine2(span, &n)
+    }
+
+    /// True when `other` has the same degree and knots, so one basis evaluation serves both
+    /// ([`Self::basis2`] / [`Self::combine2`]; weights may differ).
+    pub fn shares_basis_with(&self, other: &GuideCurve) -> bool {
+        self.degree == other.degree && self.knots == other.knots
+    }
+
+    /// Knot span and non-rational basis functions with two derivatives at `u` (clamped).
+    pub(crate) fn basis2(&self, u: f64) -> (usize, [[f64; NB]; 3]) {
         let span = self.find_span(u);
         let (lo, hi) = self.domain();
-        let u = u.clamp(lo, hi);
         let mut n = [[0.0; NB]; 3];
-        self.ders_basis(span, u, &mut n);
+        self.ders_basis(span, u.clamp(lo, hi), &mut n);
+        (span, n)
+    }
+
+    /// Point and derivatives from a span and basis computed by [`Self::basis2`] of this
+    /// curve or of one that [shares its basis](Self::shares_basis_with).
+    pub(crate) fn combine2(&self, span: usize, n: &[[f64; NB]; 3]) -> GuideEval {
+        let p = self.degree;
         let first = span - p;
         let mut d = [Vector3::zeros(); 3];
         let mut basis = [0.0; NB];
         match &self.weights {
             None => {
-                for j in 0..=p {
-                    let q = &self.ctrl[first + j];
+                for (j, q) in self.ctrl[first..=first + p].iter().enumerate() {
                     d[0] += q * n[0][j];
                     d[1] += q * n[1][j];
                     d[2] += q * n[2][j];
-                    basis[j] = n[0][j];
                 }
+                basis[..=p].copy_from_slice(&n[0][..=p]);
             }
             Some(w) => {
                 let mut aw = [Vector3::zeros(); 3];
@@ -358,6 +402,23 @@ mod tests {
                 .map(|i| c.control_points()[e.first + i] * e.basis[i])
                 .sum();
             assert!((q - e.d[0]).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)]
+    fn agrees_with_the_nurbs_crate() {
+        let c = cubic();
+        let n = c.to_curve().unwrap();
+        let back = GuideCurve::from_curve(&n).unwrap();
+        assert_eq!(back, c);
+        for &u in &[0.0, 0.2, 0.5, 0.8, 1.0] {
+            let d = n.derivs(u, 2);
+            let e = c.eval2(u);
+            for k in 0..3 {
+                let dk = Vector3::new(d[k][0], d[k][1], d[k][2]);
+                assert!((dk - e.d[k]).norm() < 1e-9 * (1.0 + dk.norm()), "{u} {k}");
+            }
         }
     }
 

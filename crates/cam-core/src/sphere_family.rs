@@ -247,6 +247,60 @@ impl SphereFamily {
         Ok(fam)
     }
 
+    /// A user-defined family (any cutter of revolution whose solid is a union of
+    /// (disc-swept) spheres): `pieces` in increasing parameter, `param_names` naming the
+    /// shape parameters their `d_shape` rows differentiate (at most 2; may be empty).
+    ///
+    /// Errors ([`CamError::InvalidCutter`]): no pieces, more than two parameter names,
+    /// non-finite coefficients, or a negative radius or disc radius at either end of a piece.
+    pub fn new(
+        pieces: Vec<SpherePiece>,
+        param_names: &'static [&'static str],
+    ) -> Result<Self, CamError> {
+        let bad = |field, value, reason| {
+            Err(CamError::InvalidCutter {
+                field,
+                value,
+                reason,
+            })
+        };
+        if pieces.is_empty() {
+            return bad("sphere_family.pieces", 0.0, "needs at least one piece");
+        }
+        if param_names.len() > 2 {
+            return bad(
+                "sphere_family.param_names",
+                param_names.len() as f64,
+                "at most two shape parameters",
+            );
+        }
+        for p in &pieces {
+            let all = [p.height, p.disc_radius, p.radius]
+                .into_iter()
+                .flatten()
+                .chain(p.d_shape.iter().flatten().copied());
+            for v in all {
+                if !v.is_finite() {
+                    return bad("sphere_family.coefficient", v, "must be finite");
+                }
+            }
+            for tau in [0.0, 1.0] {
+                let m = p.at(tau);
+                if m.radius < 0.0 || m.disc_radius < 0.0 {
+                    return bad(
+                        "sphere_family.radius",
+                        m.radius.min(m.disc_radius),
+                        "radius and disc radius must be >= 0",
+                    );
+                }
+            }
+        }
+        Ok(Self {
+            pieces,
+            param_names,
+        })
+    }
+
     /// The family of a cutter's fluted part (shape and flute length).
     pub fn from_cutter(cutter: &Cutter) -> Result<Self, CamError> {
         Self::from_shape(&cutter.shape, cutter.flute_length)
@@ -428,6 +482,24 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn user_families_are_validated() {
+        let ball = SphereFamily::from_shape(&CutterShape::BallEnd { radius: 2.0 }, 10.0).unwrap();
+        let own = SphereFamily::new(ball.pieces().to_vec(), &["radius"]).unwrap();
+        assert_eq!(own, ball);
+        assert!(SphereFamily::new(Vec::new(), &[]).is_err());
+        let mut p = ball.pieces()[0];
+        p.radius = [1.0, -2.0];
+        assert!(matches!(
+            SphereFamily::new(vec![p], &[]),
+            Err(CamError::InvalidCutter {
+                field: "sphere_family.radius",
+                ..
+            })
+        ));
+        assert!(SphereFamily::new(ball.pieces().to_vec(), &["a", "b", "c"]).is_err());
     }
 
     #[test]

@@ -46,14 +46,26 @@
 // The kernels transcribe The NURBS Book index by index; iterator rewrites would obscure that.
 #![allow(clippy::needless_range_loop)]
 
+mod arcs;
+mod bezier;
+mod curvature;
 mod curve;
+mod degree_elevation;
 mod error;
+mod homogeneous;
+mod iso_curves;
+mod knot_insertion;
 mod knots;
+mod reparam;
+mod revolution;
+mod ruled;
 mod surface;
 mod traits;
-#[allow(dead_code)] // homogeneous helpers are used by the knot algorithms landing next
+mod transform;
 mod util;
 
+pub use bezier::BezierPatch;
+pub use curvature::PrincipalCurvatures;
 pub use curve::{Curve2, Curve3, NurbsCurve, NurbsCurveData};
 pub use error::{Direction, NurbsError};
 pub use knots::{KnotVector, KnotVectorData};
@@ -65,3 +77,7 @@ pub const MAX_DEGREE: usize = 12;
 
 /// `MAX_DEGREE + 1`: size of the fixed basis-function buffers.
 pub const MAX_ORDER: usize = MAX_DEGREE + 1;
+
+pub mod closest;
+pub mod discretise;
+pub mod fit;
