@@ -21,6 +21,8 @@ struct Cli {
 enum Command {
     /// Run the whole pipeline on a job file (or the embedded default job).
     Run(cmd::run::Args),
+    /// Post-process an APT CLDATA file into a program for a machine and controller.
+    Post(cmd::post::Args),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Post(args) => cmd::post::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
