@@ -14,6 +14,7 @@
 //! the per-row parallelism.
 
 pub mod collision;
+pub mod crosscheck;
 pub mod design;
 pub mod dexel;
 pub mod error;
@@ -27,6 +28,7 @@ pub mod stock_shape;
 pub mod surface_mesh;
 pub mod tool_solid;
 
+pub use crosscheck::{crosscheck_overcut, CrossCheckPoint, Envelopes};
 pub use design::{BoxDesign, CylinderDesign, DesignModel, SurfaceGrid, TriangleMesh, UnionDesign};
 pub use dexel::{DexelGrid, Segments, TriDexel};
 pub use error::SimError;
