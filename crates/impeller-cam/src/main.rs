@@ -23,6 +23,8 @@ enum Command {
     Run(cmd::run::Args),
     /// Post-process an APT CLDATA file into a program for a machine and controller.
     Post(cmd::post::Args),
+    /// Verify a CL program against the impeller design (overcut, residual, collisions).
+    Verify(cmd::verify::Args),
 }
 
 fn main() -> ExitCode {
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Post(args) => cmd::post::run(args),
+        Command::Verify(args) => cmd::verify::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

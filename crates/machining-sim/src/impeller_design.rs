@@ -64,6 +64,8 @@ pub struct ImpellerDesign {
     sides_mesh: TriMesh,
     tri_info: Vec<(u32, Side, f64, f64)>,
     sampling: ImpellerSampling,
+    hub_z_max: f64,
+    hub_r_max: f64,
 }
 
 fn grid_tris(nu: usize, nv: usize, base: u32, out: &mut Vec<[u32; 3]>) {
@@ -130,7 +132,12 @@ impl ImpellerDesign {
         }
         let sides_mesh = TriMesh::new(vertices, tris)
             .map_err(|e| SimError::Design(format!("blade side mesh: {e:?}")))?;
+        let m = impeller.hub().meridional();
+        let (t0, t1) = m.domain();
+        let (a, b) = (m.point(t0), m.point(t1));
         Ok(Self {
+            hub_z_max: a[0].max(b[0]),
+            hub_r_max: a[1].max(b[1]),
             impeller: impeller.clone(),
             blades,
             sides_mesh,
@@ -142,6 +149,15 @@ impl ImpellerDesign {
     /// The impeller's blank as a revolved stock outline.
     pub fn blank(&self) -> Result<RevolvedStock, SimError> {
         blank_of(&self.impeller)
+    }
+
+    /// Signed distance to the hub body: below the hub surface, capped by the plane of the
+    /// hub's inlet end (`z ≤ z_inlet`) and the cylinder of its outlet radius (`r ≤ r_outlet`),
+    /// where the meridional distance alone would extend the body past the contour's ends.
+    pub fn hub_signed_distance(&self, p: &Point3) -> f64 {
+        let d = self.impeller.hub().signed_distance(&p.coords);
+        let r = (p.x * p.x + p.y * p.y).sqrt();
+        d.max(p.z - self.hub_z_max).max(r - self.hub_r_max)
     }
 
     /// Signed distance to the blade nearest to `p` (negative inside the blade, below the
@@ -182,7 +198,7 @@ impl ImpellerDesign {
                     .outward_normal(side, u, v)
                     .unwrap_or_else(Vector3::zeros);
                 // Keep samples on the real blade: above the hub, below the shroud.
-                let keep = self.impeller.hub().signed_distance(&p) > 0.0
+                let keep = self.hub_signed_distance(&Point3::from(p)) > 0.0
                     && self.impeller.shroud().signed_distance(&p) < 0.0;
                 g.points.push(Point3::from(p));
                 g.normals.push(if keep { n } else { Vector3::zeros() });
@@ -294,8 +310,8 @@ pub fn blank_of(impeller: &Impeller) -> Result<RevolvedStock, SimError> {
 
 impl DesignModel for ImpellerDesign {
     fn signed_distance(&self, p: &Point3) -> f64 {
-        let d_hub = self.impeller.hub().signed_distance(&p.coords);
-        d_hub.min(self.blade_signed_distance(p))
+        self.hub_signed_distance(p)
+            .min(self.blade_signed_distance(p))
     }
 
     fn surface_grids(&self) -> Vec<SurfaceGrid> {

@@ -26,6 +26,7 @@ pub mod removal;
 pub mod simulate;
 pub mod stock_shape;
 pub mod surface_mesh;
+pub mod synthetic;
 pub mod tool_solid;
 
 pub use crosscheck::{crosscheck_overcut, CrossCheckPoint, Envelopes};

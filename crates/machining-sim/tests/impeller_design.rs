@@ -39,6 +39,8 @@ fn signed_distance_signs_and_samples_on_surfaces() {
     // Deep below the hub surface near the axis: inside; far above the shroud: outside.
     assert!(d.signed_distance(&Point3::new(0.0, 0.0, 1.0)) < -1.0);
     assert!(d.signed_distance(&Point3::new(30.0, 0.0, 60.0)) > 1.0);
+    // On the axis above the hub's inlet end: outside (the hub body is capped there).
+    assert!(d.signed_distance(&Point3::new(0.0, 0.0, 60.0)) > 1.0);
     let grids = d.surface_grids();
     let mut kept = 0;
     for g in &grids {
