@@ -62,10 +62,8 @@ impl Envelopes {
                     }
                     continue;
                 }
-                if run.is_empty() {
-                    if k > 0 {
-                        run.push(path.moves[k - 1].cl);
-                    }
+                if run.is_empty() && k > 0 {
+                    run.push(path.moves[k - 1].cl);
                 }
                 run.push(mv.cl);
             }

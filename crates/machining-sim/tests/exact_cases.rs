@@ -1,5 +1,6 @@
 //! Exact cases: plunge of a flat end (volume, floor), ball-end groove profile, a deliberate
 //! gouge into a blade-like plate, the resolution study and collisions.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use cam_core::{
     Cutter, CutterLocation, CutterShape, HolderSegment, Move, MoveKind, Point3, ToolPath,

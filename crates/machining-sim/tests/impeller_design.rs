@@ -1,5 +1,6 @@
 //! The impeller fixture as a design model: signs of the signed distance, samples on the
 //! surfaces, and a verification run of a gouging cut.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use cam_core::{Cutter, CutterLocation, CutterShape, Move, MoveKind, Point3, ToolPath, Vector3};
 use impeller_model::fixtures::default_impeller;
