@@ -205,6 +205,13 @@ impl<const D: usize> NurbsCurve<D> {
         let p = self.knots.degree();
         let kn = self.knots.knots();
         let u = clamp_param(kn, p, u);
+        let w = self.weights.as_deref();
+        match p {
+            1 => return crate::kernels::curve_point::<D, 2>(&self.knots, &self.ctrl, w, u),
+            2 => return crate::kernels::curve_point::<D, 3>(&self.knots, &self.ctrl, w, u),
+            3 => return crate::kernels::curve_point::<D, 4>(&self.knots, &self.ctrl, w, u),
+            _ => {}
+        }
         let span = crate::knots::find_span(kn, p, u);
         let n = basis_funs_fixed(kn, p, span, u);
         let first = span - p;

@@ -54,6 +54,7 @@ mod degree_elevation;
 mod error;
 mod homogeneous;
 mod iso_curves;
+mod kernels;
 mod knot_insertion;
 mod knots;
 mod reparam;
