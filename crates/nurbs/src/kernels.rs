@@ -267,3 +267,44 @@ pub(crate) fn curve_point<const D: usize, const O: usize>(
         }
     }
 }
+
+/// `[C, C', C'']` for order `O = p + 1` (parameter already clamped; A3.2 + A4.2 to order 2).
+#[inline(always)]
+pub(crate) fn curve_derivs2<const D: usize, const O: usize>(
+    kv: &KnotVector,
+    ctrl: &[SVector<f64, D>],
+    weights: Option<&[f64]>,
+    u: f64,
+) -> [SVector<f64, D>; 3] {
+    let span = find_span(kv.knots(), O - 1, u);
+    let nd = ders2_basis::<O>(kv, span, u);
+    let first = span + 1 - O;
+    let pts = &ctrl[first..first + O];
+    let mut a = [SVector::<f64, D>::zeros(); 3];
+    match weights {
+        None => {
+            for j in 0..O {
+                for k in 0..3 {
+                    a[k] += pts[j] * nd[k][j];
+                }
+            }
+            a
+        }
+        Some(w) => {
+            let ws = &w[first..first + O];
+            let mut wd = [0.0; 3];
+            for j in 0..O {
+                let pw = pts[j] * ws[j];
+                for k in 0..3 {
+                    a[k] += pw * nd[k][j];
+                    wd[k] += ws[j] * nd[k][j];
+                }
+            }
+            let inv = 1.0 / wd[0];
+            let c0 = a[0] * inv;
+            let c1 = (a[1] - c0 * wd[1]) * inv;
+            let c2 = (a[2] - c1 * (2.0 * wd[1]) - c0 * wd[2]) * inv;
+            [c0, c1, c2]
+        }
+    }
+}

@@ -244,7 +244,11 @@ proptest! {
     fn fast_curve_point_agrees_with_derivs_on_knots(c in curve3(true), i in 0usize..30) {
         let k = c.knots().knots();
         let u = k[i % k.len()];
-        let d = c.derivs(u, 0);
+        let d = c.derivs(u, 2);
         prop_assert!((c.point(u) - d[0]).norm() <= 1e-12 * (1.0 + d[0].norm()));
+        let d2 = c.derivs2(u);
+        for k in 0..3 {
+            prop_assert!((d2[k] - d[k]).norm() <= 1e-11 * (1.0 + d[k].norm()), "order {}", k);
+        }
     }
 }
