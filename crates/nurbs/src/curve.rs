@@ -5,6 +5,7 @@
 use nalgebra::SVector;
 
 use crate::error::NurbsError;
+use crate::homogeneous::HSpline;
 use crate::knots::{basis_funs_fixed, clamp_param, ders_basis_fixed, KnotVector};
 use crate::util::binomial;
 use crate::MAX_ORDER;
@@ -118,7 +119,6 @@ impl<const D: usize> NurbsCurve<D> {
     /// Builds a curve from homogeneous data `(w_i P_i, w_i)` stored with stride `D + 1`
     /// (or Euclidean with stride `D` when `rational` is false). Used by the knot
     /// algorithms, which work in homogeneous space.
-    #[allow(dead_code)]
     pub(crate) fn from_homogeneous(
         knots: KnotVector,
         data: &[f64],
@@ -129,9 +129,37 @@ impl<const D: usize> NurbsCurve<D> {
     }
 
     /// Homogeneous control data, stride `D + 1` if rational else `D`.
-    #[allow(dead_code)]
     pub(crate) fn homogeneous(&self) -> Vec<f64> {
         crate::util::to_homogeneous(&self.ctrl, self.weights.as_deref())
+    }
+
+    /// The control polygon in homogeneous form for the chapter-5 algorithms.
+    pub(crate) fn to_hspline(&self) -> HSpline {
+        HSpline {
+            p: self.degree(),
+            knots: self.knots.knots().to_vec(),
+            pts: self.homogeneous(),
+            dim: if self.is_rational() { D + 1 } else { D },
+        }
+    }
+
+    /// Rebuilds a curve (validating it) from a homogeneous control polygon.
+    pub(crate) fn from_hspline(h: &HSpline, rational: bool) -> Result<Self, NurbsError> {
+        let kv = KnotVector::new(h.p, h.knots.clone())?;
+        Self::from_homogeneous(kv, &h.pts, rational)
+    }
+
+    /// Same knots and weights, control points mapped by `f` (callers guarantee `f`
+    /// keeps finite points finite, e.g. a rigid motion).
+    pub(crate) fn map_control_points(
+        &self,
+        f: impl Fn(SVector<f64, D>) -> SVector<f64, D>,
+    ) -> Self {
+        NurbsCurve {
+            knots: self.knots.clone(),
+            ctrl: self.ctrl.iter().map(|p| f(*p)).collect(),
+            weights: self.weights.clone(),
+        }
     }
 
     /// Parameter domain `[u_p, u_{m-p}]`.
