@@ -81,3 +81,5 @@ pub const MAX_ORDER: usize = MAX_DEGREE + 1;
 pub mod closest;
 pub mod discretise;
 pub mod fit;
+pub mod project;
+pub mod tessellate;
