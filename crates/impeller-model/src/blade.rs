@@ -215,6 +215,17 @@ impl Blade {
             .map(|n| n * self.outward_sign(side))
     }
 
+    /// The isoparametric curve u = const of `side` (a blade section line from hub to shroud;
+    /// a straight ruling on ruled blades).
+    pub fn iso_u(&self, side: Side, u: f64) -> Result<nurbs::NurbsCurve<3>, ModelError> {
+        Ok(self.side(side).iso_curve_at_u(u)?)
+    }
+
+    /// The isoparametric curve v = const of `side` (a flow line from leading to trailing edge).
+    pub fn iso_v(&self, side: Side, v: f64) -> Result<nurbs::NurbsCurve<3>, ModelError> {
+        Ok(self.side(side).iso_curve_at_v(v)?)
+    }
+
     /// The global closest-point structure of `side` (nurbs' `SurfaceProjector`: Bézier
     /// patches in a bounding-volume tree, Newton per candidate leaf), built on first use.
     pub fn projector(&self, side: Side) -> &SurfaceProjector {

@@ -36,6 +36,34 @@ fn hub_and_shroud_radii_equal_their_meridional_curves() {
     }
 }
 
+#[test]
+fn isoparametric_curves_lie_on_their_surfaces() {
+    let imp = fixtures::default_impeller().unwrap();
+    let m = imp.hub().meridian(0.7).unwrap();
+    let c = imp.hub().parallel(0.3).unwrap();
+    let r = imp.hub().meridional().point(0.3)[1];
+    for k in 0..=10 {
+        let t = k as f64 / 10.0;
+        let p = m.point(t);
+        assert!((p.y.atan2(p.x) - 0.7).abs() < 1e-12);
+        assert!((p - imp.hub().point(t, 0.7)).norm() < 1e-9);
+        let (a, b) = c.domain();
+        let q = c.point(a + (b - a) * t);
+        assert!(((q.x * q.x + q.y * q.y).sqrt() - r).abs() < 1e-9);
+    }
+    let b = imp.main().blade();
+    let ruling = b.iso_u(Side::Suction, 0.4).unwrap();
+    let flow = b.iso_v(Side::Pressure, 0.5).unwrap();
+    for k in 0..=10 {
+        let t = k as f64 / 10.0;
+        assert!((ruling.point(t) - b.suction().point(0.4, t)).norm() < 1e-9);
+        assert!((flow.point(t) - b.pressure().point(t, 0.5)).norm() < 1e-9);
+    }
+    // Rulings of a ruled blade are straight: the midpoint is the mean of the ends.
+    let mid = ruling.point(0.5);
+    assert!((mid - 0.5 * (ruling.point(0.0) + ruling.point(1.0))).norm() < 1e-9);
+}
+
 /// Normal thickness along the camber normal against the designed distribution, on the hub
 /// and shroud rows of ruled blades (where the ruled sides are offset exactly).
 #[test]
