@@ -44,7 +44,7 @@ pub mod stock;
 pub mod summary;
 pub mod thickness;
 
-pub use blade::{Blade, BladeDesign, BladeKind, BladeSet, Side};
+pub use blade::{Blade, BladeDesign, BladeEdge, BladeKind, BladeSet, Side};
 pub use error::ModelError;
 pub use impeller::Impeller;
 pub use meridional::MeridionalCurve;

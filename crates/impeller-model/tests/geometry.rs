@@ -64,6 +64,46 @@ fn isoparametric_curves_lie_on_their_surfaces() {
     assert!((mid - 0.5 * (ruling.point(0.0) + ruling.point(1.0))).norm() < 1e-9);
 }
 
+#[test]
+fn blunt_edges_have_faces_and_rounded_edges_are_closed() {
+    use impeller_model::BladeEdge;
+    let imp = fixtures::default_impeller().unwrap();
+    let b = imp.main().blade();
+    assert!(b.edge_face(BladeEdge::Leading).unwrap().is_none());
+    let face = b.edge_face(BladeEdge::Trailing).unwrap().unwrap();
+    let ((_, pu1), _) = b.pressure().domain();
+    // The face joins the two sides' trailing isocurves; its width is the 0.8 mm blade.
+    let d = b.design().unwrap();
+    let v = d.v_of_span(0.0);
+    let p = b.pressure().point(pu1, v);
+    let s = b.suction().point(pu1, v);
+    // Face u runs along the edge (the sides' v, here on [0, 1]); face v from pressure to suction.
+    assert!((face.point(v, 0.0) - p).norm() < 1e-9);
+    assert!((face.point(v, 1.0) - s).norm() < 1e-9);
+    assert!(((p - s).norm() - 0.8).abs() < 1e-6);
+}
+
+#[test]
+fn splitters_are_numbered_between_their_main_blades() {
+    use impeller_model::BladeSet;
+    let imp = fixtures::default_impeller().unwrap();
+    let split = imp.splitter().unwrap();
+    // Hand the importer's constructor a splitter row referenced one pitch too far on.
+    let shifted = BladeSet::new(8, split.instance(3)).unwrap();
+    let again = Impeller::from_parts(
+        "x",
+        imp.hub().clone(),
+        imp.shroud().clone(),
+        imp.main().clone(),
+        Some(shifted),
+        1.0,
+        imp.stock().clone(),
+    )
+    .unwrap();
+    let p = again.splitter().unwrap().blade().suction().point(0.5, 0.5);
+    assert!((p - split.blade().suction().point(0.5, 0.5)).norm() < 1e-9);
+}
+
 /// Normal thickness along the camber normal against the designed distribution, on the hub
 /// and shroud rows of ruled blades (where the ruled sides are offset exactly).
 #[test]
