@@ -21,6 +21,8 @@ struct Cli {
 enum Command {
     /// Run the whole pipeline on a job file (or the embedded default job).
     Run(cmd::run::Args),
+    /// Build an impeller and print its measured summary (blade counts, diameters, widths).
+    Model(cmd::model::Args),
     /// Post-process an APT CLDATA file into a program for a machine and controller.
     Post(cmd::post::Args),
     /// Verify a CL program against the impeller design (overcut, residual, collisions).
@@ -39,6 +41,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Model(args) => cmd::model::run(args),
         Command::Post(args) => cmd::post::run(args),
         Command::Verify(args) => cmd::verify::run(args),
     };
