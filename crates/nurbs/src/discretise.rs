@@ -121,6 +121,8 @@ fn adapt<const D: usize>(
     let m = 0.5 * (a + b);
     let left = gl8(curve, a, m);
     let right = gl8(curve, m, b);
+    // The tolerance cannot go below the round-off of the estimates themselves.
+    let tol = tol.max(16.0 * f64::EPSILON * whole.abs());
     if (left + right - whole).abs() <= tol || depth >= MAX_DEPTH || m <= a || m >= b {
         out.push((m, left));
         out.push((b, right));
