@@ -1,9 +1,13 @@
 //! Global closest points on surfaces and curves.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::sync::OnceLock;
 
 use nalgebra::{Vector2, Vector3};
-use nurbs::closest::{closest_point_on_curve, closest_point_on_surface, CurveProjector, SurfacePoint, SurfaceProjector};
+use nurbs::closest::{
+    closest_point_on_curve, closest_point_on_surface, CurveProjector, SurfacePoint,
+    SurfaceProjector,
+};
 use nurbs::{KnotVector, NurbsCurve, NurbsSurface};
 use proptest::prelude::*;
 
@@ -17,7 +21,11 @@ fn reference() -> &'static (NurbsSurface, SurfaceProjector) {
                     .map(|j| {
                         let x = 100.0 * i as f64 / 11.0;
                         let y = 100.0 * j as f64 / 11.0;
-                        Vector3::new(x, y, 8.0 * (x / 17.0).sin() * (y / 23.0).cos() + 0.002 * x * y)
+                        Vector3::new(
+                            x,
+                            y,
+                            8.0 * (x / 17.0).sin() * (y / 23.0).cos() + 0.002 * x * y,
+                        )
                     })
                     .collect()
             })
@@ -46,9 +54,16 @@ fn dense_min(s: &NurbsSurface, q: &Vector3<f64>, n: usize) -> f64 {
 /// First-order optimality: interior answers have `S − q` normal to the surface (1e-9,
 /// relative); boundary answers have the free variable's condition and the held variable's
 /// gradient pointing out of the domain.
-fn check_optimality(s: &NurbsSurface, q: &Vector3<f64>, a: &SurfacePoint) -> Result<(), TestCaseError> {
+fn check_optimality(
+    s: &NurbsSurface,
+    q: &Vector3<f64>,
+    a: &SurfacePoint,
+) -> Result<(), TestCaseError> {
     let ((u0, u1), (v0, v1)) = s.domain();
-    prop_assert!(a.u >= u0 && a.u <= u1 && a.v >= v0 && a.v <= v1, "parameters outside the domain");
+    prop_assert!(
+        a.u >= u0 && a.u <= u1 && a.v >= v0 && a.v <= v1,
+        "parameters outside the domain"
+    );
     let d = s.derivs2(a.u, a.v);
     prop_assert!((d.p - a.point).norm() <= 1e-9);
     prop_assert!(((d.p - q).norm() - a.distance).abs() <= 1e-9);
@@ -61,8 +76,16 @@ fn check_optimality(s: &NurbsSurface, q: &Vector3<f64>, a: &SurfacePoint) -> Res
     let ok = |x: f64, c: f64, lo: f64, hi: f64| {
         c.abs() <= 1e-9 || (x <= lo && c > 0.0) || (x >= hi && c < 0.0)
     };
-    prop_assert!(ok(a.u, cu, u0, u1), "u condition: cos = {cu:e} at u = {}", a.u);
-    prop_assert!(ok(a.v, cv, v0, v1), "v condition: cos = {cv:e} at v = {}", a.v);
+    prop_assert!(
+        ok(a.u, cu, u0, u1),
+        "u condition: cos = {cu:e} at u = {}",
+        a.u
+    );
+    prop_assert!(
+        ok(a.v, cv, v0, v1),
+        "v condition: cos = {cv:e} at v = {}",
+        a.v
+    );
     if !a.on_boundary {
         prop_assert!(cu.abs() <= 1e-9 && cv.abs() <= 1e-9);
     }
@@ -77,11 +100,19 @@ fn bumpy_surface(seed: u64, p: usize, rational: bool) -> NurbsSurface {
         6.0 * x * y
     };
     let ctrl: Vec<Vec<Vector3<f64>>> = (0..n)
-        .map(|i| (0..n).map(|j| Vector3::new(10.0 * i as f64, 10.0 * j as f64, h(i, j))).collect())
+        .map(|i| {
+            (0..n)
+                .map(|j| Vector3::new(10.0 * i as f64, 10.0 * j as f64, h(i, j)))
+                .collect()
+        })
         .collect();
     let weights = rational.then(|| {
         (0..n)
-            .map(|i| (0..n).map(|j| 1.0 + 0.5 * ((i * 3 + j * 5 + seed as usize) % 4) as f64).collect())
+            .map(|i| {
+                (0..n)
+                    .map(|j| 1.0 + 0.5 * ((i * 3 + j * 5 + seed as usize) % 4) as f64)
+                    .collect()
+            })
             .collect()
     });
     let k = KnotVector::clamped_uniform(p, n).unwrap().knots().to_vec();
@@ -139,7 +170,11 @@ proptest! {
 fn closest_point_on_a_plane() {
     // Bicubic patch with a planar, non-uniform control net in z = 2.
     let ctrl: Vec<Vec<Vector3<f64>>> = (0..5)
-        .map(|i| (0..4).map(|j| Vector3::new((i * i) as f64 * 3.0, j as f64 * 7.0 + i as f64, 2.0)).collect())
+        .map(|i| {
+            (0..4)
+                .map(|j| Vector3::new((i * i) as f64 * 3.0, j as f64 * 7.0 + i as f64, 2.0))
+                .collect()
+        })
         .collect();
     let s = NurbsSurface::new(
         3,
@@ -154,7 +189,11 @@ fn closest_point_on_a_plane() {
     for (u, v, h) in [(0.3, 0.4, 5.0), (0.9, 0.1, -3.0), (0.5, 0.5, 0.25)] {
         let foot = s.point(u, v);
         let a = p.closest_point(&(foot + Vector3::new(0.0, 0.0, h)));
-        assert!((a.distance - h.abs()).abs() <= 1e-12, "{} vs {h}", a.distance);
+        assert!(
+            (a.distance - h.abs()).abs() <= 1e-12,
+            "{} vs {h}",
+            a.distance
+        );
         assert!((a.point - foot).norm() <= 1e-10);
         assert!(!a.on_boundary);
     }
@@ -175,12 +214,22 @@ fn closest_point_on_a_cylinder_of_revolution() {
         None,
     )
     .unwrap();
-    let s = NurbsSurface::revolution(&line, Vector3::zeros(), Vector3::z(), std::f64::consts::TAU).unwrap();
+    let s = NurbsSurface::revolution(&line, Vector3::zeros(), Vector3::z(), std::f64::consts::TAU)
+        .unwrap();
     let p = SurfaceProjector::new(&s);
-    for (r, phi, z) in [(35.0, 0.3, 10.0), (5.0, 2.0, 25.0), (20.5, 4.0, 1.0), (12.0, 5.9, 29.0)] {
+    for (r, phi, z) in [
+        (35.0, 0.3, 10.0),
+        (5.0, 2.0, 25.0),
+        (20.5, 4.0, 1.0),
+        (12.0, 5.9, 29.0),
+    ] {
         let q = Vector3::new(r * f64::cos(phi), r * f64::sin(phi), z);
         let a = p.closest_point(&q);
-        assert!((a.distance - (r - 20.0f64).abs()).abs() <= 1e-10, "r {r}: {}", a.distance);
+        assert!(
+            (a.distance - (r - 20.0f64).abs()).abs() <= 1e-10,
+            "r {r}: {}",
+            a.distance
+        );
         let expect = Vector3::new(20.0 * phi.cos(), 20.0 * phi.sin(), z);
         assert!((a.point - expect).norm() <= 1e-9);
     }
@@ -211,7 +260,11 @@ fn closest_point_on_a_circle_arc() {
         assert!((a.point - expect).norm() <= 1e-9);
     }
     // Outside the angular range: the nearer end point.
-    let q = Vector3::new(1.0 + 12.0 * f64::cos(-0.4), 2.0 + 12.0 * f64::sin(-0.4), 3.0);
+    let q = Vector3::new(
+        1.0 + 12.0 * f64::cos(-0.4),
+        2.0 + 12.0 * f64::sin(-0.4),
+        3.0,
+    );
     let a = proj.closest_point(&q);
     assert!(a.on_boundary && a.u == 0.0);
     let hinted = proj.closest_point_with_hint(&q, Some(0.9));
@@ -225,7 +278,13 @@ fn crease_surface_global_minimum() {
     let ctrl: Vec<Vec<Vector3<f64>>> = (0..7)
         .map(|i| {
             (0..4)
-                .map(|j| Vector3::new(10.0 * i as f64, 10.0 * j as f64, -(i as f64 - 3.0).abs() * 5.0))
+                .map(|j| {
+                    Vector3::new(
+                        10.0 * i as f64,
+                        10.0 * j as f64,
+                        -(i as f64 - 3.0).abs() * 5.0,
+                    )
+                })
                 .collect()
         })
         .collect();
@@ -236,6 +295,10 @@ fn crease_surface_global_minimum() {
     let q = Vector3::new(30.0, 15.0, 8.0);
     let a = p.closest_point(&q);
     assert!(a.distance <= dense_min(&s, &q, 201) + 1e-12);
-    assert!((a.u - 0.5).abs() <= 1e-12, "minimum on the crease, got u = {}", a.u);
+    assert!(
+        (a.u - 0.5).abs() <= 1e-12,
+        "minimum on the crease, got u = {}",
+        a.u
+    );
     assert!((a.distance - 8.0).abs() <= 1e-9);
 }

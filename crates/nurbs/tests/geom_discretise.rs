@@ -1,4 +1,5 @@
 //! Arc length and curve discretisation.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::f64::consts::PI;
 
@@ -11,7 +12,15 @@ use nurbs::{KnotVector, NurbsCurve};
 use proptest::prelude::*;
 
 fn arc(r: f64, theta: f64) -> NurbsCurve<2> {
-    NurbsCurve::<2>::circle_arc(Vector2::new(3.0, -1.0), Vector2::x(), Vector2::y(), r, 0.2, 0.2 + theta).unwrap()
+    NurbsCurve::<2>::circle_arc(
+        Vector2::new(3.0, -1.0),
+        Vector2::x(),
+        Vector2::y(),
+        r,
+        0.2,
+        0.2 + theta,
+    )
+    .unwrap()
 }
 
 proptest! {
@@ -67,9 +76,21 @@ fn parameter_steps_are_uniform() {
 
 fn wavy() -> NurbsCurve<3> {
     let ctrl: Vec<Vector3<f64>> = (0..12)
-        .map(|k| Vector3::new(k as f64 * 8.0, 20.0 * (k as f64).sin(), 5.0 * (0.7 * k as f64).cos()))
+        .map(|k| {
+            Vector3::new(
+                k as f64 * 8.0,
+                20.0 * (k as f64).sin(),
+                5.0 * (0.7 * k as f64).cos(),
+            )
+        })
         .collect();
-    NurbsCurve::<3>::new(3, KnotVector::clamped_uniform(3, 12).unwrap().knots().to_vec(), ctrl, None).unwrap()
+    NurbsCurve::<3>::new(
+        3,
+        KnotVector::clamped_uniform(3, 12).unwrap().knots().to_vec(),
+        ctrl,
+        None,
+    )
+    .unwrap()
 }
 
 fn segment_distance(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
@@ -102,15 +123,30 @@ fn chord_tolerance_polyline_stays_within_tolerance() {
 #[test]
 fn every_discretise_error_is_reported() {
     let c = arc(1.0, 1.0);
-    assert!(matches!(discretise_by_arc_length(&c, 0.0), Err(DiscretiseError::InvalidValue { field: "step", .. })));
-    assert!(matches!(discretise_by_chord(&c, f64::NAN), Err(DiscretiseError::InvalidValue { field: "chord_tol", .. })));
-    assert!(matches!(arc_length(&c, -1.0), Err(DiscretiseError::InvalidValue { field: "tol", .. })));
+    assert!(matches!(
+        discretise_by_arc_length(&c, 0.0),
+        Err(DiscretiseError::InvalidValue { field: "step", .. })
+    ));
+    assert!(matches!(
+        discretise_by_chord(&c, f64::NAN),
+        Err(DiscretiseError::InvalidValue {
+            field: "chord_tol",
+            ..
+        })
+    ));
+    assert!(matches!(
+        arc_length(&c, -1.0),
+        Err(DiscretiseError::InvalidValue { field: "tol", .. })
+    ));
     assert!(matches!(
         arc_length_between(&c, 0.5, 0.2, 1e-9),
         Err(DiscretiseError::InvalidInterval { .. })
     ));
     assert!(matches!(
         discretise_by_parameter(&c, 1e-9),
-        Err(DiscretiseError::TooManyPoints { limit: nurbs::discretise::MAX_POINTS, .. })
+        Err(DiscretiseError::TooManyPoints {
+            limit: nurbs::discretise::MAX_POINTS,
+            ..
+        })
     ));
 }

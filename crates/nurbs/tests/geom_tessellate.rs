@@ -1,4 +1,5 @@
 //! Tessellation within a chord tolerance.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::Vector3;
 use nurbs::tessellate::{tessellate, Mesh, TessellateError};
@@ -13,7 +14,11 @@ fn reference() -> NurbsSurface {
                 .map(|j| {
                     let x = 100.0 * i as f64 / 11.0;
                     let y = 100.0 * j as f64 / 11.0;
-                    Vector3::new(x, y, 8.0 * (x / 17.0).sin() * (y / 23.0).cos() + 0.002 * x * y)
+                    Vector3::new(
+                        x,
+                        y,
+                        8.0 * (x / 17.0).sin() * (y / 23.0).cos() + 0.002 * x * y,
+                    )
                 })
                 .collect()
         })
@@ -29,10 +34,19 @@ fn chord_error(s: &NurbsSurface, m: &Mesh) -> f64 {
     let mut worst: f64 = 0.0;
     for t in &m.triangles {
         let [a, b, c] = t.map(|k| k as usize);
-        let mut probes = vec![[1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0], [0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]];
+        let mut probes = vec![
+            [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0],
+            [0.5, 0.5, 0.0],
+            [0.0, 0.5, 0.5],
+            [0.5, 0.0, 0.5],
+        ];
         for _ in 0..3 {
             let (x, y): (f64, f64) = (rng.random(), rng.random());
-            let (x, y) = if x + y > 1.0 { (1.0 - x, 1.0 - y) } else { (x, y) };
+            let (x, y) = if x + y > 1.0 {
+                (1.0 - x, 1.0 - y)
+            } else {
+                (x, y)
+            };
             probes.push([x, y, 1.0 - x - y]);
         }
         for w in probes {
@@ -66,7 +80,10 @@ fn reference_surface_within_chord_tolerance() {
         }
     }
     // A finer tolerance needs more triangles.
-    assert!(tessellate(&s, 0.01).unwrap().triangles.len() > tessellate(&s, 0.1).unwrap().triangles.len());
+    assert!(
+        tessellate(&s, 0.01).unwrap().triangles.len()
+            > tessellate(&s, 0.1).unwrap().triangles.len()
+    );
 }
 
 #[test]
@@ -78,13 +95,15 @@ fn rational_cylinder_within_chord_tolerance() {
         None,
     )
     .unwrap();
-    let s = NurbsSurface::revolution(&line, Vector3::zeros(), Vector3::z(), std::f64::consts::TAU).unwrap();
+    let s = NurbsSurface::revolution(&line, Vector3::zeros(), Vector3::z(), std::f64::consts::TAU)
+        .unwrap();
     let tol = 0.02;
     let m = tessellate(&s, tol).unwrap();
     assert!(chord_error(&s, &m) <= tol);
     // Geometric check: triangle centroids are inside the cylinder by at most tol.
     for t in &m.triangles {
-        let c = (m.vertices[t[0] as usize] + m.vertices[t[1] as usize] + m.vertices[t[2] as usize]) / 3.0;
+        let c = (m.vertices[t[0] as usize] + m.vertices[t[1] as usize] + m.vertices[t[2] as usize])
+            / 3.0;
         let r = c.xy().norm();
         assert!(r <= 20.0 + 1e-9 && r >= 20.0 - tol, "r = {r}");
     }
@@ -93,6 +112,12 @@ fn rational_cylinder_within_chord_tolerance() {
 #[test]
 fn every_tessellate_error_is_reported() {
     let s = reference();
-    assert_eq!(tessellate(&s, 0.0).unwrap_err(), TessellateError::InvalidTolerance(0.0));
-    assert!(matches!(tessellate(&s, 1e-12), Err(TessellateError::TooManyVertices { .. })));
+    assert_eq!(
+        tessellate(&s, 0.0).unwrap_err(),
+        TessellateError::InvalidTolerance(0.0)
+    );
+    assert!(matches!(
+        tessellate(&s, 1e-12),
+        Err(TessellateError::TooManyVertices { .. })
+    ));
 }

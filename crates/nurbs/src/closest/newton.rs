@@ -36,7 +36,11 @@ pub(crate) struct Local {
 /// coordinates, `δ(|r|²) ≈ 2|r|·δp`. Steps that increase `f` by less are accepted, so the
 /// iteration can finish converging where `f` itself no longer resolves the progress.
 #[inline]
-pub(crate) fn noise<const D: usize>(f: f64, p: &nalgebra::SVector<f64, D>, q: &nalgebra::SVector<f64, D>) -> f64 {
+pub(crate) fn noise<const D: usize>(
+    f: f64,
+    p: &nalgebra::SVector<f64, D>,
+    q: &nalgebra::SVector<f64, D>,
+) -> f64 {
     let scale = p.amax().max(q.amax()) + 1e-300;
     2.0 * f.sqrt() * 64.0 * f64::EPSILON * scale + 1e-300
 }
@@ -131,8 +135,16 @@ pub(crate) fn minimise<F: Fn(f64, f64) -> SurfaceDerivs2>(
             // Also require the angle condition (relative orthogonality) unless the step is
             // at round-off level: near-cusps make tiny steps with a sizeable angle left.
             let rn = f.sqrt();
-            let cu = if fix_u { 0.0 } else { gu.abs() / (rn * auu.sqrt()) };
-            let cv = if fix_v { 0.0 } else { gv.abs() / (rn * avv.sqrt()) };
+            let cu = if fix_u {
+                0.0
+            } else {
+                gu.abs() / (rn * auu.sqrt())
+            };
+            let cv = if fix_v {
+                0.0
+            } else {
+                gv.abs() / (rn * avv.sqrt())
+            };
             if !(cu > ANGLE_TOL || cv > ANGLE_TOL) || predicted <= 1e-3 * step_tol {
                 converged = true;
                 break;

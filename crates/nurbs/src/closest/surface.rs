@@ -244,7 +244,12 @@ impl Iv {
         }
     }
     fn mul(self, o: Iv) -> Iv {
-        let c = [self.lo * o.lo, self.lo * o.hi, self.hi * o.lo, self.hi * o.hi];
+        let c = [
+            self.lo * o.lo,
+            self.lo * o.hi,
+            self.hi * o.lo,
+            self.hi * o.hi,
+        ];
         Iv {
             lo: c.iter().copied().fold(f64::INFINITY, f64::min),
             hi: c.iter().copied().fold(f64::NEG_INFINITY, f64::max),
@@ -294,7 +299,11 @@ impl VBox {
         let mut acc = Iv { lo: 0.0, hi: 0.0 };
         for iv in &self.0 {
             let (a, b) = (iv.lo * iv.lo, iv.hi * iv.hi);
-            let lo = if iv.lo <= 0.0 && iv.hi >= 0.0 { 0.0 } else { a.min(b) };
+            let lo = if iv.lo <= 0.0 && iv.hi >= 0.0 {
+                0.0
+            } else {
+                a.min(b)
+            };
             acc = acc.add(Iv { lo, hi: a.max(b) });
         }
         acc
@@ -338,7 +347,8 @@ impl HessianBounds {
     }
 
     fn of(sub: &BezierPatch, pts: &[Vector3<f64>], axes: &[Vector3<f64>; 3]) -> HessianBounds {
-        let frame = |v: Vector3<f64>| Vector3::new(v.dot(&axes[0]), v.dot(&axes[1]), v.dot(&axes[2]));
+        let frame =
+            |v: Vector3<f64>| Vector3::new(v.dot(&axes[0]), v.dot(&axes[1]), v.dot(&axes[2]));
         let (p, q) = (sub.p, sub.q);
         let (du, dv) = (sub.u1 - sub.u0, sub.v1 - sub.v0);
         let (su, sv, suu, suv, svv) = if sub.rational {
@@ -373,15 +383,22 @@ impl HessianBounds {
                         d.1.push(frame((at(i, j + 1) - at(i, j)) * (qf / dv)));
                     }
                     if i + 2 <= p {
-                        d.2.push(frame((at(i + 2, j) - at(i + 1, j) * 2.0 + at(i, j)) * (pf * (pf - 1.0) / (du * du))));
+                        d.2.push(frame(
+                            (at(i + 2, j) - at(i + 1, j) * 2.0 + at(i, j))
+                                * (pf * (pf - 1.0) / (du * du)),
+                        ));
                     }
                     if i < p && j < q {
                         d.3.push(frame(
-                            (at(i + 1, j + 1) - at(i + 1, j) - at(i, j + 1) + at(i, j)) * (pf * qf / (du * dv)),
+                            (at(i + 1, j + 1) - at(i + 1, j) - at(i, j + 1) + at(i, j))
+                                * (pf * qf / (du * dv)),
                         ));
                     }
                     if j + 2 <= q {
-                        d.4.push(frame((at(i, j + 2) - at(i, j + 1) * 2.0 + at(i, j)) * (qf * (qf - 1.0) / (dv * dv))));
+                        d.4.push(frame(
+                            (at(i, j + 2) - at(i, j + 1) * 2.0 + at(i, j))
+                                * (qf * (qf - 1.0) / (dv * dv)),
+                        ));
                     }
                 }
             }
@@ -585,7 +602,11 @@ impl SurfaceProjector {
             let (l, r) = (node.left, node.right);
             let dl = self.nodes[l as usize].aabb.dist2(q);
             let dr = self.nodes[r as usize].aabb.dist2(q);
-            let ((near, dn), (far, df)) = if dl <= dr { ((l, dl), (r, dr)) } else { ((r, dr), (l, dl)) };
+            let ((near, dn), (far, df)) = if dl <= dr {
+                ((l, dl), (r, dr))
+            } else {
+                ((r, dr), (l, dl))
+            };
             if df < bound && sp < stack.len() {
                 stack[sp] = (far, df);
                 sp += 1;
@@ -599,7 +620,14 @@ impl SurfaceProjector {
         // surface (its true minimum lies within round-off across the edge): polish it on
         // the whole domain.
         if let Some((b, false)) = best {
-            let l = minimise(|u, v| self.derivs2(u, v), q, (ua, va), (ub, vb), (b.u, b.v), self.step_tol);
+            let l = minimise(
+                |u, v| self.derivs2(u, v),
+                q,
+                (ua, va),
+                (ub, vb),
+                (b.u, b.v),
+                self.step_tol,
+            );
             if l.d2 <= b.d2 * (1.0 + 8.0 * f64::EPSILON) {
                 best = Some((l, true));
             }
@@ -673,7 +701,9 @@ impl SurfaceProjector {
             // next to the leaf's own minimum.
             let cu = b.u.clamp(leaf.u0, leaf.u1);
             let cv = b.v.clamp(leaf.v0, leaf.v1);
-            if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0) && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0) {
+            if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0)
+                && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0)
+            {
                 start = (cu, cv);
                 d_start = (patch.point(cu, cv) - q).norm_squared();
             }
@@ -743,14 +773,26 @@ impl SurfaceProjector {
             let (um, vm) = (0.5 * (sub.u0 + sub.u1), 0.5 * (sub.v0 + sub.v1));
             let mut start = (um, vm);
             let mut ds = (patch.point(um, vm) - q).norm_squared();
-            for (u, v) in [(sub.u0, sub.v0), (sub.u1, sub.v0), (sub.u0, sub.v1), (sub.u1, sub.v1)] {
+            for (u, v) in [
+                (sub.u0, sub.v0),
+                (sub.u1, sub.v0),
+                (sub.u0, sub.v1),
+                (sub.u1, sub.v1),
+            ] {
                 let d = (patch.point(u, v) - q).norm_squared();
                 if d < ds {
                     ds = d;
                     start = (u, v);
                 }
             }
-            let l = minimise(|u, v| patch.derivs2(u, v), q, (sub.u0, sub.v0), (sub.u1, sub.v1), start, self.step_tol);
+            let l = minimise(
+                |u, v| patch.derivs2(u, v),
+                q,
+                (sub.u0, sub.v0),
+                (sub.u1, sub.v1),
+                start,
+                self.step_tol,
+            );
             if l.d2 < best.d2 {
                 *best = l;
             }
@@ -759,7 +801,9 @@ impl SurfaceProjector {
         let (um, vm) = (0.5 * (sub.u0 + sub.u1), 0.5 * (sub.v0 + sub.v1));
         let mut kids: Vec<(f64, BezierPatch)> = [(sub.u0, um), (um, sub.u1)]
             .iter()
-            .flat_map(|&(a, b)| [(sub.v0, vm), (vm, sub.v1)].map(|(c, d)| sub.sub_patch(a, b, c, d)))
+            .flat_map(|&(a, b)| {
+                [(sub.v0, vm), (vm, sub.v1)].map(|(c, d)| sub.sub_patch(a, b, c, d))
+            })
             .map(|k| {
                 let mut bx = Aabb::empty();
                 for p in k.points() {
@@ -867,13 +911,20 @@ fn certificate_failures(patch: &BezierPatch, su: usize, sv: usize) -> (bool, boo
             for s in [-1.0, 1.0] {
                 for t1 in [-1.0, 1.0] {
                     for t2 in [-1.0, 1.0] {
-                        let q = obb.c + axes[2] * (s * dd) + axes[0] * (t1 * obb.h[0]) + axes[1] * (t2 * obb.h[1]);
+                        let q = obb.c
+                            + axes[2] * (s * dd)
+                            + axes[0] * (t1 * obb.h[0])
+                            + axes[1] * (t2 * obb.h[1]);
                         ok &= hess.certifies(&obb, &q);
                     }
                 }
             }
             if !ok {
-                let mag = |b: &VBox| b.0.iter().map(|iv| iv.lo.abs().max(iv.hi.abs())).fold(0.0, f64::max);
+                let mag = |b: &VBox| {
+                    b.0.iter()
+                        .map(|iv| iv.lo.abs().max(iv.hi.abs()))
+                        .fold(0.0, f64::max)
+                };
                 if mag(&hess.suu) * obb.h[0] >= mag(&hess.svv) * obb.h[1] {
                     fu = true;
                 } else {
