@@ -426,6 +426,9 @@ impl HessianBounds {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Node {
     pub aabb: Aabb,
+    /// Oriented box around the leaves' oriented boxes, in their mean frame: much tighter
+    /// than the axis-aligned box across the surface, which is what the walk prunes with.
+    pub obb: Obb,
     /// Children (`left`, `right`) for inner nodes; `right == u32::MAX` marks a leaf whose
     /// index is `left`.
     pub left: u32,
@@ -600,8 +603,8 @@ impl SurfaceProjector {
                 continue;
             }
             let (l, r) = (node.left, node.right);
-            let dl = self.nodes[l as usize].aabb.dist2(q);
-            let dr = self.nodes[r as usize].aabb.dist2(q);
+            let dl = self.nodes[l as usize].obb.dist2(q);
+            let dr = self.nodes[r as usize].obb.dist2(q);
             let ((near, dn), (far, df)) = if dl <= dr {
                 ((l, dl), (r, dr))
             } else {
@@ -669,12 +672,18 @@ impl SurfaceProjector {
         if leaf.obb.dist2(q) >= bound {
             return None;
         }
-        let certified = leaf.hess.certifies(&leaf.obb, q);
+        // The convexity certificate is computed only when it is needed (skip test below or
+        // before solving), after the cheaper cone tests.
+        let mut certified: Option<bool> = None;
         if let Some((b, true)) = best {
             // A stationary point of the surface inside a leaf where the distance is convex
             // is that leaf's minimum.
-            if certified && b.u >= leaf.u0 && b.u <= leaf.u1 && b.v >= leaf.v0 && b.v <= leaf.v1 {
-                return None;
+            if b.u >= leaf.u0 && b.u <= leaf.u1 && b.v >= leaf.v0 && b.v <= leaf.v1 {
+                let c = leaf.hess.certifies(&leaf.obb, q);
+                certified = Some(c);
+                if c {
+                    return None;
+                }
             }
         }
         let cq = leaf.obb.c - q;
@@ -723,7 +732,7 @@ impl SurfaceProjector {
             start,
             self.step_tol,
         );
-        if !certified {
+        if !certified.unwrap_or_else(|| leaf.hess.certifies(&leaf.obb, q)) {
             // The distance may have several minima on this leaf (query beyond a centre of
             // curvature): search the leaf by branch and bound.
             let sub = patch.sub_patch(leaf.u0, leaf.u1, leaf.v0, leaf.v1);
@@ -1001,6 +1010,11 @@ fn build_bvh(leaves: &[Leaf]) -> Vec<Node> {
     let mut idx: Vec<usize> = (0..leaves.len()).collect();
     nodes.push(Node {
         aabb: Aabb::empty(),
+        obb: Obb {
+            c: Vector3::zeros(),
+            axes: [Vector3::x(), Vector3::y(), Vector3::z()],
+            h: [0.0; 3],
+        },
         left: 0,
         right: u32::MAX,
     });
@@ -1013,9 +1027,11 @@ fn build_rec(leaves: &[Leaf], idx: &mut [usize], at: usize, nodes: &mut Vec<Node
     for &i in idx.iter() {
         aabb.merge(&leaves[i].aabb);
     }
+    let obb = group_obb(leaves, idx);
     if idx.len() == 1 {
         nodes[at] = Node {
             aabb,
+            obb: leaves[idx[0]].obb,
             left: idx[0] as u32,
             right: u32::MAX,
         };
@@ -1041,20 +1057,56 @@ fn build_rec(leaves: &[Leaf], idx: &mut [usize], at: usize, nodes: &mut Vec<Node
     let l = nodes.len();
     nodes.push(Node {
         aabb: Aabb::empty(),
+        obb,
         left: 0,
         right: u32::MAX,
     });
     nodes.push(Node {
         aabb: Aabb::empty(),
+        obb,
         left: 0,
         right: u32::MAX,
     });
     nodes[at] = Node {
         aabb,
+        obb,
         left: l as u32,
         right: (l + 1) as u32,
     };
     let (a, b) = idx.split_at_mut(mid);
     build_rec(leaves, a, l, nodes);
     build_rec(leaves, b, l + 1, nodes);
+}
+
+/// Oriented box containing the oriented boxes of `idx`, in their mean frame (the axes of
+/// the world when the mean normal vanishes).
+fn group_obb(leaves: &[Leaf], idx: &[usize]) -> Obb {
+    let mut n = Vector3::zeros();
+    let mut t = Vector3::zeros();
+    for &i in idx {
+        n += leaves[i].obb.axes[2];
+        t += leaves[i].obb.axes[0];
+    }
+    let axes = match n.try_normalize(1e-9) {
+        Some(n) => {
+            let t = t - n * t.dot(&n);
+            match t.try_normalize(1e-9) {
+                Some(e1) => [e1, n.cross(&e1), n],
+                None => [Vector3::x(), Vector3::y(), Vector3::z()],
+            }
+        }
+        None => [Vector3::x(), Vector3::y(), Vector3::z()],
+    };
+    let mut corners = Vec::with_capacity(8 * idx.len());
+    for &i in idx {
+        let o = &leaves[i].obb;
+        for s0 in [-1.0, 1.0] {
+            for s1 in [-1.0, 1.0] {
+                for s2 in [-1.0, 1.0] {
+                    corners.push(o.c + o.axes[0] * (s0 * o.h[0]) + o.axes[1] * (s1 * o.h[1]) + o.axes[2] * (s2 * o.h[2]));
+                }
+            }
+        }
+    }
+    Obb::from_points(&corners, axes)
 }
