@@ -603,8 +603,16 @@ impl SurfaceProjector {
                 continue;
             }
             let (l, r) = (node.left, node.right);
-            let dl = self.nodes[l as usize].obb.dist2(q);
-            let dr = self.nodes[r as usize].obb.dist2(q);
+            let lb = |n: &Node| {
+                let a = n.aabb.dist2(q);
+                if a >= bound {
+                    a
+                } else {
+                    a.max(n.obb.dist2(q))
+                }
+            };
+            let dl = lb(&self.nodes[l as usize]);
+            let dr = lb(&self.nodes[r as usize]);
             let ((near, dn), (far, df)) = if dl <= dr {
                 ((l, dl), (r, dr))
             } else {
