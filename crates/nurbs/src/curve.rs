@@ -205,6 +205,13 @@ impl<const D: usize> NurbsCurve<D> {
         let p = self.knots.degree();
         let kn = self.knots.knots();
         let u = clamp_param(kn, p, u);
+        let w = self.weights.as_deref();
+        match p {
+            1 => return crate::kernels::curve_point::<D, 2>(&self.knots, &self.ctrl, w, u),
+            2 => return crate::kernels::curve_point::<D, 3>(&self.knots, &self.ctrl, w, u),
+            3 => return crate::kernels::curve_point::<D, 4>(&self.knots, &self.ctrl, w, u),
+            _ => {}
+        }
         let span = crate::knots::find_span(kn, p, u);
         let n = basis_funs_fixed(kn, p, span, u);
         let first = span - p;
@@ -230,8 +237,17 @@ impl<const D: usize> NurbsCurve<D> {
     }
 
     /// Point, first and second derivative `[C, C', C'']` without allocation (A3.2/A4.2
-    /// specialised to order 2). Parameters outside the domain are clamped.
+    /// specialised to order 2; O(p² + p D)). Parameters outside the domain are clamped.
     pub fn derivs2(&self, u: f64) -> [SVector<f64, D>; 3] {
+        let p = self.knots.degree();
+        let u = clamp_param(self.knots.knots(), p, u);
+        let w = self.weights.as_deref();
+        match p {
+            1 => return crate::kernels::curve_derivs2::<D, 2>(&self.knots, &self.ctrl, w, u),
+            2 => return crate::kernels::curve_derivs2::<D, 3>(&self.knots, &self.ctrl, w, u),
+            3 => return crate::kernels::curve_derivs2::<D, 4>(&self.knots, &self.ctrl, w, u),
+            _ => {}
+        }
         let mut out = [SVector::<f64, D>::zeros(); 3];
         self.derivs_into(u, &mut out);
         out

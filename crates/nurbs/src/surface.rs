@@ -6,6 +6,7 @@ use nalgebra::Vector3;
 
 use crate::error::{Direction, NurbsError};
 use crate::homogeneous::HSpline;
+use crate::kernels;
 use crate::knots::{basis_funs_fixed, clamp_param, ders_basis_fixed, find_span, KnotVector};
 use crate::util::binomial;
 use crate::MAX_ORDER;
@@ -254,6 +255,17 @@ impl NurbsSurface {
         }
     }
 
+    #[inline]
+    fn view(&self) -> kernels::SurfaceView<'_> {
+        kernels::SurfaceView {
+            ku: &self.knots_u,
+            kv: &self.knots_v,
+            n_v: self.n_v,
+            ctrl: &self.ctrl,
+            weights: self.weights.as_deref(),
+        }
+    }
+
     /// Parameter domain `((u_min, u_max), (v_min, v_max))`.
     #[inline]
     pub fn domain(&self) -> ((f64, f64), (f64, f64)) {
@@ -330,6 +342,16 @@ impl NurbsSurface {
         let (pu, pv) = (self.degree_u(), self.degree_v());
         let (ku, kv) = (self.knots_u.knots(), self.knots_v.knots());
         let (u, v) = (clamp_param(ku, pu, u), clamp_param(kv, pv, v));
+        let view = self.view();
+        macro_rules! fast {
+            ($($a:literal, $b:literal);*) => {
+                match (pu, pv) {
+                    $(($a, $b) => return kernels::surface_point::<{ $a + 1 }, { $b + 1 }>(view, u, v),)*
+                    _ => {}
+                }
+            };
+        }
+        fast!(1, 1; 1, 2; 1, 3; 2, 1; 2, 2; 2, 3; 3, 1; 3, 2; 3, 3);
         let su = find_span(ku, pu, u);
         let sv = find_span(kv, pv, v);
         let nu = basis_funs_fixed(ku, pu, su, u);
@@ -371,12 +393,23 @@ impl NurbsSurface {
     }
 
     /// Point and all partial derivatives up to second order (A3.6 restricted to
-    /// `k + l <= 2`, then the A4.4 quotient rule for rational surfaces). No heap allocation.
+    /// `k + l <= 2`, then the A4.4 quotient rule for rational surfaces; O(p² + q² + p q)).
+    /// No heap allocation.
     /// Parameters outside the domain are clamped; at knots the right-sided span is used.
     pub fn derivs2(&self, u: f64, v: f64) -> SurfaceDerivs2 {
         let (pu, pv) = (self.degree_u(), self.degree_v());
         let (ku, kv) = (self.knots_u.knots(), self.knots_v.knots());
         let (u, v) = (clamp_param(ku, pu, u), clamp_param(kv, pv, v));
+        let view = self.view();
+        macro_rules! fast {
+            ($($a:literal, $b:literal);*) => {
+                match (pu, pv) {
+                    $(($a, $b) => return kernels::surface_derivs2::<{ $a + 1 }, { $b + 1 }>(view, u, v),)*
+                    _ => {}
+                }
+            };
+        }
+        fast!(1, 1; 1, 2; 1, 3; 2, 1; 2, 2; 2, 3; 3, 1; 3, 2; 3, 3);
         let su = find_span(ku, pu, u);
         let sv = find_span(kv, pv, v);
         let du = pu.min(2);
@@ -439,21 +472,7 @@ impl NurbsSurface {
                 }
             }
         }
-        let inv = 1.0 / w[0][0];
-        let s00 = a[0][0] * inv;
-        let s10 = (a[1][0] - s00 * w[1][0]) * inv;
-        let s01 = (a[0][1] - s00 * w[0][1]) * inv;
-        let s20 = (a[2][0] - s10 * (2.0 * w[1][0]) - s00 * w[2][0]) * inv;
-        let s02 = (a[0][2] - s01 * (2.0 * w[0][1]) - s00 * w[0][2]) * inv;
-        let s11 = (a[1][1] - s01 * w[1][0] - s10 * w[0][1] - s00 * w[1][1]) * inv;
-        SurfaceDerivs2 {
-            p: s00,
-            su: s10,
-            sv: s01,
-            suu: s20,
-            suv: s11,
-            svv: s02,
-        }
+        kernels::rational_correction(&a, &w)
     }
 
     /// All partial derivatives `SKL[k][l] = ∂^{k+l} S / ∂u^k ∂v^l` for `k + l <= n`
