@@ -149,7 +149,7 @@ proptest! {
 
     /// Curves: optimality and dense-sample bound.
     #[test]
-    fn curve_closest_point_is_global(seed in 0u64..10_000, x in -10.0f64..60.0, y in -30.0f64..30.0) {
+    fn curve_closest_point_is_global(seed in 0u64..10_000, x in -60.0f64..110.0, y in -80.0f64..80.0) {
         let pts: Vec<Vector2<f64>> = (0..9)
             .map(|k| Vector2::new(6.0 * k as f64, 15.0 * ((seed as f64) * 0.3 + k as f64 * 1.7).sin()))
             .collect();
