@@ -555,6 +555,21 @@ impl SurfaceProjector {
         self.patches[self.patch_index(u, v)].derivs2(u, v)
     }
 
+    /// [`Self::derivs2`] trying the patch of the previous call first.
+    #[inline]
+    fn derivs2_cached(&self, u: f64, v: f64, last: &std::cell::Cell<usize>) -> SurfaceDerivs2 {
+        let p = &self.patches[last.get()];
+        let inside =
+            |x: f64, lo: f64, hi: f64, end: f64| x >= lo && (x < hi || (x == hi && hi == end));
+        let ((_, ue), (_, ve)) = self.domain;
+        if inside(u, p.u0, p.u1, ue) && inside(v, p.v0, p.v1, ve) {
+            return p.derivs2(u, v);
+        }
+        let k = self.patch_index(u, v);
+        last.set(k);
+        self.patches[k].derivs2(u, v)
+    }
+
     /// Point `S(u, v)` from the Bézier patches.
     #[inline]
     pub fn point(&self, u: f64, v: f64) -> Vector3<f64> {
@@ -576,10 +591,12 @@ impl SurfaceProjector {
     ) -> SurfacePoint {
         let ((ua, ub), (va, vb)) = self.domain;
         let mut best: Option<(Local, bool)> = None;
+        // Patch of the previous evaluation: consecutive Newton iterates usually stay in it.
+        let last = std::cell::Cell::new(0usize);
         if let Some((hu, hv)) = hint {
             if hu.is_finite() && hv.is_finite() {
                 let l = minimise(
-                    |u, v| self.derivs2(u, v),
+                    |u, v| self.derivs2_cached(u, v, &last),
                     q,
                     (ua, va),
                     (ub, vb),
