@@ -642,7 +642,15 @@ impl SurfaceProjector {
             };
             let dl = lb(&self.nodes[l as usize]);
             let dr = lb(&self.nodes[r as usize]);
-            let ((near, dn), (far, df)) = if dl <= dr {
+            // Nearer box first; when `q` is inside both (common near the root), the nearer
+            // box centre is the better guess.
+            let left_first = if dl == dr {
+                (self.nodes[l as usize].obb.c - q).norm_squared()
+                    <= (self.nodes[r as usize].obb.c - q).norm_squared()
+            } else {
+                dl < dr
+            };
+            let ((near, dn), (far, df)) = if left_first {
                 ((l, dl), (r, dr))
             } else {
                 ((r, dr), (l, dl))
