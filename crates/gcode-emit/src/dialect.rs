@@ -313,7 +313,14 @@ impl MotionWriter {
                 }
             }
             Feed::InverseTime(f) => {
-                words.push(format!("F{}", num(st.inverse_fmt, f, "F", at)?));
+                // A slow block has a small 1/min value: keep at least four significant
+                // digits (up to 9 decimals) so it never prints as F0.
+                let mut fmt = st.inverse_fmt;
+                if f > 0.0 && f.is_finite() {
+                    let need = (4.0 - f.log10().floor() - 1.0).clamp(0.0, 9.0) as usize;
+                    fmt.decimals = fmt.decimals.max(need);
+                }
+                words.push(format!("F{}", num(fmt, f, "F", at)?));
             }
         }
         w.block(&words.join(" "));

@@ -399,3 +399,15 @@ fn users_can_add_their_own_dialect() {
         ]
     );
 }
+
+#[test]
+fn slow_inverse_time_blocks_keep_significant_digits() {
+    let mut op = rough(OutputMode::Joint);
+    if let Motion::Simultaneous { moves, .. } = &mut op.motion {
+        moves[1].feed = Feed::InverseTime(0.000_123_456);
+    }
+    let text = LinuxCnc::default()
+        .write(&program(vec![op]), &options())
+        .unwrap();
+    assert!(text.contains("G93 G1 Z2 F0.0001235\n"), "{text}");
+}
