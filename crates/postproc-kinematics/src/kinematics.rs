@@ -91,6 +91,14 @@ impl Machine {
         UnitVector3::new_normalize(u)
     }
 
+    /// The tool tip in the machine frame at zero table angles (`cl.tip + workpiece_origin`):
+    /// the X Y Z a controller in tool-centre-point mode expects (LinuxCNC `xyzac-trt` /
+    /// `xyzbc-trt` world coordinates with G43 active and a zero work offset; Fanuc G43.4,
+    /// Sinumerik TRAORI, Heidenhain M128 likewise program the tip in the workpiece frame).
+    pub fn tcp_point(&self, cl: &CutterLocation) -> Point3 {
+        Point3::from(cl.tip.coords + self.workpiece_origin)
+    }
+
     /// Forward kinematics: the cutter location (tip in the workpiece frame, tool axis) that
     /// the joint values produce with a tool of length `tool_length` (mm, gauge line to tip;
     /// ignored by table-table machines, whose X Y Z are tool-tip coordinates).

@@ -737,7 +737,7 @@ impl Validator<'_> {
             }
             home.set(AxisId::ALL[i], val);
         }
-        for (i, a) in AxisId::ALL.iter().enumerate() {
+        for i in 0..AxisId::ALL.len() {
             if !raw.home.contains_key(&letters[i].to_string()) && !axes[i].contains(0.0, 0.0) {
                 return self.err(
                     None,
@@ -745,7 +745,6 @@ impl Validator<'_> {
                     "required: 0 lies outside the axis limits",
                 );
             }
-            let _ = a;
         }
         let safe_z = match &raw.safe_z {
             None => None,

@@ -324,12 +324,18 @@ pub fn post_path_checked(
         },
     };
     let mut scratch: Vec<(CutterLocation, Joints, f64)> = Vec::new();
-    for (i, b) in blocks.into_iter().enumerate() {
+    let initial = options.initial.unwrap_or(machine.home());
+    for b in blocks {
         let Some(p) = out.last().cloned() else {
+            // the first block starts from the initial posture
+            let mut b = b;
+            if let Some(f) = b.feed_mm_per_min {
+                let len = (b.cl.tip - machine.forward(&initial, tl).tip).norm();
+                b.inverse_time_feed = Some(inverse_time_feed(machine, &initial, &b.joints, len, f));
+            }
             out.push(b);
             continue;
         };
-        let _ = i;
         // Segments touching a block outside the limits (Report policy) are not subdivided.
         let linearise = (b.kind != MoveKind::Rapid || options.linearise_rapids)
             && !b.unwound
