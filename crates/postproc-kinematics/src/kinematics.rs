@@ -84,6 +84,14 @@ impl Machine {
         }
     }
 
+    /// Tool axis (tip → spindle) in the machine frame at zero rotary angles (`u₀`): +Z for
+    /// table-table machines, the configured `spindle_direction` for head machines. Joint X Y Z
+    /// of head machines assume tool length compensation along it; a program without tool
+    /// length compensation adds `tool_length·u₀` to X Y Z.
+    pub fn zero_spindle_direction(&self) -> UnitVector3 {
+        UnitVector3::new_normalize(self.chain().u0)
+    }
+
     /// Tool axis (tip → spindle, workpiece frame) produced by the rotary angles (rad).
     pub fn tool_axis(&self, tilt: f64, rotate: f64) -> UnitVector3 {
         let ch = self.chain();
