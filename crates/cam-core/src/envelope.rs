@@ -29,7 +29,7 @@
 //! # Computation
 //!
 //! Stationarity: `∂F/∂s = 0`, `∂F/∂t = 0` (with bounds). At fixed `s` the `t`-equation has a
-//! closed-form solution over the whole family ([`SpherePiece::min_over_tau`]: the function is
+//! closed-form solution over the whole family ([`crate::SpherePiece::min_over_tau`]: the function is
 //! convex in `t` on each piece), so the 2×2 Newton system is reduced exactly to its Schur
 //! complement in `s`:
 //!

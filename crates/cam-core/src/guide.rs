@@ -248,7 +248,7 @@ impl GuideCurve {
     }
 
     /// True when `other` has the same degree and knots, so one basis evaluation serves both
-    /// ([`Self::basis2`] / [`Self::combine2`]; weights may differ).
+    /// (the envelope then evaluates the basis once per frame; weights may differ).
     pub fn shares_basis_with(&self, other: &GuideCurve) -> bool {
         self.degree == other.degree && self.knots == other.knots
     }
@@ -262,8 +262,8 @@ impl GuideCurve {
         (span, n)
     }
 
-    /// Point and derivatives from a span and basis computed by [`Self::basis2`] of this
-    /// curve or of one that [shares its basis](Self::shares_basis_with).
+    /// Point and derivatives from a span and basis computed by `basis2` of this curve or of
+    /// one that [shares its basis](Self::shares_basis_with).
     pub(crate) fn combine2(&self, span: usize, n: &[[f64; NB]; 3]) -> GuideEval {
         let p = self.degree;
         let first = span - p;

@@ -91,7 +91,7 @@ pub struct SpherePiece {
     pub disc_radius: [f64; 2],
     /// `[ρ(0), ρ(1) − ρ(0)]`.
     pub radius: [f64; 2],
-    /// `d_shape[k]` = ∂(height[0], height[1], disc[0], disc[1], radius[0], radius[1]) / ∂q_k
+    /// `d_shape[k]` = `∂(height[0], height[1], disc[0], disc[1], radius[0], radius[1]) / ∂q_k`
     /// for the family's shape parameters `q_k`.
     pub d_shape: [[f64; 6]; 2],
 }

@@ -106,10 +106,17 @@ fn flat_end_along_a_line_is_a_slab() {
     for (p, exact) in [
         (Point3::new(-5.0, 0.0, 5.0), 1.0),
         (Point3::new(-3.0, 4.0, 2.0), 1.0),
-        (Point3::new(106.0, 0.0, -2.0), (4.0f64 + 2.0f64.powi(2)).sqrt()),
+        (
+            Point3::new(106.0, 0.0, -2.0),
+            (4.0f64 + 2.0f64.powi(2)).sqrt(),
+        ),
     ] {
         let d = env.signed_distance(&p, None).unwrap();
-        assert!((d.distance - exact).abs() < 1e-9, "{p}: {} vs {exact}", d.distance);
+        assert!(
+            (d.distance - exact).abs() < 1e-9,
+            "{p}: {} vs {exact}",
+            d.distance
+        );
         assert!(d.param.s == 0.0 || d.param.s == 1.0);
     }
 }
