@@ -371,3 +371,21 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn tool_paths_with_cutters_write_and_read_back() {
+    let p = demo_program();
+    let op = &p.operations[0];
+    let q = ClProgram::from_tool_paths(
+        Some("JOB".into()),
+        [(op.path.clone(), op.cutter.clone(), Some(7))],
+    );
+    let r = read(&write_cl(&q, &ClWriteOptions::default()).unwrap()).unwrap();
+    assert_eq!(r.part_name.as_deref(), Some("JOB"));
+    let c = r.operations[0].cutter.as_ref().unwrap();
+    assert_eq!(c.flute_length, 35.0);
+    assert!(
+        (c.shape.radius_at(3.0) - op.cutter.as_ref().unwrap().shape.radius_at(3.0)).abs() < 1e-12
+    );
+    assert_eq!(r.operations[0].path.moves.len(), op.path.moves.len());
+}

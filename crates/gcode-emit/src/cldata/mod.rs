@@ -77,6 +77,30 @@ impl ClOperation {
     }
 }
 
+impl ClProgram {
+    /// A program from tool paths with their cutters and tool numbers (spindle and coolant
+    /// unset), e.g. to write the CL file of a job's operations.
+    pub fn from_tool_paths(
+        part_name: Option<String>,
+        paths: impl IntoIterator<Item = (ToolPath, Option<Cutter>, Option<u32>)>,
+    ) -> Self {
+        Self {
+            part_name,
+            operations: paths
+                .into_iter()
+                .map(|(path, cutter, tool_number)| {
+                    let mut op = ClOperation::new(path);
+                    op.apt_cutter = cutter.as_ref().map(AptCutter::from_cutter);
+                    op.cutter = cutter;
+                    op.tool_number = tool_number;
+                    op
+                })
+                .collect(),
+            warnings: Vec::new(),
+        }
+    }
+}
+
 /// A record the reader did not use, kept so nothing is silently dropped.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ClWarning {
