@@ -3,7 +3,7 @@
 //!
 //! A CL file is a sequence of records `WORD/param,param,...`. A trailing `$` continues a
 //! record on the next line; `$$` starts a comment. The reader understands `PARTNO`, `UNITS`,
-//! `MULTAX`, `LOADTL`, `CUTTER`, `TLAXIS`, `FEDRAT`, `RAPID`, `GOTO` (3 or 6 values), `FROM`,
+//! `MULTAX`, `LOADTL`, `CUTTER` (1–7 parameters), `TLDATA/MILL` (NX), `TLAXIS`, `FEDRAT`, `RAPID`, `GOTO` (3 or 6 values), `FROM`,
 //! `SPINDL`, `COOLNT`, `PPRINT`, `TOOL PATH` / `END-OF-PATH` (operation brackets written by
 //! many CAM systems) and `FINI`; every other record is kept as a [`ClWarning`] with its line.
 
