@@ -411,3 +411,10 @@ fn nx_tldata_mill_defines_the_cutter() {
     assert_eq!(parse_err("TLDATA/MILL,x\n"), (1, "TLDATA".into(), 2));
     assert_eq!(parse_err("TLDATA/MILL\n"), (1, "TLDATA".into(), 2));
 }
+
+#[test]
+fn windows_files_with_bom_and_crlf_read_like_unix_ones() {
+    let unix = read(SAMPLE).unwrap();
+    let win = format!("\u{feff}{}", SAMPLE.replace('\n', "\r\n"));
+    assert_eq!(read(&win).unwrap(), unix);
+}

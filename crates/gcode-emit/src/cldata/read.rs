@@ -63,6 +63,8 @@ pub fn read_cl_file(path: &Path, options: &ClReadOptions) -> Result<ClProgram, G
 /// [`GcodeError::ClParse`].
 pub fn read_cl(text: &str, file: &str, options: &ClReadOptions) -> Result<ClProgram, GcodeError> {
     let mut reader = Reader::new(file, *options);
+    // Editors on Windows may start the file with a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut pending: Option<(usize, String)> = None;
     let mut last_line = 0;
     for (i, raw) in text.lines().enumerate() {
