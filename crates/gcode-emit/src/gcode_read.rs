@@ -8,6 +8,7 @@
 //! (`G91`), inch mode (`G20`), parameters and expressions (`#`, `[`), `O` words.
 
 use crate::GcodeError;
+use postproc_kinematics::{AxisId, Joints, Machine};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -138,6 +139,20 @@ pub fn read_gcode(text: &str, file: &str) -> Result<Vec<GcodeBlock>, GcodeError>
         }
     }
     Ok(out)
+}
+
+/// The machine joints of a block (rotary words in degrees → radians), using the machine's
+/// axis letters; `None` while one of its five axes has never been programmed. Feed it to
+/// [`Machine::forward`] to verify a program.
+pub fn joints_of(block: &GcodeBlock, machine: &Machine) -> Option<Joints> {
+    let idx = |a: AxisId| "XYZABC".find(machine.letter(a)).and_then(|k| block.axes[k]);
+    Some(Joints {
+        x: idx(AxisId::X)?,
+        y: idx(AxisId::Y)?,
+        z: idx(AxisId::Z)?,
+        tilt: idx(AxisId::Tilt)?.to_radians(),
+        rotate: idx(AxisId::Rotate)?.to_radians(),
+    })
 }
 
 /// Removes `( )` comments and everything after `;`.

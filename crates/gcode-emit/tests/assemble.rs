@@ -10,7 +10,7 @@ use gcode_emit::{
     assemble_program, read_gcode, AssembleOptions, Dialect, GcodeError, GcodeMotion, LinuxCnc,
     Motion, OutputMode, ProgramOptions, Sinumerik,
 };
-use postproc_kinematics::{Joints, Machine};
+use postproc_kinematics::Machine;
 use proptest::prelude::*;
 
 /// Angular words carry 4 decimals (0.5e-4° → 0.9 µrad) and linear words 4 decimals; at radii
@@ -31,23 +31,13 @@ fn roundtrip_through_program(machine: &Machine) {
         .write(&a.program, &ProgramOptions::default())
         .unwrap();
     let blocks = read_gcode(&text, "rt.ngc").unwrap();
-    let tilt = machine.letter(postproc_kinematics::AxisId::Tilt);
-    let ti = "XYZABC".find(tilt).unwrap();
     let cls: Vec<CutterLocation> = blocks
         .iter()
         .filter(|b| !b.machine_coordinates)
-        .filter(|b| [0, 1, 2, ti, 5].iter().all(|&k| b.axes[k].is_some()))
-        .map(|b| {
-            let j = Joints {
-                x: b.axes[0].unwrap(),
-                y: b.axes[1].unwrap(),
-                z: b.axes[2].unwrap(),
-                tilt: b.axes[ti].unwrap().to_radians(),
-                rotate: b.axes[5].unwrap().to_radians(),
-            };
-            machine.forward(&j, 0.0)
-        })
+        .filter_map(|b| gcode_emit::gcode_read::joints_of(b, machine))
+        .map(|j| machine.forward(&j, 0.0))
         .collect();
+    assert!(cls.len() >= ops[0].path.moves.len());
     // Every source CL is reached by some block of the program.
     for m in &ops[0].path.moves {
         let best = cls
@@ -223,5 +213,33 @@ proptest! {
     #[test]
     fn gcode_reader_never_panics(s in "[GXYZACFMN0-9. ;()%#\\[\\]\n-]{0,200}") {
         let _ = read_gcode(&s, "fuzz.ngc");
+    }
+}
+
+#[test]
+fn tilted_plane_operations_are_checked_against_the_axis_limits() {
+    let machine = support::xyzac();
+    let mut op = support::indexed_op("pocket", 4);
+    for m in &mut op.path.moves {
+        m.cl.tip.x += 1000.0; // X travel is ±200 mm
+    }
+    let r = assemble_program(
+        "p",
+        &[op],
+        &machine,
+        &Sinumerik::default(),
+        &AssembleOptions {
+            mode: OutputMode::TcpAngles,
+            ..Default::default()
+        },
+    );
+    match r {
+        Err(GcodeError::Kinematics {
+            operation, reason, ..
+        }) => {
+            assert_eq!(operation, "pocket");
+            assert!(reason.contains("axis X"), "{reason}");
+        }
+        other => panic!("{other:?}"),
     }
 }

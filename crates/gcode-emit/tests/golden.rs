@@ -189,6 +189,15 @@ fn fanuc_tcp_angles_and_vectors_match_golden() {
 }
 
 #[test]
+fn fanuc_joint_inverse_time_and_g68_2_match_golden() {
+    let p = program(vec![rough(OutputMode::Joint), finish_indexed()]);
+    assert_same(
+        &Fanuc.write(&p, &options()).unwrap(),
+        "fanuc_joint_g68_2.nc",
+    );
+}
+
+#[test]
 fn sinumerik_traori_and_cycle800_match_golden() {
     let p = program(vec![rough(OutputMode::TcpAngles), finish_indexed()]);
     assert_same(
@@ -224,16 +233,11 @@ fn line_numbers_are_optional_except_on_heidenhain() {
 #[test]
 fn dialect_limits_are_typed_errors() {
     let indexed = program(vec![finish_indexed()]);
-    for d in [&LinuxCnc::default() as &dyn Dialect, &Fanuc] {
-        assert!(
-            matches!(
-                d.write(&indexed, &options()),
-                Err(GcodeError::Unsupported { .. })
-            ),
-            "{}",
-            d.name()
-        );
-    }
+    // LinuxCNC has no tilted-plane function.
+    assert!(matches!(
+        LinuxCnc::default().write(&indexed, &options()),
+        Err(GcodeError::Unsupported { .. })
+    ));
     let joint = program(vec![rough(OutputMode::Joint)]);
     assert!(matches!(
         HeidenhainIso.write(&joint, &options()),
@@ -320,4 +324,94 @@ fn program_file_is_written_whole_through_a_temporary() {
     assert!(!path2.exists());
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A user-defined dialect built from the public helpers only.
+#[derive(Debug)]
+struct Minimal;
+
+impl Dialect for Minimal {
+    fn name(&self) -> &'static str {
+        "minimal"
+    }
+    fn extension(&self) -> &'static str {
+        "txt"
+    }
+    fn supports(&self, mode: OutputMode) -> bool {
+        mode == OutputMode::TcpAngles
+    }
+    fn supports_indexed(&self) -> bool {
+        false
+    }
+    fn write(&self, program: &NcProgram, o: &ProgramOptions) -> Result<String, GcodeError> {
+        use gcode_emit::dialect::{At, BlockWriter, MotionStyle, MotionWriter};
+        use gcode_emit::NumberFormat;
+        let f = NumberFormat::fixed(3);
+        let mut w = BlockWriter::new(o.line_numbers, ";");
+        let mut mw = MotionWriter::new(MotionStyle {
+            rapid: "G0",
+            linear: "G1",
+            feed_modes: ("G93", "G94"),
+            vector_words: ["I", "J", "K"],
+            linear_fmt: f,
+            angular_fmt: f,
+            feed_fmt: NumberFormat::trimmed(0),
+            inverse_fmt: f,
+        });
+        for op in &program.operations {
+            let Motion::Simultaneous { mode, moves } = &op.motion else {
+                return Err(GcodeError::Unsupported {
+                    dialect: "minimal",
+                    what: "3+2".into(),
+                });
+            };
+            for (i, m) in moves.iter().enumerate() {
+                mw.write(
+                    &mut w,
+                    m,
+                    *mode,
+                    "",
+                    At {
+                        op: &op.name,
+                        block: i,
+                    },
+                )?;
+            }
+        }
+        Ok(w.finish())
+    }
+}
+
+#[test]
+fn users_can_add_their_own_dialect() {
+    let p = program(vec![rough(OutputMode::TcpAngles)]);
+    let text = Minimal
+        .write(
+            &p,
+            &ProgramOptions {
+                line_numbers: None,
+                ..options()
+            },
+        )
+        .unwrap();
+    assert_eq!(
+        text.lines().take(3).collect::<Vec<_>>(),
+        [
+            "G0 X10.000 Y-5.000 Z50.000 A0.000 C0.000;",
+            "G1 Z2.000 F500;",
+            "X12.500 Z1.250 A-15.000 C30.500 F800;"
+        ]
+    );
+}
+
+#[test]
+fn slow_inverse_time_blocks_keep_significant_digits() {
+    let mut op = rough(OutputMode::Joint);
+    if let Motion::Simultaneous { moves, .. } = &mut op.motion {
+        moves[1].feed = Feed::InverseTime(0.000_123_456);
+    }
+    let text = LinuxCnc::default()
+        .write(&program(vec![op]), &options())
+        .unwrap();
+    assert!(text.contains("G93 G1 Z2 F0.0001235\n"), "{text}");
 }

@@ -84,11 +84,27 @@ impl Machine {
         }
     }
 
+    /// Tool axis (tip → spindle) in the machine frame at zero rotary angles (`u₀`): +Z for
+    /// table-table machines, the configured `spindle_direction` for head machines. Joint X Y Z
+    /// of head machines assume tool length compensation along it; a program without tool
+    /// length compensation adds `tool_length·u₀` to X Y Z.
+    pub fn zero_spindle_direction(&self) -> UnitVector3 {
+        UnitVector3::new_normalize(self.chain().u0)
+    }
+
     /// Tool axis (tip → spindle, workpiece frame) produced by the rotary angles (rad).
     pub fn tool_axis(&self, tilt: f64, rotate: f64) -> UnitVector3 {
         let ch = self.chain();
         let u = rot_z(ch.s_c * rotate, &rot_tilt(ch.tilt, ch.s_t * tilt, &ch.u0));
         UnitVector3::new_normalize(u)
+    }
+
+    /// The tool tip in the machine frame at zero table angles (`cl.tip + workpiece_origin`):
+    /// the X Y Z a controller in tool-centre-point mode expects (LinuxCNC `xyzac-trt` /
+    /// `xyzbc-trt` world coordinates with G43 active and a zero work offset; Fanuc G43.4,
+    /// Sinumerik TRAORI, Heidenhain M128 likewise program the tip in the workpiece frame).
+    pub fn tcp_point(&self, cl: &CutterLocation) -> Point3 {
+        Point3::from(cl.tip.coords + self.workpiece_origin)
     }
 
     /// Forward kinematics: the cutter location (tip in the workpiece frame, tool axis) that

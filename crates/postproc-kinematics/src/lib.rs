@@ -8,6 +8,25 @@
 //! [`Machine::axis_words`]. A cutter location is the tool tip plus the unit tool axis
 //! (tip → spindle), in the workpiece frame.
 //!
+//! Joint output convention: for table-table machines X Y Z are the tool-tip coordinates in the
+//! machine frame with tool length compensation active (the tool length does not enter the
+//! rotary transform — exactly LinuxCNC's `xyzac-trt` / `xyzbc-trt` relation between joints
+//! and world with G43); for head machines X Y Z are the tip position the machine would have at
+//! zero head angles, so pivot length plus tool length enter the transform. Rotary senses
+//! follow LinuxCNC's `conventional_directions` for table-table machines and explicit
+//! `tilt_sign` / `rotary_sign` for head machines (see [`machine`]).
+//!
+//! Modules: [`machine`] (description and TOML file), [`kinematics`] (forward / inverse,
+//! solution choice), [`post`] (path post-processing and metrics), [`reverse_motion`]
+//! (detection and removal, paper 004), [`bspline_fit`] (least-squares cubic B-spline used by
+//! the smoothing), [`linearise`] (joint-interpolation error and subdivision), [`feed`]
+//! (inverse-time feed), [`plot`] (SVG displacement curves).
+//!
+//! Dependencies: `cam-core` (cutter locations, moves), `nalgebra` (vectors; SVD least squares
+//! of the small B-spline systems), `serde` + `toml` (machine files with spans for line
+//! numbers), `thiserror` (errors), `rayon` (segment deviations evaluated in parallel) — the
+//! workspace's chosen crates.
+//!
 //! ```
 //! use postproc_kinematics::{Machine, post_locations, PostOptions};
 //! use cam_core::{CutterLocation, Point3, Vector3};

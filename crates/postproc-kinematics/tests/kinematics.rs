@@ -378,3 +378,80 @@ fn out_of_limits_names_axis() {
         other => panic!("expected limit error, got {other:?}"),
     }
 }
+
+/// LinuxCNC (2.10) `xyzac_forward_math` / `xyzbc_forward_math` with `conventional_directions`
+/// (`con = ±1`), transcribed term by term; angles in degrees, tool offset 0.
+fn linuxcnc_forward_con(ac: bool, j: [f64; 5], off: [f64; 3], con: f64) -> [f64; 3] {
+    let (t, c) = (j[3].to_radians(), j[4].to_radians());
+    if ac {
+        let (dy, dz) = (off[1], off[2]);
+        [
+            c.cos() * j[0] - con * c.sin() * t.cos() * (j[1] - dy)
+                + c.sin() * t.sin() * (j[2] - dz)
+                - con * c.sin() * dy,
+            con * c.sin() * j[0] + c.cos() * t.cos() * (j[1] - dy)
+                - con * c.cos() * t.sin() * (j[2] - dz)
+                + c.cos() * dy,
+            con * t.sin() * (j[1] - dy) + t.cos() * (j[2] - dz) + dz,
+        ]
+    } else {
+        let (dx, dz) = (off[0], off[2]);
+        [
+            c.cos() * t.cos() * (j[0] - dx) - con * c.sin() * j[1]
+                + con * c.cos() * t.sin() * (j[2] - dz)
+                + c.cos() * dx,
+            con * c.sin() * t.cos() * (j[0] - dx)
+                + c.cos() * j[1]
+                + c.sin() * t.sin() * (j[2] - dz)
+                + con * c.sin() * dx,
+            -con * t.sin() * (j[0] - dx) + t.cos() * (j[2] - dz) + dz,
+        ]
+    }
+}
+
+#[test]
+fn conventional_directions_match_linuxcnc_both_ways() {
+    let mut rng = ChaCha8Rng::seed_from_u64(10);
+    for (name, ac, off) in [
+        ("xyzac-trt", true, [0.0, 20.0, 10.0]),
+        ("xyzbc-trt", false, [-20.0, 0.0, -15.0]),
+    ] {
+        for conventional in [false, true] {
+            let text = std::fs::read_to_string(format!(
+                "{}/../../fixtures/machines/{name}.toml",
+                env!("CARGO_MANIFEST_DIR")
+            ))
+            .unwrap()
+            .replace(
+                "conventional_directions = false",
+                &format!("conventional_directions = {conventional}"),
+            );
+            let m = Machine::from_toml_str(&text, "m.toml").unwrap();
+            let con = if conventional { 1.0 } else { -1.0 };
+            for _ in 0..100 {
+                let j = [
+                    rng.random_range(-150.0..150.0),
+                    rng.random_range(-80.0..80.0),
+                    rng.random_range(-100.0..100.0),
+                    rng.random_range(-100.0..50.0),
+                    rng.random_range(-360.0..360.0),
+                ];
+                let w = linuxcnc_forward_con(ac, j, off, con);
+                let joints = Joints {
+                    x: j[0],
+                    y: j[1],
+                    z: j[2],
+                    tilt: j[3].to_radians(),
+                    rotate: j[4].to_radians(),
+                };
+                let ours = m.forward(&joints, 0.0).tip;
+                for k in 0..3 {
+                    assert!(
+                        (w[k] - ours[k]).abs() < 1e-9,
+                        "{name} con={con}: {w:?} vs {ours:?}"
+                    );
+                }
+            }
+        }
+    }
+}
