@@ -1,11 +1,15 @@
 //! One-off measurement: 100,000 moves of a five-axis tapered ball end on the 77 mm fixture's
 //! blank (Ø79 × 44 mm) at 0.1 mm. Run in release with peak memory:
 //! `/usr/bin/time -v cargo run --release -p machining-sim --example removal_100k -- 0.1 100000`
+//! A third argument `design` runs the full `simulate` against the fixture impeller (design
+//! collisions through parry, overcut/residual maps) instead of the removal alone.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use impeller_model::fixtures::default_impeller;
 use machining_sim::synthetic::{workload_cutter, zigzag_path};
-use machining_sim::{blank_of, cut, SimOptions, TriDexel};
+use machining_sim::{
+    blank_of, cut, simulate, ImpellerDesign, ImpellerSampling, SimOptions, TriDexel,
+};
 use std::time::Instant;
 
 fn main() {
@@ -33,8 +37,28 @@ fn main() {
         progress: true,
         ..SimOptions::default()
     };
+    let with_design = args.get(3).is_some_and(|a| a == "design");
     let t = Instant::now();
-    let out = cut(&mut stock, None, &[(cutter, path)], &opts).unwrap();
+    let ops = [(cutter, path)];
+    let out = if with_design {
+        let design = ImpellerDesign::new(&imp, ImpellerSampling::default()).unwrap();
+        let rep = simulate(&mut stock, &design, &ops, &opts).unwrap();
+        println!(
+            "simulate: max_overcut_mm {:.3}, max_residual_mm {:.3}, collisions {}, \
+             design collision {:.2} s, measure {:.2} s",
+            rep.metrics.max_overcut_mm,
+            rep.metrics.max_residual_mm,
+            rep.metrics.collisions,
+            rep.stats.design_collision_ms / 1e3,
+            rep.stats.measure_ms / 1e3
+        );
+        machining_sim::CutOutcome {
+            collisions: rep.collisions,
+            stats: rep.stats,
+        }
+    } else {
+        cut(&mut stock, None, &ops, &opts).unwrap()
+    };
     let dt = t.elapsed().as_secs_f64();
     println!(
         "{} moves, {} positions, {:.2} s wall ({:.1} µs/move), removed {:.0} mm³, \
