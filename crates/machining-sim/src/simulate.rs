@@ -48,7 +48,7 @@ impl Default for SimOptions {
             interpolation: Interpolation::Tcp,
             check_collisions: true,
             collision_tol_mm: None,
-            probe_depth_mm: 5.0,
+            probe_depth_mm: 3.0,
             batch_positions: 4096,
             progress: false,
         }

@@ -72,7 +72,7 @@ pub struct Args {
     #[arg(long)]
     pub out: PathBuf,
     /// Largest thickness the overcut/residual probes measure (mm).
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 3.0)]
     pub probe_depth: f64,
     /// STL lattice spacing in dexel cells (1 = full resolution; default: about 0.3 mm).
     #[arg(long)]
