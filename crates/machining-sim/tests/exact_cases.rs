@@ -346,3 +346,59 @@ fn dexel_overcut_agrees_with_the_swept_envelope_within_a_cell() {
     assert!((env_max - 0.35).abs() < 1e-6, "{env_max}");
     assert!((rep.metrics.max_overcut_mm - env_max).abs() < h);
 }
+
+#[test]
+fn contour_around_a_cylinder_design_finds_the_radial_gouge() {
+    // Cylinder design r = 5 (z 0..8) in a box blank; a flat end (r 2) contours it at
+    // radius 5 + 2 − 0.2 over a quarter turn: 0.2 mm radial overcut on the side there,
+    // the rest of the side keeps its stock.
+    let h = 0.1;
+    let design = machining_sim::CylinderDesign {
+        radius: 5.0,
+        z0: 0.0,
+        z1: 8.0,
+        sample_spacing: 0.4,
+    };
+    let block = BoxStock::new([-8.0, -8.0, 0.0], [8.0, 8.0, 8.0]).unwrap();
+    let mut stock = TriDexel::from_shape(&block, h).unwrap();
+    let cutter = Cutter::new("f4", CutterShape::FlatEnd { radius: 2.0 }, 12.0, 2.0, 40.0).unwrap();
+    let rc = 5.0 + 2.0 - 0.2;
+    let mut moves = vec![
+        (MoveKind::Rapid, vertical(rc, 0.0, 20.0)),
+        (MoveKind::Plunge, vertical(rc, 0.0, -1.0)),
+    ];
+    for k in 1..=60 {
+        let a = std::f64::consts::FRAC_PI_2 * f64::from(k) / 60.0;
+        moves.push((MoveKind::Feed, vertical(rc * a.cos(), rc * a.sin(), -1.0)));
+    }
+    let rep = simulate(
+        &mut stock,
+        &design,
+        &[(cutter, path(moves))],
+        &SimOptions::default(),
+    )
+    .unwrap();
+    let e = rep.max_overcut.clone().unwrap();
+    assert_eq!(e.surface, "side");
+    // Chords of the 60-segment polygon cut slightly deeper than the arc: ≤ rc(1 − cos(π/240)).
+    assert!((e.value_mm - 0.2).abs() < h, "{e:?}");
+    let ang = e.point[1].atan2(e.point[0]);
+    assert!(
+        (-0.05..=std::f64::consts::FRAC_PI_2 + 0.05).contains(&ang),
+        "{e:?}"
+    );
+    // Away from the contoured quarter the side is untouched: residual = stock thickness there
+    // (capped by the probe depth or the box corner).
+    let side = rep.maps.iter().find(|m| m.name == "side").unwrap();
+    for (k, p) in side.points.iter().enumerate() {
+        let a = p[1].atan2(p[0]);
+        if a < -0.6 {
+            assert_eq!(side.overcut_mm[k], Some(0.0), "{p:?}");
+            assert!(
+                side.residual_mm[k].unwrap() > 2.5,
+                "{p:?} {:?}",
+                side.residual_mm[k]
+            );
+        }
+    }
+}
