@@ -16,7 +16,7 @@ use crate::design::{DesignModel, SurfaceGrid, TriangleMesh};
 use crate::error::SimError;
 use crate::stock_shape::RevolvedStock;
 use cam_core::{Point3, Vector3};
-use impeller_model::query::blade_side_distance;
+use impeller_model::query::closest_point;
 use impeller_model::{Blade, Impeller, Side};
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::PointQueryWithLocation;
@@ -69,6 +69,8 @@ pub struct ImpellerDesign {
     /// Half the largest blade thickness plus the side mesh's chord error (mm): beyond this
     /// mesh distance a point is outside every blade.
     far_mm: f64,
+    hub_sd: ContourDistance,
+    shroud_sd: ContourDistance,
 }
 
 fn grid_tris(nu: usize, nv: usize, base: u32, out: &mut Vec<[u32; 3]>) {
@@ -169,6 +171,8 @@ impl ImpellerDesign {
             hub_z_max: a[0].max(b[0]),
             hub_r_max: a[1].max(b[1]),
             far_mm,
+            hub_sd: ContourDistance::new(impeller.hub().meridional()),
+            shroud_sd: ContourDistance::new(impeller.shroud().meridional()),
             impeller: impeller.clone(),
             blades,
             sides_mesh,
@@ -186,7 +190,7 @@ impl ImpellerDesign {
     /// hub's inlet end (`z ≤ z_inlet`) and the cylinder of its outlet radius (`r ≤ r_outlet`),
     /// where the meridional distance alone would extend the body past the contour's ends.
     pub fn hub_signed_distance(&self, p: &Point3) -> f64 {
-        let d = self.impeller.hub().signed_distance(&p.coords);
+        let d = self.hub_sd.signed_distance(p);
         let r = (p.x * p.x + p.y * p.y).sqrt();
         d.max(p.z - self.hub_z_max).max(r - self.hub_r_max)
     }
@@ -201,18 +205,17 @@ impl ImpellerDesign {
         let Some(&(bi, side, u, v)) = self.tri_info.get(tri as usize) else {
             return f64::INFINITY;
         };
-        let pv = p.coords;
         let dm = (proj.point - q).length();
         if dm > self.far_mm {
             // Farther than half the thickest blade from every side: outside all blades, and
             // the distance to the blade solids is at least dm − chord − t_max/2.
-            let ds = self.impeller.shroud().signed_distance(&pv);
+            let ds = self.shroud_sd.signed_distance(p);
             return (dm - self.far_mm).max(ds).max(1e-9);
         }
         let blade = &self.blades[bi as usize].1;
-        let (_, d1) = blade_side_distance(blade, side, &pv, Some((u, v)));
-        let (_, d2) = blade_side_distance(blade, side.other(), &pv, Some((u, v)));
-        let ds = self.impeller.shroud().signed_distance(&pv);
+        let d1 = side_distance(blade, side, p, (u, v));
+        let d2 = side_distance(blade, side.other(), p, (u, v));
+        let ds = self.shroud_sd.signed_distance(p);
         d1.max(d2).max(ds)
     }
 
@@ -287,7 +290,7 @@ impl ImpellerDesign {
         let tip_point = |side: Side, u: f64| -> Option<Vector3> {
             let s = blade.side(side);
             let ((_, _), (v0, v1)) = s.domain();
-            let f = |v: f64| shroud.signed_distance(&s.point(u, v));
+            let f = |v: f64| self.shroud_sd.signed_distance(&Point3::from(s.point(u, v)));
             let (mut a, mut b) = (v0, v1);
             if f(a) > 0.0 || f(b) < 0.0 {
                 return None;
@@ -322,6 +325,92 @@ impl ImpellerDesign {
             }
         }
         g
+    }
+}
+
+/// Signed distance to a surface of revolution through its meridional contour, without
+/// allocation: nearest of `CONTOUR_SAMPLES` contour samples, then golden-section refinement of
+/// |C(t) − p| on the two neighbouring sample intervals (to 1e-9 of the interval), sign from the
+/// channel-side normal (contour tangent rotated, as in impeller-model).
+#[derive(Debug, Clone)]
+struct ContourDistance {
+    curve: impeller_model::MeridionalCurve,
+    ts: Vec<f64>,
+    pts: Vec<nalgebra::Vector2<f64>>,
+}
+
+const CONTOUR_SAMPLES: usize = 256;
+
+impl ContourDistance {
+    fn new(curve: &impeller_model::MeridionalCurve) -> Self {
+        let (t0, t1) = curve.domain();
+        let ts: Vec<f64> = (0..=CONTOUR_SAMPLES)
+            .map(|k| t0 + (t1 - t0) * k as f64 / CONTOUR_SAMPLES as f64)
+            .collect();
+        let pts = ts.iter().map(|&t| curve.point(t)).collect();
+        Self {
+            curve: curve.clone(),
+            ts,
+            pts,
+        }
+    }
+
+    fn signed_distance(&self, p: &Point3) -> f64 {
+        let zr = nalgebra::Vector2::new(p.z, (p.x * p.x + p.y * p.y).sqrt());
+        let mut k = 0;
+        let mut best = f64::INFINITY;
+        for (i, q) in self.pts.iter().enumerate() {
+            let d = (q - zr).norm_squared();
+            if d < best {
+                best = d;
+                k = i;
+            }
+        }
+        let n = self.ts.len() - 1;
+        let (mut a, mut b) = (self.ts[k.saturating_sub(1)], self.ts[(k + 1).min(n)]);
+        let f = |t: f64| (self.curve.point(t) - zr).norm_squared();
+        let g = 0.618_033_988_749_895;
+        let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
+        let (mut f1, mut f2) = (f(x1), f(x2));
+        let tol = 1e-9 * (b - a).abs().max(1e-300);
+        while (b - a).abs() > tol {
+            if f1 < f2 {
+                b = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = b - g * (b - a);
+                f1 = f(x1);
+            } else {
+                a = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = a + g * (b - a);
+                f2 = f(x2);
+            }
+        }
+        let t = 0.5 * (a + b);
+        let c = self.curve.point(t);
+        // Tangent by central difference (step well above round-off, far below curvature).
+        let (t0, t1) = self.curve.domain();
+        let e = 1e-6 * (t1 - t0);
+        let d = self.curve.point((t + e).min(t1)) - self.curve.point((t - e).max(t0));
+        let nrm = nalgebra::Vector2::new(d[1], -d[0]);
+        let dist = (zr - c).norm();
+        if (zr - c).dot(&nrm) >= 0.0 {
+            dist
+        } else {
+            -dist
+        }
+    }
+}
+
+/// Signed distance to one blade side by Newton point inversion from `hint` (impeller-model's
+/// `closest_point`, NURBS Book §6.1; allocation-free), positive on the outward side.
+fn side_distance(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> f64 {
+    let sp = closest_point(blade.side(side), &p.coords, Some(hint));
+    match blade.outward_normal(side, sp.u, sp.v) {
+        Some(n) if (p.coords - sp.point).dot(&n) < 0.0 => -sp.distance,
+        _ => sp.distance,
     }
 }
 
@@ -390,5 +479,33 @@ impl DesignModel for ImpellerDesign {
         }
         grid_tris(np, nt, base, &mut m.triangles);
         m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn contour_distance_matches_the_model_projection() {
+        let imp = impeller_model::fixtures::default_impeller().unwrap();
+        let hub = ContourDistance::new(imp.hub().meridional());
+        let shroud = ContourDistance::new(imp.shroud().meridional());
+        let mut k = 0u32;
+        for iz in 0..12 {
+            for ir in 0..12 {
+                let z = -2.0 + 50.0 * f64::from(iz) / 11.0;
+                let r = 1.0 + 42.0 * f64::from(ir) / 11.0;
+                let phi = 0.37 * f64::from(k);
+                k += 1;
+                let p = Point3::new(r * phi.cos(), r * phi.sin(), z);
+                let a = hub.signed_distance(&p);
+                let b = imp.hub().signed_distance(&p.coords);
+                assert!((a - b).abs() < 1e-6, "hub at {p:?}: {a} vs {b}");
+                let a = shroud.signed_distance(&p);
+                let b = imp.shroud().signed_distance(&p.coords);
+                assert!((a - b).abs() < 1e-6, "shroud at {p:?}: {a} vs {b}");
+            }
+        }
     }
 }
