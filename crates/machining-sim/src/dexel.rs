@@ -253,8 +253,9 @@ pub struct TriDexel {
     grids: [DexelGrid; 3],
 }
 
-/// Largest number of rays per grid accepted (guards against a resolution typo).
-pub const MAX_RAYS_PER_GRID: usize = 50_000_000;
+/// Largest number of rays per grid accepted (guards against a resolution typo; 2·10⁷ rays
+/// are 480 MB per grid).
+pub const MAX_RAYS_PER_GRID: usize = 20_000_000;
 
 impl TriDexel {
     /// Samples `shape` on ray grids of spacing `cell` (mm) over the shape's bounding box
@@ -284,12 +285,12 @@ impl TriDexel {
             max[k] = min[k] + n[k] as f64 * cell;
         }
         for d in 0..3 {
-            let rays = n[(d + 1) % 3] * n[(d + 2) % 3];
+            let rays = n[(d + 1) % 3].saturating_mul(n[(d + 2) % 3]);
             if rays > MAX_RAYS_PER_GRID {
                 return Err(SimError::InvalidOption {
                     name: "resolution",
                     value: cell,
-                    reason: "too fine for the stock size (more than 5·10⁷ rays per grid)",
+                    reason: "too fine for the stock size (more than 2·10⁷ rays per grid)",
                 });
             }
         }
@@ -430,6 +431,23 @@ mod tests {
         assert_eq!(s.subtract(20.0, 30.0), 0.0);
         assert!((s.subtract(-1.0, 20.0) - 4.0).abs() < 1e-6, "{s:?}");
         assert!(s.is_empty());
+    }
+
+    #[test]
+    fn bad_resolutions_are_typed_errors() {
+        let b = crate::stock_shape::BoxStock::new([0.0; 3], [100.0; 3]).unwrap();
+        for h in [0.0, -1.0, f64::NAN, 1e-4] {
+            assert!(
+                matches!(
+                    TriDexel::from_shape(&b, h),
+                    Err(SimError::InvalidOption {
+                        name: "resolution",
+                        ..
+                    })
+                ),
+                "{h}"
+            );
+        }
     }
 
     #[test]
