@@ -398,3 +398,98 @@ fn read_gcode_ops(
     }));
     Ok((ops, interp))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    fn args(extra: &[&str]) -> Args {
+        let mut v = vec!["verify", "--impeller", "default", "--out", "/tmp/none"];
+        v.extend_from_slice(extra);
+        Cli::parse_from(v).args
+    }
+
+    #[test]
+    fn stock_and_cutter_specs_parse_or_say_what_is_wrong() {
+        assert!(parse_stock("box:0,0,0,1,1,1").is_ok());
+        assert!(parse_stock("cylinder:79,44").is_ok());
+        assert!(parse_stock("revolved:0,0;0,10;5,10;5,0").is_ok());
+        let e = parse_stock("box:1,2")
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("6 numbers"), "{e}");
+        let e = parse_stock("sphere:3")
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("unknown kind"), "{e}");
+        let a = args(&["--cl", "x.cls"]);
+        assert!(parse_cutter(&a, "ball:3").is_ok());
+        assert!(parse_cutter(&a, "tapered-ball:1.5,3").is_ok());
+        let e = parse_cutter(&a, "bull:3")
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("expected 2"), "{e}");
+    }
+
+    #[test]
+    fn gcode_blocks_become_forward_kinematics_locations_with_joint_interpolation() {
+        let dir = std::env::temp_dir().join(format!("verify_gcode_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let prog = dir.join("p.ngc");
+        std::fs::write(
+            &prog,
+            "%\nG21 G90 G94\nG53 G0 Z100\nG0 X10 Y0 Z60 A0 C0\nG1 X12 Y1 Z40 A30 C45 F500\nG1 X14 Y2 Z38 A30 C90\n%\n",
+        )
+        .unwrap();
+        let machine = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/machines/xyzac-trt.toml"
+        );
+        let a = args(&[
+            "--gcode",
+            prog.to_str().unwrap(),
+            "--machine",
+            machine,
+            "--cutter",
+            "ball:2",
+        ]);
+        let (ops, interp) = read_gcode_ops(&a, &prog).unwrap();
+        assert_eq!(ops.len(), 1, "the G53 block only starts the path");
+        let path = &ops[0].1;
+        assert_eq!(path.moves.len(), 3);
+        assert_eq!(path.moves[0].kind, MoveKind::Rapid);
+        let m = Machine::from_file(machine).unwrap();
+        let j1 = Joints {
+            x: 12.0,
+            y: 1.0,
+            z: 40.0,
+            tilt: 30f64.to_radians(),
+            rotate: 45f64.to_radians(),
+        };
+        let j2 = Joints {
+            x: 14.0,
+            y: 2.0,
+            z: 38.0,
+            tilt: 30f64.to_radians(),
+            rotate: 90f64.to_radians(),
+        };
+        let want = m.forward(&j1, 0.0);
+        assert!((path.moves[1].cl.tip - want.tip).norm() < 1e-9);
+        // Halfway through the last move: the forward kinematics of the mid joints.
+        let mid = interp.at(0, 2, &path.moves[1].cl, &path.moves[2].cl, 0.5);
+        let want = m.forward(&j1.lerp(&j2, 0.5), 0.0);
+        assert!((mid.tip - want.tip).norm() < 1e-9);
+        assert!((mid.axis.into_inner() - want.axis.into_inner()).norm() < 1e-12);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
