@@ -5,10 +5,20 @@
 //! (`cam_core::Cutter`), cutter locations / tool paths and a [`DesignModel`].
 //!
 //! Pipeline: [`TriDexel::from_shape`] samples the blank ([`BoxStock`], [`RevolvedStock`]);
-//! [`simulate`] sweeps every move's cutter through the stock ([`removal`]) and checks the
+//! [`simulate()`] sweeps every move's cutter through the stock ([`removal`]) and checks the
 //! non-cutting parts against the stock in process (on the dexels, exact along each ray) and
-//! against the design mesh (parry BVH, [`collision`]); [`measure`] probes the finished stock along design normals for overcut and
-//! residual; [`surface_mesh`] extracts an STL of the final stock.
+//! against the design mesh (parry BVH, [`collision`]); [`measure`] probes the finished stock
+//! along design normals for overcut and residual; [`surface_mesh`] extracts an STL of the
+//! final stock; [`crosscheck`] compares the dexel overcut with cam-core's swept envelopes.
+//! [`ImpellerDesign`] makes an `impeller_model::Impeller` a [`DesignModel`].
+//!
+//! Figures (blank of the 77 mm fixture impeller, Ø79 × 44 mm; `examples/removal_100k.rs`,
+//! release, 2 shared cores): at 0.1 mm the three grids hold 1,327,392 rays in 31.9 MB
+//! (24 bytes per ray inline, 46.3 MB after 100,000 five-axis moves); at 0.2 mm 334,671 rays
+//! in 8.0 MB — memory and work per cutter position scale as O(h⁻²) per direction. 100,000
+//! moves of a tapered ball end (204,777 positions) take 14.2 s CPU at 0.1 mm (3.2 s at
+//! 0.2 mm); the full `simulate` against the impeller (design collisions and 55,680 surface
+//! samples) adds 1.0 s and 3.0 s; peak RSS 125 MB.
 //!
 //! ```
 //! use cam_core::{Cutter, CutterLocation, CutterShape, Move, MoveKind, Point3, ToolPath};
