@@ -145,7 +145,9 @@ impl CutterShape {
                 if h >= radius {
                     radius
                 } else {
-                    (radius * radius - (radius - h) * (radius - h)).max(0.0).sqrt()
+                    (radius * radius - (radius - h) * (radius - h))
+                        .max(0.0)
+                        .sqrt()
                 }
             }
             CutterShape::BullNose {

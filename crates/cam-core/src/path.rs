@@ -141,8 +141,12 @@ impl ToolPath {
 
     /// (kind, length, feed) of each move after the first.
     fn segments(&self) -> impl Iterator<Item = (MoveKind, f64, Option<f64>)> + '_ {
-        self.moves
-            .windows(2)
-            .map(|w| (w[1].kind, (w[1].cl.tip - w[0].cl.tip).norm(), w[1].feed_mm_per_min))
+        self.moves.windows(2).map(|w| {
+            (
+                w[1].kind,
+                (w[1].cl.tip - w[0].cl.tip).norm(),
+                w[1].feed_mm_per_min,
+            )
+        })
     }
 }

@@ -21,6 +21,8 @@ struct Cli {
 enum Command {
     /// Run the whole pipeline on a job file (or the embedded default job).
     Run(cmd::run::Args),
+    /// Rayleigh–Ritz stiffness indicator of a conical cutter.
+    Stiffness(cmd::stiffness::Args),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Stiffness(args) => cmd::stiffness::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
