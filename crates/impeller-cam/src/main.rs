@@ -5,6 +5,10 @@
 
 mod cmd;
 mod error;
+#[allow(dead_code)] // wired into `run` as the pipeline stages land
+mod job;
+#[allow(dead_code)]
+mod plot;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
