@@ -1,20 +1,36 @@
-//! Shared CAM vocabulary of the impeller toolkit: cutters, cutter locations, moves, tool
-//! paths and named tolerances.
+//! Shared CAM vocabulary of the impeller toolkit: cutters (with APT conversion and
+//! collision-ready frusta), cutter locations, moves, tool paths, named tolerances — and the
+//! distance-function core of flank milling: a cutter as an exact family of spheres
+//! ([`sphere_family`]) and the signed distance from a point to the envelope it sweeps along a
+//! two-guide tool-axis trajectory, with closed-form derivatives ([`envelope`]).
 //!
 //! Conventions (see the workspace `DESIGN.md` §3): lengths in millimetres, angles in radians,
 //! `f64` throughout. A cutter location is the tool *tip* (lowest point of the cutter on its
 //! axis) plus the unit tool axis pointing from the tip toward the spindle (APT convention).
 
+pub mod apt;
+pub mod assembly;
 pub mod cutter;
+pub mod envelope;
 pub mod error;
+pub mod guide;
 pub mod location;
 pub mod path;
+pub mod sphere_family;
 pub mod tolerance;
 
+pub use apt::{AptCutter, APT_CONSISTENCY_TOL};
+pub use assembly::Frustum;
 pub use cutter::{Cutter, CutterShape, HolderSegment};
+pub use envelope::{
+    ControlPointGradient, EnvelopeDistance, EnvelopeGradient, EnvelopeOptions, EnvelopeParam,
+    SweptEnvelope,
+};
 pub use error::CamError;
+pub use guide::{GuideCurve, GuideEval, MAX_GUIDE_DEGREE};
 pub use location::CutterLocation;
 pub use path::{Move, MoveKind, Rates, ToolPath};
+pub use sphere_family::{SphereFamily, SpherePiece, SweptSphere};
 pub use tolerance::Tolerances;
 
 /// Point in the workpiece frame (mm).

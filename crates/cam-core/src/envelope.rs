@@ -1,0 +1,872 @@
+//! Signed distance from a point to the envelope swept by a cutter moving along a tool-axis
+//! trajectory surface, and its first-order change with respect to the tool path and the
+//! cutter shape — without building the swept surface.
+//!
+//! # The two-parameter sphere family
+//!
+//! The tool axis at path parameter `s` runs through `P0(s)` toward `P1(s)` (two guiding
+//! B-spline/NURBS curves): `D = P1 − P0`, `ℓ = |D|`, `a(s) = D/ℓ`. `P0` is the axis point at
+//! height `h_g` (the *guide height*, 0 when `P0` is the tool tip) above the tip. The cutter is
+//! a [`SphereFamily`]: member `t` is centred on the axis at height `c(t)` above the tip, with
+//! disc radius `e(t)` (0 for a plain sphere) and sphere radius `ρ(t)`. Moving the cutter gives
+//! the two-parameter family with centres
+//!
+//! `o(s, t) = P0(s) + (c(t) − h_g)·a(s)`,
+//!
+//! and the swept volume is the union of all members (paper 002, §"Representation of cutter
+//! swept envelope as sphere-swept surface"; Zhu et al.'s sphere congruence). With `v = p − o`,
+//! `z = v·a`, `w = √(|v|² − z²)`:
+//!
+//! `F(s, t) = √(z² + max(w − e, 0)²) − ρ`  (`= |p − o| − ρ` for a plain sphere),
+//! `d(p) = min_{s ∈ [s₀, s₁], t ∈ [0, n]} F(s, t)`.
+//!
+//! `d > 0`: `p` is outside the swept volume and `d` is its exact Euclidean distance (distance
+//! to a union = smallest distance to a member). `d < 0`: `p` is inside; `−d` is the depth of
+//! `p` inside the deepest single member — a lower bound of the depth below the swept envelope
+//! (exact when the deepest member's surface normal through `p` reaches the envelope, which is
+//! the usual case for small overcuts of ball and tapered ball ends). `d = 0` on the envelope.
+//!
+//! # Computation
+//!
+//! Stationarity: `∂F/∂s = 0`, `∂F/∂t = 0` (with bounds). At fixed `s` the `t`-equation has a
+//! closed-form solution over the whole family ([`crate::SpherePiece::min_over_tau`]: the function is
+//! convex in `t` on each piece), so the 2×2 Newton system is reduced exactly to its Schur
+//! complement in `s`:
+//!
+//! `g(s) = F(s, t*(s))`, `g' = F_s`, `g'' = F_ss − F_st²/F_tt` (`t*` interior, `F_tt > 0`;
+//! else `g'' = F_ss` because `t*` sits on a bound or on a kink of the family),
+//!
+//! and Newton steps in `s` are projected onto `[s₀, s₁]` and safeguarded by Armijo
+//! backtracking on `g` (a gradient step when `g'' <= 0`). Derivatives of `F` come from the
+//! guides' first and second derivatives (`a' = (D' − a ℓ')/ℓ`, `ℓ' = a·D'`,
+//! `a'' = (D'' − 2a'ℓ' − aℓ'')/ℓ`, `ℓ'' = a'·D' + a·D''`) through `z` and `w`.
+//!
+//! *Cold* queries seed globally: at construction both guides are sampled
+//! `samples_per_span` times per knot span (union of both curves' breakpoints) and the tip and
+//! axis are cached; a query evaluates the closed-form `min_t F` at every sample (no curve
+//! evaluation), keeps the best `newton_starts` discrete local minima in `s` and polishes each.
+//! *Warm* queries start Newton from a hint (typically the previous point's result) and trust
+//! its basin. Iterations stop when the Newton step moves the centre less than `step_tol` (mm).
+//! Cost: cold O(samples · pieces) + a few Newton iterations, warm a few Newton iterations,
+//! each O(p²) for degree-p guides; no allocation.
+//!
+//! # First-order change (envelope theorem)
+//!
+//! At the minimiser `(s*, t*)` (bounds fixed: `s ∈ [s₀, s₁]`, `τ ∈ [0, 1]` per piece), the
+//! derivative of `d` with respect to any data `q` is `∂F/∂q` at fixed `(s*, t*)` (Danskin; the
+//! terms through `∂s*/∂q`, `∂t*/∂q` vanish by stationarity or by the bound). With
+//! `G_v = ∂F/∂v`, `G_a = ∂F/∂a|_v` and `m = c − h_g`:
+//!
+//! - plain sphere: `G_v = v/|v|` (the unit normal `n`), `G_a = 0`;
+//! - beyond a disc rim (`w > e`, `g = w − e`, `Q = √(z² + g²)`):
+//!   `G_v = (z·a + g·(v − z a)/w)/Q`, `G_a = z(1 − g/w)·v/Q`, `∂F/∂e = −g/Q`;
+//! - over a disc (`w <= e`): `G_v = σ·a`, `G_a = σ·v`, `∂F/∂e = 0`, with `σ = sign(z)`, except
+//!   at the kink `z = 0` where the minimising member's centre plane passes through `p`: there
+//!   the value is `−ρ(t*)` with `c(t*) = z`, which gives `σ = −ρ'/c'` (0 for a bull nose);
+//! - point: `∂d/∂p = G_v` (the unit outward normal of the envelope at the foot point);
+//! - axis: `∂F/∂a = G_a − m·G_v`, projected on the sphere of unit vectors,
+//!   `∂F/∂D = (I − a aᵀ)·∂F/∂a / ℓ`;
+//! - guides: `∂d/∂P1 = ∂F/∂D`, `∂d/∂P0 = −G_v − ∂F/∂D`, and for control points
+//!   `∂d/∂Q0_i = R⁰_i(s*)·∂d/∂P0`, `∂d/∂Q1_j = R¹_j(s*)·∂d/∂P1` (rational basis, weights fixed;
+//!   only `degree + 1` control points of each curve are non-zero);
+//! - shape parameter `q_k`: `∂d/∂q_k = −(G_v·a)·∂c/∂q_k + ∂F/∂e·∂e/∂q_k − ∂ρ/∂q_k`, with the
+//!   closed-form coefficient derivatives of the family at fixed `τ*` (for a tapered ball:
+//!   ball radius and half angle).
+//!
+//! The derivative is exact where the minimiser is unique; where several `(s, t)` attain the
+//! minimum (e.g. a point below a flat bottom, equidistant from several members) it is one
+//! valid one-sided derivative.
+
+//!
+//! # Example
+//!
+//! ```
+//! use cam_core::{CutterShape, EnvelopeOptions, GuideCurve, Point3, SphereFamily,
+//!                SweptEnvelope, Vector3};
+//! // A 3 mm ball, 3° taper, moving 50 mm along +x with a vertical axis.
+//! let shape = CutterShape::TaperedBallEnd { ball_radius: 3.0, half_angle: 3f64.to_radians() };
+//! let family = SphereFamily::from_shape(&shape, 25.0)?;
+//! let line = |z: f64| GuideCurve::new(1, vec![0.0, 0.0, 1.0, 1.0],
+//!     vec![Vector3::new(0.0, 0.0, z), Vector3::new(50.0, 0.0, z)], None);
+//! let env = SweptEnvelope::new(family, line(0.0)?, line(10.0)?, 0.0,
+//!                              EnvelopeOptions::default())?;
+//! // 1 mm below the tip line: outside, 1 mm away.
+//! let (d, grad) = env.signed_distance_with_gradient(&Point3::new(25.0, 0.0, -1.0), None)?;
+//! assert!((d.distance - 1.0).abs() < 1e-12);
+//! assert!((grad.point - Vector3::new(0.0, 0.0, -1.0)).norm() < 1e-9);
+//! // ∂d/∂(ball radius) = 0 here: the tip (lowest point) stays on the guide when r grows.
+//! assert!(grad.shape[0].abs() < 1e-9);
+//! // Warm start for the next point along the path.
+//! let next = env.signed_distance(&Point3::new(26.0, 0.0, -1.0), Some(d.param))?;
+//! assert!((next.distance - 1.0).abs() < 1e-12);
+//! # Ok::<(), cam_core::CamError>(())
+//! ```
+
+use crate::guide::GuideEval;
+use crate::{CamError, CutterLocation, GuideCurve, Point3, SphereFamily, Vector3};
+
+const NB: usize = crate::guide::MAX_GUIDE_DEGREE + 1;
+
+/// A point whose height above a disc member's centre plane is below this (mm) is treated as
+/// lying in that plane (the kink of `|z − c(t)|` where the exact `t`-minimisation puts it).
+pub const KINK_TOL_MM: f64 = 1e-9;
+
+/// Named numerical settings of [`SweptEnvelope`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvelopeOptions {
+    /// Seed samples per knot span of the guides (cold queries).
+    pub samples_per_span: usize,
+    /// Number of best discrete local minima polished by Newton on a cold query.
+    pub newton_starts: usize,
+    /// Newton stops when a step moves the sphere centre less than this (mm).
+    pub step_tol: f64,
+    /// Iteration cap per Newton run.
+    pub max_iterations: usize,
+    /// Smallest allowed `|P1 − P0|` (mm); below it the axis is undefined.
+    pub min_axis_length: f64,
+}
+
+impl Default for EnvelopeOptions {
+    fn default() -> Self {
+        Self {
+            samples_per_span: 4,
+            newton_starts: 2,
+            step_tol: 1e-10,
+            max_iterations: 40,
+            min_axis_length: 1e-9,
+        }
+    }
+}
+
+/// Parameters of the minimising member: path parameter `s` and global family parameter `t`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvelopeParam {
+    /// Path (guide-curve) parameter.
+    pub s: f64,
+    /// Family parameter in `[0, number of pieces]`.
+    pub t: f64,
+}
+
+/// Result of a signed-distance query.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvelopeDistance {
+    /// Signed distance (mm): positive outside the swept volume, negative inside.
+    pub distance: f64,
+    /// Minimiser; pass it as the hint of the next query on a neighbouring point.
+    pub param: EnvelopeParam,
+    /// Newton iterations used (all starts).
+    pub iterations: usize,
+}
+
+/// Sensitivity of the distance to one guide's control points: `∂d/∂Q_{first+i} =
+/// basis[i]·direction` for `i < count`, zero for the others.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlPointGradient {
+    /// First control point with a non-zero sensitivity.
+    pub first: usize,
+    /// Number of control points with a non-zero sensitivity (`degree + 1`).
+    pub count: usize,
+    /// Rational basis values `R_{first+i}(s*)`.
+    pub basis: [f64; NB],
+    /// `∂d/∂P(s*)`: gradient with respect to the guide's point.
+    pub direction: Vector3,
+}
+
+impl ControlPointGradient {
+    /// `∂d/∂Q_i` (zero vector outside the support).
+    pub fn get(&self, i: usize) -> Vector3 {
+        if i >= self.first && i < self.first + self.count {
+            self.direction * self.basis[i - self.first]
+        } else {
+            Vector3::zeros()
+        }
+    }
+
+    /// Adds `scale·∂d/∂Q_i` into `out[i]` for every control point in the support
+    /// (`out` indexed like the guide's control points).
+    pub fn add_to(&self, out: &mut [Vector3], scale: f64) {
+        for i in 0..self.count {
+            if let Some(o) = out.get_mut(self.first + i) {
+                *o += self.direction * (scale * self.basis[i]);
+            }
+        }
+    }
+}
+
+/// First-order change of the signed distance (envelope theorem; see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvelopeGradient {
+    /// `∂d/∂p`: outside the swept volume the unit normal of the envelope at the foot point
+    /// (pointing toward `p`); inside, the gradient of the deepest-member depth (a unit vector
+    /// too, except at the kink over a disc, see the module docs).
+    pub point: Vector3,
+    /// Sensitivity to the control points of `P0` (the lower guide).
+    pub guide0: ControlPointGradient,
+    /// Sensitivity to the control points of `P1` (the upper guide).
+    pub guide1: ControlPointGradient,
+    /// `∂d/∂q_k` for the family's shape parameters
+    /// ([`SphereFamily::shape_param_names`]); unused slots are 0.
+    pub shape: [f64; 2],
+}
+
+/// Cached tip and axis at a seed parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Seed {
+    s: f64,
+    tip: Vector3,
+    axis: Vector3,
+}
+
+/// Tool axis frame at `s` with derivatives.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    p0: [Vector3; 3],
+    a: Vector3,
+    a_s: Vector3,
+    a_ss: Vector3,
+    ell: f64,
+    e0: GuideEval,
+    e1: GuideEval,
+}
+
+/// `F` and its first and second derivatives in `(s, τ)`, plus the pieces needed later.
+#[derive(Debug, Clone, Copy)]
+struct Local {
+    /// `F` itself (the Newton loop takes it from the exact `t`-minimisation instead).
+    #[cfg_attr(not(test), allow(dead_code))]
+    f: f64,
+    g: [f64; 2],
+    h: [[f64; 2]; 2],
+    /// |∂o/∂s|, |∂o/∂τ| (mm per unit parameter), for the step test.
+    speed: [f64; 2],
+}
+
+/// The envelope swept by a sphere-family cutter along a two-guide tool-axis trajectory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweptEnvelope {
+    family: SphereFamily,
+    guide0: GuideCurve,
+    guide1: GuideCurve,
+    guide_height: f64,
+    domain: (f64, f64),
+    seeds: Vec<Seed>,
+    opts: EnvelopeOptions,
+    /// Both guides have the same degree and knots: one basis evaluation per frame.
+    shared_basis: bool,
+}
+
+impl SweptEnvelope {
+    /// Builds the envelope of `family` moving with its axis through `guide0(s)` (at height
+    /// `guide_height` above the tip) toward `guide1(s)`. Samples and caches the seed frames.
+    ///
+    /// Errors: [`CamError::InvalidGuide`] if the guides' domains differ or an option is out of
+    /// range; [`CamError::DegenerateAxis`] if the guides meet at a seed parameter;
+    /// [`CamError::NonPositive`] for a non-finite guide height or non-positive tolerances.
+    pub fn new(
+        family: SphereFamily,
+        guide0: GuideCurve,
+        guide1: GuideCurve,
+        guide_height: f64,
+        opts: EnvelopeOptions,
+    ) -> Result<Self, CamError> {
+        let (d0, d1) = (guide0.domain(), guide1.domain());
+        let scale = 1.0 + d0.0.abs().max(d0.1.abs());
+        if (d0.0 - d1.0).abs() > 1e-12 * scale || (d0.1 - d1.1).abs() > 1e-12 * scale {
+            return Err(CamError::InvalidGuide {
+                reason: "the two guides must share one parameter domain",
+            });
+        }
+        if opts.samples_per_span == 0 || opts.newton_starts == 0 || opts.max_iterations == 0 {
+            return Err(CamError::InvalidGuide {
+                reason: "samples_per_span, newton_starts and max_iterations must be >= 1",
+            });
+        }
+        for (field, value) in [
+            ("step_tol", opts.step_tol),
+            ("min_axis_length", opts.min_axis_length),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(CamError::NonPositive { field, value });
+            }
+        }
+        if !guide_height.is_finite() {
+            return Err(CamError::NonPositive {
+                field: "guide_height",
+                value: guide_height,
+            });
+        }
+        let mut breaks = guide0.breakpoints();
+        breaks.extend(guide1.breakpoints());
+        breaks.sort_by(f64::total_cmp);
+        breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * scale);
+        let shared_basis = guide0.shares_basis_with(&guide1);
+        let mut env = Self {
+            shared_basis,
+            family,
+            guide0,
+            guide1,
+            guide_height,
+            domain: d0,
+            seeds: Vec::new(),
+            opts,
+        };
+        let mut seeds = Vec::with_capacity(breaks.len() * opts.samples_per_span + 1);
+        for w in breaks.windows(2) {
+            for k in 0..opts.samples_per_span {
+                let s = w[0] + (w[1] - w[0]) * k as f64 / opts.samples_per_span as f64;
+                seeds.push(env.seed_at(s)?);
+            }
+        }
+        seeds.push(env.seed_at(d0.1)?);
+        env.seeds = seeds;
+        Ok(env)
+    }
+
+    /// Convenience: the envelope of `cutter`'s fluted part moving along two `nurbs` guides.
+    pub fn for_cutter(
+        cutter: &crate::Cutter,
+        guide0: &nurbs::Curve3,
+        guide1: &nurbs::Curve3,
+        guide_height: f64,
+        opts: EnvelopeOptions,
+    ) -> Result<Self, CamError> {
+        Self::new(
+            SphereFamily::from_cutter(cutter)?,
+            GuideCurve::from_curve(guide0)?,
+            GuideCurve::from_curve(guide1)?,
+            guide_height,
+            opts,
+        )
+    }
+
+    fn seed_at(&self, s: f64) -> Result<Seed, CamError> {
+        let (tip, axis) = self.tip_axis(s)?;
+        Ok(Seed { s, tip, axis })
+    }
+
+    /// The cutter family.
+    pub fn family(&self) -> &SphereFamily {
+        &self.family
+    }
+    /// The lower guide `P0`.
+    pub fn guide0(&self) -> &GuideCurve {
+        &self.guide0
+    }
+    /// The upper guide `P1`.
+    pub fn guide1(&self) -> &GuideCurve {
+        &self.guide1
+    }
+    /// Height of `P0` above the tool tip (mm).
+    pub fn guide_height(&self) -> f64 {
+        self.guide_height
+    }
+    /// Path parameter domain.
+    pub fn domain(&self) -> (f64, f64) {
+        self.domain
+    }
+
+    /// Tool tip and unit axis at path parameter `s` (clamped to the domain).
+    fn tip_axis(&self, s: f64) -> Result<(Vector3, Vector3), CamError> {
+        let p0 = self.guide0.point(s);
+        let d = self.guide1.point(s) - p0;
+        let ell = d.norm();
+        if ell.is_nan() || ell < self.opts.min_axis_length {
+            return Err(CamError::DegenerateAxis { s });
+        }
+        let a = d / ell;
+        Ok((p0 - a * self.guide_height, a))
+    }
+
+    /// The cutter location (tip + axis) at path parameter `s`.
+    pub fn cutter_location(&self, s: f64) -> Result<CutterLocation, CamError> {
+        let (tip, axis) = self.tip_axis(s)?;
+        CutterLocation::new(Point3::from(tip), axis)
+    }
+
+    fn frame(&self, s: f64) -> Result<Frame, CamError> {
+        let (e0, e1) = if self.shared_basis {
+            let (span, n) = self.guide0.basis2(s);
+            (
+                self.guide0.combine2(span, &n),
+                self.guide1.combine2(span, &n),
+            )
+        } else {
+            (self.guide0.eval2(s), self.guide1.eval2(s))
+        };
+        let d = e1.d[0] - e0.d[0];
+        let d1 = e1.d[1] - e0.d[1];
+        let d2 = e1.d[2] - e0.d[2];
+        let ell = d.norm();
+        if ell.is_nan() || ell < self.opts.min_axis_length {
+            return Err(CamError::DegenerateAxis { s });
+        }
+        let a = d / ell;
+        let ell_s = a.dot(&d1);
+        let a_s = (d1 - a * ell_s) / ell;
+        let ell_ss = a_s.dot(&d1) + a.dot(&d2);
+        let a_ss = (d2 - a_s * (2.0 * ell_s) - a * ell_ss) / ell;
+        Ok(Frame {
+            p0: e0.d,
+            a,
+            a_s,
+            a_ss,
+            ell,
+            e0,
+            e1,
+        })
+    }
+
+    /// `F`, gradient and Hessian in `(s, τ)` of the member `t` at the frame.
+    fn local(&self, p: &Vector3, fr: &Frame, t: f64) -> Local {
+        let (k, tau) = self.family.split(t);
+        let piece = &self.family.pieces()[k];
+        let m = piece.height[0] + tau * piece.height[1] - self.guide_height;
+        let dc = piece.height[1];
+        let a = fr.a;
+        let o_s = fr.p0[1] + fr.a_s * m;
+        let o_ss = fr.p0[2] + fr.a_ss * m;
+        let o_t = a * dc;
+        let o_st = fr.a_s * dc;
+        let v = p - (fr.p0[0] + a * m);
+        let (v_s, v_t, v_ss, v_st) = (-o_s, -o_t, -o_ss, -o_st);
+        let n = v.norm_squared();
+        let n_i = [2.0 * v.dot(&v_s), 2.0 * v.dot(&v_t)];
+        let n_ij = [
+            [
+                2.0 * (v_s.dot(&v_s) + v.dot(&v_ss)),
+                2.0 * (v_s.dot(&v_t) + v.dot(&v_st)),
+            ],
+            [0.0, 2.0 * v_t.dot(&v_t)],
+        ];
+        let tiny = 1e-300;
+        let (q, q_i, q_ij);
+        if piece.is_sphere() {
+            let qq = n.sqrt().max(tiny);
+            let qi = [n_i[0] / (2.0 * qq), n_i[1] / (2.0 * qq)];
+            let h = |i: usize, j: usize| (0.5 * n_ij[i.min(j)][i.max(j)] - qi[i] * qi[j]) / qq;
+            q = qq;
+            q_i = qi;
+            q_ij = [[h(0, 0), h(0, 1)], [h(0, 1), h(1, 1)]];
+        } else {
+            let e = piece.disc_radius[0] + tau * piece.disc_radius[1];
+            let de = piece.disc_radius[1];
+            let z = v.dot(&a);
+            let z_i = [v_s.dot(&a) + v.dot(&fr.a_s), v_t.dot(&a)];
+            let z_ij = [
+                [
+                    v_ss.dot(&a) + 2.0 * v_s.dot(&fr.a_s) + v.dot(&fr.a_ss),
+                    v_st.dot(&a) + v_t.dot(&fr.a_s),
+                ],
+                [0.0, 0.0],
+            ];
+            let zz = |i: usize, j: usize| z_ij[i.min(j)][i.max(j)];
+            let ww = n - z * z;
+            let w = ww.max(0.0).sqrt();
+            if w > e && w > 1e-12 * (1.0 + e) {
+                let w_cap_i = [n_i[0] - 2.0 * z * z_i[0], n_i[1] - 2.0 * z * z_i[1]];
+                let w_i = [w_cap_i[0] / (2.0 * w), w_cap_i[1] / (2.0 * w)];
+                let w_ij = |i: usize, j: usize| {
+                    let wc = n_ij[i.min(j)][i.max(j)] - 2.0 * (z_i[i] * z_i[j] + z * zz(i, j));
+                    (0.5 * wc - w_i[i] * w_i[j]) / w
+                };
+                let g = w - e;
+                let g_i = [w_i[0], w_i[1] - de];
+                let qq = (z * z + g * g).sqrt().max(tiny);
+                let qi = [
+                    (z * z_i[0] + g * g_i[0]) / qq,
+                    (z * z_i[1] + g * g_i[1]) / qq,
+                ];
+                let h = |i: usize, j: usize| {
+                    (z_i[i] * z_i[j] + z * zz(i, j) + g_i[i] * g_i[j] + g * w_ij(i, j)
+                        - qi[i] * qi[j])
+                        / qq
+                };
+                q = qq;
+                q_i = qi;
+                q_ij = [[h(0, 0), h(0, 1)], [h(0, 1), h(1, 1)]];
+            } else {
+                let sg = flat_sign(z, piece);
+                q = z.abs();
+                q_i = [sg * z_i[0], sg * z_i[1]];
+                q_ij = [[sg * zz(0, 0), sg * zz(0, 1)], [sg * zz(0, 1), 0.0]];
+            }
+        }
+        let rho = piece.radius[0] + tau * piece.radius[1];
+        Local {
+            f: q - rho,
+            g: [q_i[0], q_i[1] - piece.radius[1]],
+            h: q_ij,
+            speed: [o_s.norm(), o_t.norm()],
+        }
+    }
+
+    /// `min_t F(s, t)` at a frame: (value, global t).
+    fn g_frame(&self, p: &Vector3, fr: &Frame) -> (f64, f64) {
+        let v = p - (fr.p0[0] - fr.a * self.guide_height);
+        let z = v.dot(&fr.a);
+        let w = (v.norm_squared() - z * z).max(0.0).sqrt();
+        self.family.signed_distance(w, z)
+    }
+
+    /// Newton on `g(s) = min_t F(s, t)` from `s`; returns (value, s, t, iterations).
+    /// Each iteration evaluates both guides once (with two derivatives) at the trial point,
+    /// which is reused as the next iterate when the full step is accepted.
+    fn polish(&self, p: &Vector3, s_start: f64) -> Result<(f64, f64, f64, usize), CamError> {
+        let (lo, hi) = self.domain;
+        let mut s = s_start.clamp(lo, hi);
+        let mut fr = self.frame(s)?;
+        let (mut f, mut t) = self.g_frame(p, &fr);
+        let n_pieces = self.family.pieces().len() as f64;
+        let mut iters = 0;
+        while iters < self.opts.max_iterations {
+            iters += 1;
+            let loc = self.local(p, &fr, t);
+            let gs = loc.g[0];
+            if (s <= lo && gs >= 0.0) || (s >= hi && gs <= 0.0) {
+                break; // minimum on the domain end
+            }
+            // Schur complement of the 2×2 Newton system (t solved exactly).
+            let tau = t - self.family.split(t).0 as f64;
+            let t_interior = tau > 0.0 && tau < 1.0 && t > 0.0 && t < n_pieces;
+            let mut gss = loc.h[0][0];
+            if t_interior && loc.h[1][1] > 1e-12 * (loc.h[0][0].abs() + 1.0) {
+                gss -= loc.h[0][1] * loc.h[0][1] / loc.h[1][1];
+            }
+            let step = if gss > 0.0 {
+                -gs / gss
+            } else {
+                -gs.signum() * 0.05 * (hi - lo)
+            };
+            // Converged when the (projected) Newton step would move the centre less than
+            // step_tol, or would lower F by less than its rounding noise (the line search
+            // could not see the decrease; the remaining error is below that noise).
+            if gss > 0.0 {
+                let ds = (s + step).clamp(lo, hi) - s;
+                let noise = 64.0 * f64::EPSILON * (1.0 + p.amax() + fr.p0[0].amax());
+                if ds.abs() * loc.speed[0] < self.opts.step_tol || -gs * ds < noise {
+                    break;
+                }
+            }
+            let mut alpha = 1.0;
+            let mut accepted = None;
+            while alpha > 1e-12 {
+                let s_new = (s + alpha * step).clamp(lo, hi);
+                let fr_new = self.frame(s_new)?;
+                let (f_new, t_new) = self.g_frame(p, &fr_new);
+                if f_new <= f + 1e-4 * gs * (s_new - s) {
+                    accepted = Some((s_new, fr_new, f_new, t_new));
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            let Some((s_new, fr_new, f_new, t_new)) = accepted else {
+                break; // no decrease possible at this resolution: converged
+            };
+            let moved = (s_new - s).abs() * loc.speed[0];
+            s = s_new;
+            fr = fr_new;
+            f = f_new;
+            t = t_new;
+            if moved < self.opts.step_tol {
+                break;
+            }
+        }
+        Ok((f, s, t, iters))
+    }
+
+    /// Signed distance from `p` to the swept envelope (module docs), globally seeded when
+    /// `hint` is `None`, else Newton from `hint.s` (the family parameter is recomputed
+    /// exactly). No allocation.
+    ///
+    /// Errors: [`CamError::NonFinitePoint`]; [`CamError::DegenerateAxis`] if the guides meet
+    /// where the search goes.
+    pub fn signed_distance(
+        &self,
+        p: &Point3,
+        hint: Option<EnvelopeParam>,
+    ) -> Result<EnvelopeDistance, CamError> {
+        if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+            return Err(CamError::NonFinitePoint(p.x, p.y, p.z));
+        }
+        let pv = p.coords;
+        if let Some(h) = hint {
+            let (f, s, t, iterations) = self.polish(&pv, h.s)?;
+            return Ok(EnvelopeDistance {
+                distance: f,
+                param: EnvelopeParam { s, t },
+                iterations,
+            });
+        }
+        // Discrete local minima of min_t F over the cached seeds (best `newton_starts`).
+        const MAX_STARTS: usize = 8;
+        let k_starts = self.opts.newton_starts.min(MAX_STARTS);
+        let mut best = [(f64::INFINITY, 0.0f64); MAX_STARTS];
+        let value = |sd: &Seed| {
+            let v = pv - sd.tip;
+            let z = v.dot(&sd.axis);
+            let w = (v.norm_squared() - z * z).max(0.0).sqrt();
+            self.family.signed_distance(w, z).0
+        };
+        let n = self.seeds.len();
+        let mut prev = f64::INFINITY;
+        let mut cur = value(&self.seeds[0]);
+        for i in 0..n {
+            let next = if i + 1 < n {
+                value(&self.seeds[i + 1])
+            } else {
+                f64::INFINITY
+            };
+            if cur <= prev && cur <= next {
+                // Insert into the sorted list of the best local minima.
+                let mut item = (cur, self.seeds[i].s);
+                for slot in best.iter_mut().take(k_starts) {
+                    if item.0 < slot.0 {
+                        std::mem::swap(slot, &mut item);
+                    }
+                }
+            }
+            prev = cur;
+            cur = next;
+        }
+        let mut out: Option<EnvelopeDistance> = None;
+        let mut iterations = 0;
+        for &(v, s0) in best.iter().take(k_starts) {
+            if !v.is_finite() {
+                break;
+            }
+            let (f, s, t, it) = self.polish(&pv, s0)?;
+            iterations += it;
+            if out.is_none_or(|o| f < o.distance) {
+                out = Some(EnvelopeDistance {
+                    distance: f,
+                    param: EnvelopeParam { s, t },
+                    iterations: 0,
+                });
+            }
+        }
+        let mut out = match out {
+            Some(o) => o,
+            None => {
+                // Every seed value was NaN/infinite: cannot happen for finite data, but stay
+                // total: polish from the domain start.
+                let (f, s, t, it) = self.polish(&pv, self.domain.0)?;
+                iterations += it;
+                EnvelopeDistance {
+                    distance: f,
+                    param: EnvelopeParam { s, t },
+                    iterations: 0,
+                }
+            }
+        };
+        out.iterations = iterations;
+        Ok(out)
+    }
+
+    /// First-order change of the distance at a query's minimiser (envelope theorem, module
+    /// docs): with respect to the point, both guides' control points and the shape
+    /// parameters. O(p²), no allocation.
+    pub fn gradient(
+        &self,
+        p: &Point3,
+        at: &EnvelopeDistance,
+    ) -> Result<EnvelopeGradient, CamError> {
+        let s = at.param.s;
+        let fr = self.frame(s)?;
+        let (k, tau) = self.family.split(at.param.t);
+        let piece = &self.family.pieces()[k];
+        let member = piece.at(tau);
+        let m = member.height - self.guide_height;
+        let a = fr.a;
+        let v = p.coords - (fr.p0[0] + a * m);
+        let (g_v, g_a, f_e) = if piece.is_sphere() {
+            let q = v.norm();
+            let g_v = if q > 0.0 { v / q } else { a };
+            (g_v, Vector3::zeros(), 0.0)
+        } else {
+            let z = v.dot(&a);
+            let w = (v.norm_squared() - z * z).max(0.0).sqrt();
+            let e = member.disc_radius;
+            if w > e && w > 0.0 {
+                let g = w - e;
+                let q = (z * z + g * g).sqrt();
+                if q > 0.0 {
+                    let radial = (v - a * z) / w;
+                    (
+                        (a * z + radial * g) / q,
+                        v * (z * (1.0 - g / w) / q),
+                        -g / q,
+                    )
+                } else {
+                    (radial_or_axis(&v, &a, w), Vector3::zeros(), -1.0)
+                }
+            } else {
+                let sg = flat_sign(z, piece);
+                (a * sg, v * sg, 0.0)
+            }
+        };
+        let df_da = g_a - g_v * m;
+        let df_dd = (df_da - a * a.dot(&df_da)) / fr.ell;
+        let dp1 = df_dd;
+        let dp0 = -g_v - df_dd;
+        let mut shape = [0.0; 2];
+        let f_c = -g_v.dot(&a);
+        for (k_param, out) in shape
+            .iter_mut()
+            .enumerate()
+            .take(self.family.shape_param_names().len())
+        {
+            let d = &piece.d_shape[k_param];
+            let dc = d[0] + tau * d[1];
+            let de = d[2] + tau * d[3];
+            let drho = d[4] + tau * d[5];
+            *out = f_c * dc + f_e * de - drho;
+        }
+        let cp = |e: &GuideEval, direction: Vector3| ControlPointGradient {
+            first: e.first,
+            count: e.count,
+            basis: e.basis,
+            direction,
+        };
+        Ok(EnvelopeGradient {
+            point: g_v,
+            guide0: cp(&fr.e0, dp0),
+            guide1: cp(&fr.e1, dp1),
+            shape,
+        })
+    }
+
+    /// [`Self::signed_distance`] followed by [`Self::gradient`].
+    pub fn signed_distance_with_gradient(
+        &self,
+        p: &Point3,
+        hint: Option<EnvelopeParam>,
+    ) -> Result<(EnvelopeDistance, EnvelopeGradient), CamError> {
+        let d = self.signed_distance(p, hint)?;
+        let g = self.gradient(p, &d)?;
+        Ok((d, g))
+    }
+}
+
+/// `∂|z|/∂z` over a disc, where `z` is the height of `p` above the member's centre plane. At
+/// the kink `z = 0` reached by the exact `t`-minimisation (p lies in the centre plane of a
+/// member containing it) the value is `min_t (|z − c(t)| − ρ(t)) = −ρ(t*)` with `c(t*) = z`, so
+/// its derivative follows `t*`: the effective slope is `−ρ'/c'` (0 for a bull nose: the depth
+/// `−ρ` is locally constant).
+fn flat_sign(z: f64, piece: &crate::SpherePiece) -> f64 {
+    if z.abs() <= KINK_TOL_MM && piece.height[1] != 0.0 {
+        -piece.radius[1] / piece.height[1]
+    } else if z < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
+/// Unit radial direction of `v` (or the axis when `v` is on it).
+fn radial_or_axis(v: &Vector3, a: &Vector3, w: f64) -> Vector3 {
+    if w > 0.0 {
+        (v - a * v.dot(a)) / w
+    } else {
+        *a
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::CutterShape;
+
+    fn guide(pts: &[[f64; 3]]) -> GuideCurve {
+        let n = pts.len();
+        let p = 3;
+        let mut knots = vec![0.0; p + 1];
+        for i in 1..(n - p) {
+            knots.push(i as f64 / (n - p) as f64);
+        }
+        knots.extend([1.0; 4]);
+        GuideCurve::new(
+            p,
+            knots,
+            pts.iter().map(|q| Vector3::new(q[0], q[1], q[2])).collect(),
+            None,
+        )
+        .unwrap()
+    }
+
+    /// `local` derivatives against central differences of `F`, for sphere and disc pieces.
+    #[test]
+    #[allow(clippy::needless_range_loop)]
+    fn local_derivatives_match_finite_differences() {
+        let g0 = guide(&[
+            [0.0, 0.0, 0.0],
+            [10.0, 5.0, 1.0],
+            [20.0, -3.0, 2.0],
+            [30.0, 2.0, 0.0],
+            [40.0, 0.0, 1.0],
+        ]);
+        let g1 = guide(&[
+            [0.0, 3.0, 20.0],
+            [12.0, 6.0, 19.0],
+            [19.0, 1.0, 21.0],
+            [33.0, 5.0, 20.0],
+            [41.0, 4.0, 18.0],
+        ]);
+        let shapes = [
+            CutterShape::TaperedBallEnd {
+                ball_radius: 3.0,
+                half_angle: 0.05,
+            },
+            CutterShape::BullNose {
+                radius: 5.0,
+                corner_radius: 1.0,
+            },
+            CutterShape::TaperedFlatEnd {
+                tip_radius: 4.0,
+                half_angle: 0.1,
+            },
+        ];
+        let p = Vector3::new(17.0, 9.0, 4.0);
+        for shape in shapes {
+            let fam = SphereFamily::from_shape(&shape, 25.0).unwrap();
+            let env =
+                SweptEnvelope::new(fam, g0.clone(), g1.clone(), 1.5, EnvelopeOptions::default())
+                    .unwrap();
+            for &(s, t) in &[(0.3, 0.4), (0.55, 0.7), (0.42, 0.2)] {
+                let h = 1e-6;
+                let f = |s: f64, t: f64| env.local(&p, &env.frame(s).unwrap(), t);
+                let l = f(s, t);
+                let (sp, sm) = (f(s + h, t), f(s - h, t));
+                let (tp, tm) = (f(s, t + h), f(s, t - h));
+                let fd_g = [(sp.f - sm.f) / (2.0 * h), (tp.f - tm.f) / (2.0 * h)];
+                let fd_h = [
+                    [
+                        (sp.g[0] - sm.g[0]) / (2.0 * h),
+                        (tp.g[0] - tm.g[0]) / (2.0 * h),
+                    ],
+                    [
+                        (sp.g[1] - sm.g[1]) / (2.0 * h),
+                        (tp.g[1] - tm.g[1]) / (2.0 * h),
+                    ],
+                ];
+                let scale = 1.0 + l.g[0].abs() + l.g[1].abs();
+                for i in 0..2 {
+                    assert!(
+                        (l.g[i] - fd_g[i]).abs() < 1e-6 * scale,
+                        "{shape:?} g{i}: {} vs {}",
+                        l.g[i],
+                        fd_g[i]
+                    );
+                    for j in 0..2 {
+                        let hs = 1.0 + l.h[i][j].abs();
+                        assert!(
+                            (l.h[i][j] - fd_h[i][j]).abs() < 1e-5 * hs * scale,
+                            "{shape:?} h{i}{j}: {} vs {}",
+                            l.h[i][j],
+                            fd_h[i][j]
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
