@@ -27,6 +27,8 @@ enum Command {
     Run(cmd::run::Args),
     /// Rayleigh–Ritz stiffness indicator of a conical cutter.
     Stiffness(cmd::stiffness::Args),
+    /// Build an impeller and print its measured summary (blade counts, diameters, widths).
+    Model(cmd::model::Args),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
         Command::Stiffness(args) => cmd::stiffness::run(args),
+        Command::Model(args) => cmd::model::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
