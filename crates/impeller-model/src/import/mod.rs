@@ -1,0 +1,22 @@
+//! Importers of blade-design exports: TurboGrid curve sets, NUMECA AutoGrid `.geomTurbo`, and
+//! BladeGen `rtzt` meanline files.
+//!
+//! Each importer reads its format into a [`RawImpeller`]: point data in millimetres with the
+//! rotation axis along +Z, still in the file's axial sense and not yet fitted. Every failure
+//! is an [`ImportError`] naming the file, the line and what was expected there.
+
+pub mod error;
+pub mod geomturbo;
+pub mod raw;
+pub mod rtzt;
+mod text;
+pub mod turbogrid;
+
+pub use error::ImportError;
+pub use geomturbo::{parse_geomturbo, read_geomturbo};
+pub use raw::{
+    BladeRole, LengthUnit, RawBlade, RawImpeller, RawSection, SectionShape, SourceFormat,
+    ThicknessKind,
+};
+pub use rtzt::{parse_rtzt, read_rtzt};
+pub use turbogrid::{read_turbogrid, turbogrid_from_bytes, TurboGridInf};
