@@ -118,7 +118,11 @@ fn read_side(
         if !first_word_is(text, "XYZ") {
             return Err(r.syntax(no, what, text));
         }
-        let n = read_count(r, &format!("number of points of {side} section {}", k + 1), 2)?;
+        let n = read_count(
+            r,
+            &format!("number of points of {side} section {}", k + 1),
+            2,
+        )?;
         let pts = read_points::<3>(r, n, "x y z")?;
         sections.push((no, pts.into_iter().map(Vector3::from).collect()));
     }
@@ -212,9 +216,25 @@ pub fn parse_geomturbo(file: &Path, bytes: &[u8]) -> Result<RawImpeller, ImportE
                 };
                 match curves.last_mut() {
                     Some(c) if c.points.is_empty() => c.points = pts,
-                    Some(_) => return Err(r.invalid(no, "curve", "a second point list in one basic_curve")),
+                    Some(_) => {
+                        return Err(r.invalid(
+                            no,
+                            "curve",
+                            "a second point list in one basic_curve",
+                        ))
+                    }
                     None => return Err(r.syntax(no, "ZR/XYZ inside a basic_curve block", text)),
                 }
+            }
+            "zrcurve" | "xyzcurve" => {
+                return Err(r.syntax(
+                    no,
+                    format!(
+                        "NI_END {} (the point count says how many points follow)",
+                        top.kind
+                    ),
+                    text,
+                ));
             }
             "channel_curve" if first == "VERTEX" => {
                 let rest: Vec<&str> = toks.collect();
@@ -247,7 +267,11 @@ pub fn parse_geomturbo(file: &Path, bytes: &[u8]) -> Result<RawImpeller, ImportE
                     "units" => {
                         let f = r.number(no, &rest_after_first(t), "units")?;
                         if !(f > 0.0) {
-                            return Err(r.invalid(no, "units", format!("{f} is not a positive scale factor")));
+                            return Err(r.invalid(
+                                no,
+                                "units",
+                                format!("{f} is not a positive scale factor"),
+                            ));
                         }
                         blade.units = Some((no, f));
                     }
@@ -297,7 +321,11 @@ pub fn parse_geomturbo(file: &Path, bytes: &[u8]) -> Result<RawImpeller, ImportE
         .filter(|b| !(b.suction.is_empty() && b.pressure.is_empty()))
         .collect();
     if blades_with_geometry.is_empty() {
-        return Err(r.invalid(row.line, "NIROW", "the row has no blade with suction/pressure sections"));
+        return Err(r.invalid(
+            row.line,
+            "NIROW",
+            "the row has no blade with suction/pressure sections",
+        ));
     }
     let mm_per_unit = |b: &BladeData| b.units.map_or(1.0, |(_, f)| f) * LengthUnit::Metre.mm();
     let channel_scale = mm_per_unit(&blades_with_geometry[0]);
@@ -314,7 +342,11 @@ pub fn parse_geomturbo(file: &Path, bytes: &[u8]) -> Result<RawImpeller, ImportE
             (Some((_, p)), _) => p,
             (None, Some((_, n))) => n,
             (None, None) => {
-                return Err(r.invalid(b.line, "PERIODICITY", "neither the row's PERIODICITY nor the blade's number_of_blades is given"))
+                return Err(r.invalid(
+                    b.line,
+                    "PERIODICITY",
+                    "neither the row's PERIODICITY nor the blade's number_of_blades is given",
+                ))
             }
         };
         if b.suction.len() != b.pressure.len() {
@@ -372,7 +404,11 @@ pub fn parse_geomturbo(file: &Path, bytes: &[u8]) -> Result<RawImpeller, ImportE
                     continue;
                 }
                 let c = curves.iter().find(|c| c.name == name).ok_or_else(|| {
-                    r.invalid(no, "VERTEX CURVE_P", format!("no basic_curve named {name:?}"))
+                    r.invalid(
+                        no,
+                        "VERTEX CURVE_P",
+                        format!("no basic_curve named {name:?}"),
+                    )
                 })?;
                 used.push(name);
                 append_curve(&mut pts, &c.points);
@@ -404,7 +440,11 @@ pub fn parse_geomturbo(file: &Path, bytes: &[u8]) -> Result<RawImpeller, ImportE
 /// Appends a curve's points, dropping a first point that repeats the last one already held.
 fn append_curve(out: &mut Vec<Vector2<f64>>, pts: &[Vector2<f64>]) {
     for (i, p) in pts.iter().enumerate() {
-        if i == 0 && out.last().is_some_and(|q| (q - p).norm() <= 1e-12 * (1.0 + p.norm())) {
+        if i == 0
+            && out
+                .last()
+                .is_some_and(|q| (q - p).norm() <= 1e-12 * (1.0 + p.norm()))
+        {
             continue;
         }
         out.push(*p);

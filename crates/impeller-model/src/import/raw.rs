@@ -303,7 +303,10 @@ mod tests {
 
     #[test]
     fn tangential_offset_is_exact() {
-        let pts = vec![from_cylindrical(50.0, 0.1, 0.0), from_cylindrical(60.0, 0.2, 5.0)];
+        let pts = vec![
+            from_cylindrical(50.0, 0.1, 0.0),
+            from_cylindrical(60.0, 0.2, 5.0),
+        ];
         let (p, m) = offset_camber(&pts, &[2.0, 1.0], ThicknessKind::Tangential).unwrap();
         assert!((p[0].y.atan2(p[0].x) - (0.1 + 1.0 / 50.0)).abs() < 1e-12);
         assert!((m[1].y.atan2(m[1].x) - (0.2 - 0.5 / 60.0)).abs() < 1e-12);

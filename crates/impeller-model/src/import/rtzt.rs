@@ -17,8 +17,7 @@
 //! Each layer is a camber line with its thickness. Points of zero thickness before the first
 //! and after the last non-zero one describe the flow path beyond the blade: the hub and
 //! shroud contours are the meridional traces of the main blade's first and last layers (all
-//! points), and each blade section keeps only the bladed part (with one zero-thickness point
-//! at each end if present). Splitter θ values are taken as absolute (the pitch fraction is
+//! points), and each blade section keeps only its points of non-zero thickness. Splitter θ values are taken as absolute (the pitch fraction is
 //! kept for information only). Splitter count = blade count × splitters per blade.
 
 use super::error::ImportError;
@@ -58,7 +57,11 @@ pub fn parse_rtzt(file: &Path, bytes: &[u8], unit: LengthUnit) -> Result<RawImpe
         let (no, text) = r.expect_nonblank(&format!("the number of layers of the {label}"))?;
         let n_layers = r.count(no, text, "number of layers")?;
         if n_layers < 2 {
-            return Err(r.invalid(no, "number of layers", format!("at least 2 required, found {n_layers}")));
+            return Err(r.invalid(
+                no,
+                "number of layers",
+                format!("at least 2 required, found {n_layers}"),
+            ));
         }
         let mut kind = ThicknessKind::Normal;
         if let Some(peek) = r.peek_nonblank() {
@@ -76,7 +79,10 @@ pub fn parse_rtzt(file: &Path, bytes: &[u8], unit: LengthUnit) -> Result<RawImpe
         let mut sections = Vec::new();
         let mut last_span = f64::NEG_INFINITY;
         for l in 0..n_layers {
-            let what = format!("layer {} of {n_layers} of the {label}: span fraction, number of points [a|t|b]", l + 1);
+            let what = format!(
+                "layer {} of {n_layers} of the {label}: span fraction, number of points [a|t|b]",
+                l + 1
+            );
             let (no, text) = r.expect_nonblank(&what)?;
             let toks: Vec<&str> = tokens(text).collect();
             if toks.len() < 2 || toks.len() > 3 {
@@ -87,22 +93,36 @@ pub fn parse_rtzt(file: &Path, bytes: &[u8], unit: LengthUnit) -> Result<RawImpe
                 return Err(r.invalid(no, "span fraction", format!("{span} is not within 0–1")));
             }
             if span <= last_span {
-                return Err(r.invalid(no, "span fraction", "layers must go from hub to shroud with increasing span"));
+                return Err(r.invalid(
+                    no,
+                    "span fraction",
+                    "layers must go from hub to shroud with increasing span",
+                ));
             }
             last_span = span;
             let n_pts = r.count(no, toks[1], "number of points")?;
             if n_pts < 2 {
-                return Err(r.invalid(no, "number of points", format!("at least 2 required, found {n_pts}")));
+                return Err(r.invalid(
+                    no,
+                    "number of points",
+                    format!("at least 2 required, found {n_pts}"),
+                ));
             }
             if let Some(flag) = toks.get(2) {
-                if !flag.chars().all(|c| matches!(c.to_ascii_lowercase(), 'a' | 't' | 'b')) {
+                if !flag
+                    .chars()
+                    .all(|c| matches!(c.to_ascii_lowercase(), 'a' | 't' | 'b'))
+                {
                     return Err(r.syntax(no, "layer usage flags a, t, b", text));
                 }
             }
             let mut pts = Vec::new();
             let mut thick = Vec::new();
             for k in 0..n_pts {
-                let (pno, ptext) = r.expect_nonblank(&format!("point {} of {n_pts} (r theta z thickness)", k + 1))?;
+                let (pno, ptext) = r.expect_nonblank(&format!(
+                    "point {} of {n_pts} (r theta z thickness)",
+                    k + 1
+                ))?;
                 let [rr, th, z, t] = r.numbers::<4>(pno, ptext, "r theta z thickness")?;
                 if rr < 0.0 {
                     return Err(r.invalid(pno, "r", format!("{rr} is negative")));
@@ -119,14 +139,29 @@ pub fn parse_rtzt(file: &Path, bytes: &[u8], unit: LengthUnit) -> Result<RawImpe
             if b == 0 && l + 1 == n_layers {
                 shroud = pts.iter().map(meridional).collect();
             }
-            // Keep the bladed part: from the last zero before the first non-zero thickness to
-            // the first zero after the last non-zero one.
+            // Keep the bladed part: the points from the first to the last non-zero thickness.
             let Some(first_nz) = thick.iter().position(|&t| t > 0.0) else {
-                return Err(r.invalid(no, "thickness", format!("layer {} of the {label} has zero thickness everywhere", l + 1)));
+                return Err(r.invalid(
+                    no,
+                    "thickness",
+                    format!(
+                        "layer {} of the {label} has zero thickness everywhere",
+                        l + 1
+                    ),
+                ));
             };
             let last_nz = thick.iter().rposition(|&t| t > 0.0).unwrap_or(first_nz);
-            let lo = first_nz.saturating_sub(1);
-            let hi = (last_nz + 1).min(n_pts - 1);
+            let (lo, hi) = (first_nz, last_nz);
+            if hi - lo < 1 {
+                return Err(r.invalid(
+                    no,
+                    "thickness",
+                    format!(
+                        "layer {} of the {label} has fewer than 2 points of non-zero thickness",
+                        l + 1
+                    ),
+                ));
+            }
             sections.push(RawSection {
                 line: no,
                 span: Some(span),

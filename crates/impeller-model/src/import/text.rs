@@ -104,7 +104,10 @@ impl<'a> LineReader<'a> {
     }
 
     /// The next non-blank line; at end of file an error saying `expected` is returned.
-    pub(crate) fn expect_nonblank(&mut self, expected: &str) -> Result<(usize, &'a str), ImportError> {
+    pub(crate) fn expect_nonblank(
+        &mut self,
+        expected: &str,
+    ) -> Result<(usize, &'a str), ImportError> {
         match self.next_nonblank() {
             Some(r) => r,
             None => Err(self.eof(expected)),
@@ -125,7 +128,12 @@ impl<'a> LineReader<'a> {
     }
 
     /// A syntax error at `line`.
-    pub(crate) fn syntax(&self, line: usize, expected: impl Into<String>, found: &str) -> ImportError {
+    pub(crate) fn syntax(
+        &self,
+        line: usize,
+        expected: impl Into<String>,
+        found: &str,
+    ) -> ImportError {
         ImportError::Syntax {
             file: self.file.clone(),
             line,
@@ -219,9 +227,18 @@ mod tests {
     fn numbers_reject_nan_and_extra_tokens() {
         let r = LineReader::new(Path::new("f"), b"");
         assert_eq!(r.numbers::<2>(1, "1 2D-1", "a b").unwrap(), [1.0, 0.2]);
-        assert!(matches!(r.numbers::<2>(1, "1 NaN", "a b"), Err(ImportError::Invalid { .. })));
-        assert!(matches!(r.numbers::<2>(1, "1 2 3", "a b"), Err(ImportError::Syntax { .. })));
-        assert!(matches!(r.numbers::<2>(1, "1", "a b"), Err(ImportError::Syntax { .. })));
+        assert!(matches!(
+            r.numbers::<2>(1, "1 NaN", "a b"),
+            Err(ImportError::Invalid { .. })
+        ));
+        assert!(matches!(
+            r.numbers::<2>(1, "1 2 3", "a b"),
+            Err(ImportError::Syntax { .. })
+        ));
+        assert!(matches!(
+            r.numbers::<2>(1, "1", "a b"),
+            Err(ImportError::Syntax { .. })
+        ));
         assert_eq!(r.count(1, "+100", "n").unwrap(), 100);
         assert!(r.count(1, "-1", "n").is_err());
     }

@@ -145,7 +145,11 @@ impl TurboGridInf {
                         "cartesian" => CoordinateType::Cartesian,
                         "cylindrical" => CoordinateType::Cylindrical,
                         _ => {
-                            return Err(r.syntax(no, "Coordinate Type: Cartesian or Cylindrical", text))
+                            return Err(r.syntax(
+                                no,
+                                "Coordinate Type: Cartesian or Cylindrical",
+                                text,
+                            ))
                         }
                     });
                 }
@@ -181,7 +185,8 @@ impl TurboGridInf {
                         .split_whitespace()
                         .next()
                         .unwrap_or("");
-                    let idx = r.count(no, idx_text, "blade index in `Blade k Profile Data File`")?;
+                    let idx =
+                        r.count(no, idx_text, "blade index in `Blade k Profile Data File`")?;
                     if value.is_empty() {
                         return Err(r.syntax(no, format!("{}: FILE NAME", key.trim()), text));
                     }
@@ -242,7 +247,11 @@ impl TurboGridInf {
         let s = self.units.mm();
         match self.coordinates {
             CoordinateType::Cylindrical => {
-                let theta = if self.degrees { v[1].to_radians() } else { v[1] };
+                let theta = if self.degrees {
+                    v[1].to_radians()
+                } else {
+                    v[1]
+                };
                 from_cylindrical(v[0] * s, theta, v[2] * s)
             }
             CoordinateType::Cartesian => {
@@ -314,7 +323,10 @@ pub fn parse_profiles(
             return Err(r.invalid(
                 line,
                 "profile",
-                format!("a closed section loop needs at least 4 points, found {}", pts.len()),
+                format!(
+                    "a closed section loop needs at least 4 points, found {}",
+                    pts.len()
+                ),
             ));
         }
         out.push(RawSection {
@@ -345,9 +357,15 @@ pub fn parse_profiles(
                     let v = s
                         .strip_suffix('%')
                         .and_then(super::text::parse_number)
-                        .ok_or_else(|| r.syntax(no, "a span percentage after `at` (e.g. 20%)", text))?;
+                        .ok_or_else(|| {
+                            r.syntax(no, "a span percentage after `at` (e.g. 20%)", text)
+                        })?;
                     if !(0.0..=100.0).contains(&v) {
-                        return Err(r.invalid(no, "profile span", format!("{v}% is not within 0–100%")));
+                        return Err(r.invalid(
+                            no,
+                            "profile span",
+                            format!("{v}% is not within 0–100%"),
+                        ));
                     }
                     span = Some(v / 100.0);
                 }

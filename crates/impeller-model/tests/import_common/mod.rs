@@ -35,5 +35,7 @@ pub fn centrifugal_geomturbo() -> PathBuf {
 
 /// Our own sample files.
 pub fn sample(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
 }
