@@ -2,6 +2,8 @@
 //! export, fed to every importer: always a typed error or a valid result, never a panic.
 //! The real exports are read from `../shared/data` at test time and mutated in memory.
 
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)]
+
 mod import_common;
 
 use impeller_model::import::{

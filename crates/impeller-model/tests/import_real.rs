@@ -53,3 +53,96 @@ fn centrifugal_raw_counts_and_units() {
     // SOURCE.txt: blade TE radius ≈ 0.20 m.
     assert!((te_r - 200.0).abs() < 2.0, "largest blade radius {te_r} mm");
 }
+
+use impeller_model::import::{prepare, RawImpeller, RawSection};
+
+fn z_range(p: &impeller_model::import::PreparedImpeller) -> (f64, f64) {
+    p.hub
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+            (a.min(q.x), b.max(q.x))
+        })
+}
+
+#[test]
+fn centrifugal_prepared_in_workpiece_frame() {
+    let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
+    let p = prepare(&raw).unwrap();
+    assert!(p.flipped, "the file's inlet is at low z");
+    let (zmin, zmax) = z_range(&p);
+    assert!(zmin.abs() < 1e-9, "hub back end at z = 0, got {zmin}");
+    // The turn keeps the hub's axial extent.
+    let (rmin, rmax) = raw
+        .hub
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+            (a.min(q.x), b.max(q.x))
+        });
+    assert!((zmax - (rmax - rmin)).abs() < 1e-9);
+    assert!(
+        p.hub[0].x > p.hub[p.hub.len() - 1].x,
+        "hub listed from the inlet"
+    );
+    for b in &p.blades {
+        for s in &b.sections {
+            for side in [&s.pressure, &s.suction] {
+                let (le, te) = (side[0], side[side.len() - 1]);
+                assert!(le.z > te.z, "LE toward +Z (inlet)");
+                assert!(le.xy().norm() < te.xy().norm(), "TE at the larger radius");
+                let r_te = te.xy().norm();
+                assert!((r_te - 200.0).abs() < 2.0, "TE radius {r_te} mm");
+            }
+        }
+    }
+}
+
+/// The convexity rule that labels unlabelled sides reproduces AutoGrid's own suction and
+/// pressure labels on the centrifugal impeller.
+#[test]
+fn convexity_rule_matches_autogrid_labels() {
+    let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
+    let labelled = prepare(&raw).unwrap();
+    let mut looped: RawImpeller = raw.clone();
+    for b in &mut looped.blades {
+        for s in &mut b.sections {
+            let SectionShape::Sides { suction, pressure } = &s.shape else {
+                unreachable!()
+            };
+            // A loop that starts on the pressure side, so the rule must swap.
+            let mut pts: Vec<_> = pressure.clone();
+            pts.extend(suction.iter().rev().skip(1));
+            *s = RawSection {
+                line: s.line,
+                span: None,
+                shape: SectionShape::Loop(pts),
+            };
+        }
+    }
+    let unlabelled = prepare(&looped).unwrap();
+    for (a, b) in labelled.blades.iter().zip(&unlabelled.blades) {
+        for (sa, sb) in a.sections.iter().zip(&b.sections) {
+            let mid_a = sa.suction[sa.suction.len() / 2];
+            let d = sb
+                .suction
+                .iter()
+                .map(|q| (q - mid_a).norm())
+                .fold(f64::INFINITY, f64::min);
+            assert!(d < 1e-9, "suction side relabelled (distance {d})");
+        }
+    }
+}
+
+#[test]
+fn rotor37_prepared() {
+    let raw = read_turbogrid(&import_common::rotor37_inf()).unwrap();
+    let p = prepare(&raw).unwrap();
+    assert!(p.flipped, "rotor 37's inlet is at low z in the file");
+    assert_eq!(p.main_blade_count(), 36);
+    for s in &p.blades[0].sections {
+        for side in [&s.pressure, &s.suction] {
+            assert!(side[0].z > side[side.len() - 1].z);
+        }
+        // LE and TE shared by both sides of the split loop.
+        assert!((s.pressure[0] - s.suction[0]).norm() < 1e-12);
+    }
+}

@@ -20,7 +20,8 @@
 
 use super::error::ImportError;
 use super::raw::{
-    BladeRole, LengthUnit, RawBlade, RawImpeller, RawSection, SectionShape, SourceFormat,
+    positive, BladeRole, LengthUnit, Polyline3, RawBlade, RawImpeller, RawSection, SectionShape,
+    SourceFormat,
 };
 use super::text::{tokens, LineReader};
 use nalgebra::{Vector2, Vector3};
@@ -97,10 +98,7 @@ fn read_count(r: &mut LineReader<'_>, field: &str, min: usize) -> Result<usize, 
 }
 
 /// Reads one blade side after its `suction` / `pressure` keyword.
-fn read_side(
-    r: &mut LineReader<'_>,
-    side: &str,
-) -> Result<Vec<(usize, Vec<Vector3<f64>>)>, ImportError> {
+fn read_side(r: &mut LineReader<'_>, side: &str) -> Result<Vec<(usize, Polyline3)>, ImportError> {
     let (no, text) = r.expect_nonblank(&format!("SECTIONAL after `{side}`"))?;
     if !first_word_is(text, "SECTIONAL") {
         return Err(r.syntax(no, format!("SECTIONAL after `{side}`"), text));
@@ -266,7 +264,7 @@ pub fn parse_geomturbo(file: &Path, bytes: &[u8]) -> Result<RawImpeller, ImportE
                 match lower.as_str() {
                     "units" => {
                         let f = r.number(no, &rest_after_first(t), "units")?;
-                        if !(f > 0.0) {
+                        if !positive(f) {
                             return Err(r.invalid(
                                 no,
                                 "units",

@@ -7,6 +7,7 @@
 
 pub mod error;
 pub mod geomturbo;
+pub mod prepare;
 pub mod raw;
 pub mod rtzt;
 mod text;
@@ -14,6 +15,7 @@ pub mod turbogrid;
 
 pub use error::ImportError;
 pub use geomturbo::{parse_geomturbo, read_geomturbo};
+pub use prepare::{prepare, PreparedBlade, PreparedImpeller, SectionSides};
 pub use raw::{
     BladeRole, LengthUnit, RawBlade, RawImpeller, RawSection, SectionShape, SourceFormat,
     ThicknessKind,

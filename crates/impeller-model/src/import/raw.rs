@@ -171,6 +171,17 @@ impl RawImpeller {
     }
 }
 
+/// A polyline of 3D points, mm.
+pub type Polyline3 = Vec<Vector3<f64>>;
+
+/// Two blade sides as point lists.
+pub type SidePair = (Polyline3, Polyline3);
+
+/// Whether `x` is a number greater than zero (false for NaN).
+pub(crate) fn positive(x: f64) -> bool {
+    x > 0.0
+}
+
 /// Meridional coordinates (z, r) of a point (rotation axis +Z).
 pub fn meridional(p: &Vector3<f64>) -> Vector2<f64> {
     Vector2::new(p.z, p.x.hypot(p.y))
@@ -188,7 +199,7 @@ pub fn from_cylindrical(r: f64, theta: f64, z: f64) -> Vector3<f64> {
 /// repeated closing point is dropped first. Both returned sides run from the first edge found
 /// (lower loop index) to the other; callers orient and label them. Returns `None` when the
 /// loop has fewer than 4 distinct points or its meridional extent is zero.
-pub fn split_loop(points: &[Vector3<f64>]) -> Option<(Vec<Vector3<f64>>, Vec<Vector3<f64>>)> {
+pub fn split_loop(points: &[Vector3<f64>]) -> Option<SidePair> {
     let mut pts: Vec<Vector3<f64>> = points.to_vec();
     while pts.len() > 1 {
         let (first, last) = (pts[0], pts[pts.len() - 1]);
@@ -214,7 +225,7 @@ pub fn split_loop(points: &[Vector3<f64>]) -> Option<(Vec<Vector3<f64>>, Vec<Vec
             }
         }
     }
-    if !(best > 0.0) {
+    if !positive(best) {
         return None;
     }
     let side_a: Vec<Vector3<f64>> = pts[bi..=bj].to_vec();
@@ -243,7 +254,7 @@ pub fn offset_camber(
     points: &[Vector3<f64>],
     thickness: &[f64],
     kind: ThicknessKind,
-) -> Option<(Vec<Vector3<f64>>, Vec<Vector3<f64>>)> {
+) -> Option<SidePair> {
     let n = points.len();
     if n < 2 || thickness.len() != n {
         return None;
@@ -253,7 +264,7 @@ pub fn offset_camber(
     for i in 0..n {
         let p = points[i];
         let r = p.x.hypot(p.y);
-        if !(r > 0.0) {
+        if !positive(r) {
             return None;
         }
         let half = 0.5 * thickness[i];

@@ -1,5 +1,5 @@
 //! Shared helpers of the import/export tests: where the public design exports live.
-#![allow(dead_code)]
+#![allow(dead_code, clippy::panic, clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::PathBuf;
 
