@@ -65,3 +65,7 @@ pub const MAX_DEGREE: usize = 12;
 
 /// `MAX_DEGREE + 1`: size of the fixed basis-function buffers.
 pub const MAX_ORDER: usize = MAX_DEGREE + 1;
+
+pub mod closest;
+pub mod discretise;
+pub mod fit;

@@ -1,0 +1,28 @@
+//! Global closest points on curves and surfaces.
+//!
+//! * [`SurfaceProjector`] — precomputed query structure for a [`crate::NurbsSurface`]; global
+//!   minimum with boundary handling and optional warm start.
+//! * [`CurveProjector`] — the same for a [`crate::NurbsCurve`] in any dimension.
+//! * [`closest_point_on_surface`], [`closest_point_on_curve`] — one-off conveniences that
+//!   build the projector and answer one query.
+
+pub(crate) mod bezier;
+mod curve;
+pub(crate) mod decompose;
+mod newton;
+mod surface;
+
+pub use curve::{closest_point_on_curve, CurvePoint, CurveProjector};
+pub use surface::{SurfacePoint, SurfaceProjector};
+
+pub(crate) use decompose::{decompose_curve, decompose_surface};
+
+use nalgebra::Vector3;
+
+use crate::NurbsSurface;
+
+/// Global closest point of `surface` to `q` (builds a [`SurfaceProjector`]; for more than a
+/// few queries on one surface, build the projector once and reuse it).
+pub fn closest_point_on_surface(surface: &NurbsSurface, q: &Vector3<f64>) -> SurfacePoint {
+    SurfaceProjector::new(surface).closest_point(q)
+}

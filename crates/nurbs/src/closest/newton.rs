@@ -1,0 +1,163 @@
+//! Bound-constrained Newton iteration for the squared distance `f(u,v) = ½|S(u,v) − q|²`
+//! on a parameter box (projected Newton with an active set).
+//!
+//! Gradient `g = (r·S_u, r·S_v)` with `r = S − q`; Hessian
+//! `H = [[S_u·S_u + r·S_uu, S_u·S_v + r·S_uv], [·, S_v·S_v + r·S_vv]]`. A variable sitting on
+//! a bound with the gradient pushing outwards is fixed (the iteration then continues on that
+//! edge, a 1D Newton in the other variable; both fixed = a corner). When `H` is not positive
+//! definite the Gauss–Newton matrix `JᵀJ` is used instead; a backtracking step keeps `f`
+//! decreasing. Quadratic convergence near a non-degenerate minimum.
+
+use nalgebra::Vector3;
+
+use crate::SurfaceDerivs2;
+
+/// Largest number of Newton iterations (a well-started iteration needs 3–6).
+pub(crate) const MAX_ITER: usize = 40;
+
+/// Result of a bound-constrained Newton run.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Local {
+    pub u: f64,
+    pub v: f64,
+    pub point: Vector3<f64>,
+    /// Squared distance.
+    pub d2: f64,
+    /// Per variable: 0 = free (gradient ≈ 0), -1 = held at the lower bound, +1 = at the upper.
+    pub active: [i8; 2],
+    /// The iteration met its step tolerance (otherwise it stopped at MAX_ITER).
+    pub converged: bool,
+}
+
+/// Minimises `½|S − q|²` over `[lo.0, hi.0] × [lo.1, hi.1]` from `(u, v)`.
+/// `eval` gives the derivatives at a parameter pair; `step_tol` is the 3D step length (mm)
+/// below which the iteration stops.
+#[inline]
+pub(crate) fn minimise<F: Fn(f64, f64) -> SurfaceDerivs2>(
+    eval: F,
+    q: &Vector3<f64>,
+    lo: (f64, f64),
+    hi: (f64, f64),
+    start: (f64, f64),
+    step_tol: f64,
+) -> Local {
+    let (mut u, mut v) = (start.0.clamp(lo.0, hi.0), start.1.clamp(lo.1, hi.1));
+    let mut e = eval(u, v);
+    let mut r = e.p - q;
+    let mut f = r.norm_squared();
+    let mut active = [0i8; 2];
+    let mut converged = false;
+    for _ in 0..MAX_ITER {
+        let gu = r.dot(&e.su);
+        let gv = r.dot(&e.sv);
+        let fix_u = (u <= lo.0 && gu > 0.0) || (u >= hi.0 && gu < 0.0);
+        let fix_v = (v <= lo.1 && gv > 0.0) || (v >= hi.1 && gv < 0.0);
+        active = [
+            if fix_u {
+                if u <= lo.0 {
+                    -1
+                } else {
+                    1
+                }
+            } else {
+                0
+            },
+            if fix_v {
+                if v <= lo.1 {
+                    -1
+                } else {
+                    1
+                }
+            } else {
+                0
+            },
+        ];
+        let auu = e.su.norm_squared();
+        let avv = e.sv.norm_squared();
+        let auv = e.su.dot(&e.sv);
+        let huu = auu + r.dot(&e.suu);
+        let hvv = avv + r.dot(&e.svv);
+        let huv = auv + r.dot(&e.suv);
+        let (du, dv) = match (fix_u, fix_v) {
+            (true, true) => {
+                converged = true;
+                break;
+            }
+            (false, true) => {
+                let h = if huu > 0.0 { huu } else { auu };
+                (if h > 0.0 { -gu / h } else { 0.0 }, 0.0)
+            }
+            (true, false) => {
+                let h = if hvv > 0.0 { hvv } else { avv };
+                (0.0, if h > 0.0 { -gv / h } else { 0.0 })
+            }
+            (false, false) => {
+                let det = huu * hvv - huv * huv;
+                if huu > 0.0 && det > 1e-12 * huu * hvv.abs() {
+                    ((-gu * hvv + gv * huv) / det, (-gv * huu + gu * huv) / det)
+                } else {
+                    let det = auu * avv - auv * auv;
+                    if det > 1e-14 * auu * avv {
+                        ((-gu * avv + gv * auv) / det, (-gv * auu + gu * auv) / det)
+                    } else {
+                        let s = auu + avv;
+                        if s > 0.0 {
+                            (-gu / s, -gv / s)
+                        } else {
+                            (0.0, 0.0)
+                        }
+                    }
+                }
+            }
+        };
+        // Backtracking on the projected step.
+        let mut t = 1.0;
+        let mut accepted = false;
+        let (mut un, mut vn) = (u, v);
+        let mut en = e;
+        let mut fnew = f;
+        for _ in 0..12 {
+            un = (u + t * du).clamp(lo.0, hi.0);
+            vn = (v + t * dv).clamp(lo.1, hi.1);
+            en = eval(un, vn);
+            fnew = (en.p - q).norm_squared();
+            if fnew <= f * (1.0 + 4.0 * f64::EPSILON) + 1e-300 {
+                accepted = true;
+                break;
+            }
+            t *= 0.5;
+        }
+        let step = (e.su * (un - u) + e.sv * (vn - v)).norm();
+        if !accepted {
+            // No decrease even for tiny steps: at a minimum within round-off.
+            converged = true;
+            break;
+        }
+        u = un;
+        v = vn;
+        e = en;
+        r = e.p - q;
+        f = fnew;
+        if step <= step_tol {
+            converged = true;
+            break;
+        }
+    }
+    // Refresh the active set at the final point.
+    let gu = r.dot(&e.su);
+    let gv = r.dot(&e.sv);
+    if active[0] == 0 && ((u <= lo.0 && gu > 0.0) || (u >= hi.0 && gu < 0.0)) {
+        active[0] = if u <= lo.0 { -1 } else { 1 };
+    }
+    if active[1] == 0 && ((v <= lo.1 && gv > 0.0) || (v >= hi.1 && gv < 0.0)) {
+        active[1] = if v <= lo.1 { -1 } else { 1 };
+    }
+    Local {
+        u,
+        v,
+        point: e.p,
+        d2: f,
+        active,
+        converged,
+    }
+}

@@ -1,0 +1,690 @@
+//! Global closest point on a NURBS surface.
+//!
+//! [`SurfaceProjector`] precomputes a query structure from the surface's Bézier
+//! decomposition (one patch per knot-span rectangle, NURBS Book A5.7; large or strongly
+//! curved patches are subdivided by de Casteljau into *leaves*):
+//!
+//! * per leaf, an oriented bounding box of its control net (convex-hull property: the leaf
+//!   lies inside; weights are positive) and an axis-aligned box for the BVH above the leaves;
+//! * per leaf of a polynomial surface, the *tangent cones* of `S_u` and `S_v` (cones
+//!   containing the hodograph control vectors, hence every tangent of the leaf);
+//! * a bounding-volume hierarchy (median split of leaf centroids);
+//! * a 3×3 grid of sample points per leaf for starting points.
+//!
+//! A query keeps the best candidate `d*` and walks the BVH nearest-child first, skipping
+//! every node whose box is at least `d*` away (a lower bound of the distance to everything
+//! inside). A remaining leaf is skipped when
+//! 1. its oriented box is at least `d*` away, or
+//! 2. the *tangent-cone test* proves `(S − q)·S_u` (or `·S_v`) has one strict sign on the whole
+//!    leaf (the dot product of any vector of the box `OBB − q` with any vector of the cone is
+//!    bounded away from 0): then the distance is strictly monotone across the leaf, its
+//!    minimum lies on one edge, and if that edge is interior to the surface and the surface
+//!    is C¹ across it, the neighbour leaf sharing that edge accounts for it, or
+//! 3. the current best is a stationary point lying in the leaf (see below).
+//!
+//! Otherwise a bound-constrained Newton iteration (module `newton`) minimises the distance
+//! over the closed leaf from its nearest sample; when Newton reaches the leaf's edge it
+//! continues along the edge (1D) and stops at corners, so answers on the surface's boundary
+//! are exact KKT points with parameters inside the domain.
+//!
+//! **Global optimality.** The returned point is the minimum over all leaves that could hold
+//! a closer point, *provided the distance has a single local minimum on each leaf*. That is
+//! the case whenever the query lies closer to the leaf than its smallest radius of curvature
+//! (then the Hessian of the squared distance is positive definite on the leaf); leaves are
+//! split at build time until their normals turn by at most ~35° so that this holds for all
+//! but points near centres of curvature of strongly curved regions.
+//!
+//! **Warm start.** With a hint `(u, v)` (typically the previous answer along a path) Newton
+//! first runs on the whole domain from the hint; the resulting `d*` is usually already the
+//! answer and the BVH walk only has to certify it.
+//!
+//! Tolerances: Newton stops when its 3D step is below `1e-13 × (1 + surface size)` mm;
+//! interior answers then satisfy `(S − q)·S_u = (S − q)·S_v = 0` to ~1e-12 relative.
+//! Cost: cold ≈ 1 µs, warm ≈ 0.3 µs for a bicubic 12×12 surface (see `benches/nurbs.rs`).
+//! Queries take `&self` and do not allocate; the projector is `Send + Sync`.
+
+use nalgebra::Vector3;
+
+use super::bezier::BezierPatch;
+use super::newton::{minimise, Local};
+use crate::{NurbsSurface, SurfaceDerivs2};
+
+/// The closest point found on a surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    /// Parameter `u` of the closest point (inside the domain).
+    pub u: f64,
+    /// Parameter `v` of the closest point (inside the domain).
+    pub v: f64,
+    /// `S(u, v)`.
+    pub point: Vector3<f64>,
+    /// Distance from the query point to `point` (mm).
+    pub distance: f64,
+    /// The answer lies on the boundary of the parameter domain with the distance still
+    /// decreasing outwards (a constrained minimum, where `S − q` is not normal to the surface).
+    pub on_boundary: bool,
+}
+
+/// Axis-aligned box.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Aabb {
+    pub min: Vector3<f64>,
+    pub max: Vector3<f64>,
+}
+
+impl Aabb {
+    pub(crate) fn empty() -> Self {
+        Aabb {
+            min: Vector3::repeat(f64::INFINITY),
+            max: Vector3::repeat(f64::NEG_INFINITY),
+        }
+    }
+    pub(crate) fn add(&mut self, p: &Vector3<f64>) {
+        self.min = self.min.inf(p);
+        self.max = self.max.sup(p);
+    }
+    pub(crate) fn merge(&mut self, o: &Aabb) {
+        self.min = self.min.inf(&o.min);
+        self.max = self.max.sup(&o.max);
+    }
+    /// Squared distance from `q` to the box (0 inside).
+    #[inline]
+    pub(crate) fn dist2(&self, q: &Vector3<f64>) -> f64 {
+        let mut s = 0.0;
+        for k in 0..3 {
+            let d = (self.min[k] - q[k]).max(q[k] - self.max[k]).max(0.0);
+            s += d * d;
+        }
+        s
+    }
+}
+
+/// Oriented box: centre, orthonormal axes, half extents.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Obb {
+    pub c: Vector3<f64>,
+    pub axes: [Vector3<f64>; 3],
+    pub h: [f64; 3],
+}
+
+impl Obb {
+    fn from_points(points: &[Vector3<f64>], axes: [Vector3<f64>; 3]) -> Self {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in points {
+            for k in 0..3 {
+                let x = p.dot(&axes[k]);
+                lo[k] = lo[k].min(x);
+                hi[k] = hi[k].max(x);
+            }
+        }
+        let mut c = Vector3::zeros();
+        let mut h = [0.0; 3];
+        for k in 0..3 {
+            c += axes[k] * (0.5 * (lo[k] + hi[k]));
+            // Pad by a few ulps so round-off never puts the leaf outside its box.
+            h[k] = 0.5 * (hi[k] - lo[k]) * (1.0 + 1e-12) + 1e-12 * (lo[k].abs() + hi[k].abs());
+        }
+        Obb { c, axes, h }
+    }
+
+    /// Squared distance from `q` to the box.
+    #[inline]
+    pub(crate) fn dist2(&self, q: &Vector3<f64>) -> f64 {
+        let d = q - self.c;
+        let mut s = 0.0;
+        for k in 0..3 {
+            let x = d.dot(&self.axes[k]).abs() - self.h[k];
+            if x > 0.0 {
+                s += x * x;
+            }
+        }
+        s
+    }
+}
+
+/// Cone `{t : angle(t, axis) ≤ α}` containing every tangent `S_u` (or `S_v`) of a leaf.
+#[derive(Debug, Clone, Copy)]
+struct Cone {
+    axis: Vector3<f64>,
+    sin_half_angle: f64,
+    /// `Σ_k h_k |e_k · axis|` for the leaf's OBB: half the width of the box along the axis.
+    obb_half_width: f64,
+}
+
+impl Cone {
+    /// Cone of the non-zero vectors `dirs`, or `None` if they span a half-space or more.
+    fn of(dirs: &[Vector3<f64>], obb: &Obb) -> Option<Cone> {
+        let mut axis = Vector3::zeros();
+        for d in dirs {
+            let n = d.norm();
+            if n > 0.0 {
+                axis += d / n;
+            }
+        }
+        let len = axis.norm();
+        if len <= 0.0 {
+            return None;
+        }
+        axis /= len;
+        let mut sin_max: f64 = 0.0;
+        for d in dirs {
+            let n = d.norm();
+            if n == 0.0 {
+                continue;
+            }
+            let c = d.dot(&axis) / n;
+            if c <= 1e-3 {
+                return None;
+            }
+            sin_max = sin_max.max(d.cross(&axis).norm() / n);
+        }
+        // Cover round-off in the hodograph and in the sine.
+        let sin_half_angle = (sin_max * (1.0 + 1e-9) + 1e-12).min(1.0);
+        let obb_half_width = (0..3)
+            .map(|k| obb.h[k] * obb.axes[k].dot(&axis).abs())
+            .sum();
+        Some(Cone {
+            axis,
+            sin_half_angle,
+            obb_half_width,
+        })
+    }
+
+    /// Sign of `(S − q)·t` over all `S` in the box and `t` in the cone: +1 if certainly
+    /// positive, -1 if certainly negative, 0 if undecided.
+    #[inline]
+    fn sign(&self, obb: &Obb, cq: &Vector3<f64>, max_w: f64) -> i8 {
+        let mid = cq.dot(&self.axis);
+        let margin = max_w * self.sin_half_angle;
+        if mid - self.obb_half_width > margin {
+            1
+        } else if mid + self.obb_half_width < -margin {
+            -1
+        } else {
+            let _ = obb;
+            0
+        }
+    }
+}
+
+/// A piece of a Bézier patch with its bounds and starting samples.
+#[derive(Debug, Clone)]
+pub(crate) struct Leaf {
+    pub u0: f64,
+    pub u1: f64,
+    pub v0: f64,
+    pub v1: f64,
+    pub patch: usize,
+    pub obb: Obb,
+    pub aabb: Aabb,
+    cone_u: Option<Cone>,
+    cone_v: Option<Cone>,
+    obb_half_diag: f64,
+    /// May the leaf be dropped because the distance decreases towards edge
+    /// `[u0, u1, v0, v1]` (edge interior to the surface and C¹ across it)?
+    exclude_towards: [bool; 4],
+    samples: [(f64, f64, Vector3<f64>); 9],
+}
+
+/// BVH node: box plus either two children or a leaf index.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Node {
+    pub aabb: Aabb,
+    /// Children (`left`, `right`) for inner nodes; `right == u32::MAX` marks a leaf whose
+    /// index is `left`.
+    pub left: u32,
+    pub right: u32,
+}
+
+/// Precomputed closest-point query structure for one surface. See the module docs.
+#[derive(Debug, Clone)]
+pub struct SurfaceProjector {
+    pub(crate) patches: Vec<BezierPatch>,
+    /// Patch boundaries: patch `(a, b)` covers `[u_breaks[a], u_breaks[a+1]] × [v_breaks[b], v_breaks[b+1]]`.
+    pub(crate) u_breaks: Vec<f64>,
+    pub(crate) v_breaks: Vec<f64>,
+    pub(crate) leaves: Vec<Leaf>,
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) domain: ((f64, f64), (f64, f64)),
+    step_tol: f64,
+}
+
+/// Largest number of Newton-solved leaves per query before the walk trusts the best found
+/// (never reached on sane geometry; protects against pathological input).
+const MAX_LEAF_SOLVES: usize = 4096;
+
+/// Leaves whose normals turn by more than this (cosine) are split.
+const LEAF_NORMAL_COS: f64 = 0.82;
+
+/// Deepest leaf split per patch direction (2^3 = 8 pieces).
+const MAX_LEAF_DEPTH: usize = 3;
+
+impl SurfaceProjector {
+    /// Builds the query structure: Bézier decomposition, leaf subdivision, bounds, cones,
+    /// samples and BVH. O(number of spans × (p+1)²(q+1)²).
+    pub fn new(surface: &NurbsSurface) -> Self {
+        let (patches, u_breaks, v_breaks) = super::decompose_surface(surface);
+        let domain = surface.domain();
+        let c1_u: Vec<bool> = u_breaks
+            .iter()
+            .map(|&u| surface.knots_u().multiplicity(u) < surface.degree_u())
+            .collect();
+        let c1_v: Vec<bool> = v_breaks
+            .iter()
+            .map(|&v| surface.knots_v().multiplicity(v) < surface.degree_v())
+            .collect();
+        let nv = v_breaks.len() - 1;
+        let mut leaves = Vec::new();
+        let mut size = Aabb::empty();
+        for (k, patch) in patches.iter().enumerate() {
+            let (a, b) = (k / nv, k % nv);
+            for p in patch.points() {
+                size.add(&p);
+            }
+            let (su, sv) = leaf_split(patch);
+            for i in 0..su {
+                for j in 0..sv {
+                    let lu0 = lerp(patch.u0, patch.u1, i, su);
+                    let lu1 = lerp(patch.u0, patch.u1, i + 1, su);
+                    let lv0 = lerp(patch.v0, patch.v1, j, sv);
+                    let lv1 = lerp(patch.v0, patch.v1, j + 1, sv);
+                    let sub = if su == 1 && sv == 1 {
+                        patch.clone()
+                    } else {
+                        patch.sub_patch(lu0, lu1, lv0, lv1)
+                    };
+                    let rational = surface.is_rational();
+                    let excl = [
+                        i > 0 || (a > 0 && c1_u[a]),
+                        i + 1 < su || (a + 1 < u_breaks.len() - 1 && c1_u[a + 1]),
+                        j > 0 || (b > 0 && c1_v[b]),
+                        j + 1 < sv || (b + 1 < nv && c1_v[b + 1]),
+                    ];
+                    leaves.push(make_leaf(patch, &sub, k, excl, rational));
+                }
+            }
+        }
+        let diag = (size.max - size.min).norm();
+        let step_tol = 1e-13 * (1.0 + if diag.is_finite() { diag } else { 0.0 });
+        let nodes = build_bvh(&leaves);
+        SurfaceProjector {
+            patches,
+            u_breaks,
+            v_breaks,
+            leaves,
+            nodes,
+            domain,
+            step_tol,
+        }
+    }
+
+    /// The parameter domain of the surface.
+    pub fn domain(&self) -> ((f64, f64), (f64, f64)) {
+        self.domain
+    }
+
+    /// Number of leaves (Bézier pieces after subdivision) in the query structure.
+    pub fn leaf_count(&self) -> usize {
+        self.leaves.len()
+    }
+
+    /// Index of the patch containing `(u, v)` (right-sided at interior breaks).
+    #[inline]
+    pub(crate) fn patch_index(&self, u: f64, v: f64) -> usize {
+        let nu = self.u_breaks.len() - 1;
+        let nv = self.v_breaks.len() - 1;
+        let a = self.u_breaks[1..nu].partition_point(|&b| b <= u);
+        let b = self.v_breaks[1..nv].partition_point(|&b| b <= v);
+        a * nv + b
+    }
+
+    /// Point and derivatives up to order two at `(u, v)` from the Bézier patches.
+    #[inline]
+    pub fn derivs2(&self, u: f64, v: f64) -> SurfaceDerivs2 {
+        self.patches[self.patch_index(u, v)].derivs2(u, v)
+    }
+
+    /// Point `S(u, v)` from the Bézier patches.
+    #[inline]
+    pub fn point(&self, u: f64, v: f64) -> Vector3<f64> {
+        self.patches[self.patch_index(u, v)].point(u, v)
+    }
+
+    /// The global closest point of the surface to `q` (cold query).
+    pub fn closest_point(&self, q: &Vector3<f64>) -> SurfacePoint {
+        self.closest_point_with_hint(q, None)
+    }
+
+    /// The global closest point of the surface to `q`, starting from `hint = (u, v)` when
+    /// given (typically the previous answer of a path of queries). The hint only speeds the
+    /// search up; the answer is the same global minimum as without it.
+    pub fn closest_point_with_hint(
+        &self,
+        q: &Vector3<f64>,
+        hint: Option<(f64, f64)>,
+    ) -> SurfacePoint {
+        let ((ua, ub), (va, vb)) = self.domain;
+        let mut best: Option<(Local, bool)> = None;
+        if let Some((hu, hv)) = hint {
+            if hu.is_finite() && hv.is_finite() {
+                let l = minimise(
+                    |u, v| self.derivs2(u, v),
+                    q,
+                    (ua, va),
+                    (ub, vb),
+                    (hu, hv),
+                    self.step_tol,
+                );
+                best = Some((l, l.converged));
+            }
+        }
+        let mut stack = [0u32; 64];
+        let mut sp = 1usize;
+        stack[0] = 0;
+        let mut solves = 0usize;
+        while sp > 0 {
+            sp -= 1;
+            let node = self.nodes[stack[sp] as usize];
+            let bound = best.map_or(f64::INFINITY, |b| b.0.d2);
+            if node.aabb.dist2(q) >= bound {
+                continue;
+            }
+            if node.right == u32::MAX {
+                if solves >= MAX_LEAF_SOLVES {
+                    continue;
+                }
+                if let Some(l) = self.solve_leaf(node.left as usize, q, best, bound) {
+                    solves += 1;
+                    if l.0.d2 < bound {
+                        best = Some(l);
+                    }
+                }
+                continue;
+            }
+            let (l, r) = (node.left as usize, node.right as usize);
+            let dl = self.nodes[l].aabb.dist2(q);
+            let dr = self.nodes[r].aabb.dist2(q);
+            let (near, far, dfar) = if dl <= dr { (l, r, dr) } else { (r, l, dl) };
+            if dfar < bound && sp < stack.len() {
+                stack[sp] = far as u32;
+                sp += 1;
+            }
+            if sp < stack.len() {
+                stack[sp] = near as u32;
+                sp += 1;
+            }
+        }
+        let l = match best {
+            Some(b) => b.0,
+            // Unreachable for a non-empty structure; answer the domain corner.
+            None => minimise(
+                |u, v| self.derivs2(u, v),
+                q,
+                (ua, va),
+                (ub, vb),
+                (ua, va),
+                self.step_tol,
+            ),
+        };
+        let on_boundary = (l.active[0] != 0) || (l.active[1] != 0);
+        SurfacePoint {
+            u: l.u,
+            v: l.v,
+            point: l.point,
+            distance: l.d2.sqrt(),
+            on_boundary,
+        }
+    }
+
+    /// Minimises over one leaf unless it is certified not to hold a point closer than
+    /// `bound` (squared). Returns the leaf minimum and whether it is a KKT point of the
+    /// whole domain.
+    #[inline]
+    fn solve_leaf(
+        &self,
+        index: usize,
+        q: &Vector3<f64>,
+        best: Option<(Local, bool)>,
+        bound: f64,
+    ) -> Option<(Local, bool)> {
+        let leaf = &self.leaves[index];
+        if leaf.obb.dist2(q) >= bound {
+            return None;
+        }
+        if let Some((b, true)) = best {
+            if b.u >= leaf.u0 && b.u <= leaf.u1 && b.v >= leaf.v0 && b.v <= leaf.v1 {
+                return None;
+            }
+        }
+        let cq = leaf.obb.c - q;
+        let max_w = cq.norm() + leaf.obb_half_diag;
+        if let Some(c) = &leaf.cone_u {
+            match c.sign(&leaf.obb, &cq, max_w) {
+                1 if leaf.exclude_towards[0] => return None,
+                -1 if leaf.exclude_towards[1] => return None,
+                _ => {}
+            }
+        }
+        if let Some(c) = &leaf.cone_v {
+            match c.sign(&leaf.obb, &cq, max_w) {
+                1 if leaf.exclude_towards[2] => return None,
+                -1 if leaf.exclude_towards[3] => return None,
+                _ => {}
+            }
+        }
+        let mut start = (leaf.samples[0].0, leaf.samples[0].1);
+        let mut d_start = f64::INFINITY;
+        for (u, v, p) in &leaf.samples {
+            let d = (p - q).norm_squared();
+            if d < d_start {
+                d_start = d;
+                start = (*u, *v);
+            }
+        }
+        let patch = &self.patches[leaf.patch];
+        let l = minimise(
+            |u, v| patch.derivs2(u, v),
+            q,
+            (leaf.u0, leaf.v0),
+            (leaf.u1, leaf.v1),
+            start,
+            self.step_tol,
+        );
+        let ((ua, ub), (va, vb)) = self.domain;
+        let kkt_u = match l.active[0] {
+            0 => true,
+            -1 => l.u <= ua,
+            _ => l.u >= ub,
+        };
+        let kkt_v = match l.active[1] {
+            0 => true,
+            -1 => l.v <= va,
+            _ => l.v >= vb,
+        };
+        Some((l, l.converged && kkt_u && kkt_v))
+    }
+}
+
+fn lerp(a: f64, b: f64, i: usize, n: usize) -> f64 {
+    if i == n {
+        b
+    } else {
+        a + (b - a) * i as f64 / n as f64
+    }
+}
+
+/// How many pieces a patch is split into in u and v so that each piece's normals turn by at
+/// most ~35° (estimated on a 5×5 grid of normals per piece).
+fn leaf_split(patch: &BezierPatch) -> (usize, usize) {
+    let mut su = 1;
+    let mut sv = 1;
+    for _ in 0..MAX_LEAF_DEPTH {
+        let mut worst_u: f64 = 1.0;
+        let mut worst_v: f64 = 1.0;
+        for i in 0..su {
+            for j in 0..sv {
+                let u0 = lerp(patch.u0, patch.u1, i, su);
+                let u1 = lerp(patch.u0, patch.u1, i + 1, su);
+                let v0 = lerp(patch.v0, patch.v1, j, sv);
+                let v1 = lerp(patch.v0, patch.v1, j + 1, sv);
+                let uc = 0.5 * (u0 + u1);
+                let vc = 0.5 * (v0 + v1);
+                let Some(nc) = patch.derivs2(uc, vc).normal() else {
+                    continue;
+                };
+                for k in 0..=4 {
+                    let t = k as f64 / 4.0;
+                    if let Some(n) = patch.derivs2(u0 + (u1 - u0) * t, vc).normal() {
+                        worst_u = worst_u.min(n.dot(&nc));
+                    }
+                    if let Some(n) = patch.derivs2(uc, v0 + (v1 - v0) * t).normal() {
+                        worst_v = worst_v.min(n.dot(&nc));
+                    }
+                }
+            }
+        }
+        let split_u = worst_u < LEAF_NORMAL_COS;
+        let split_v = worst_v < LEAF_NORMAL_COS;
+        if !split_u && !split_v {
+            break;
+        }
+        if split_u {
+            su *= 2;
+        }
+        if split_v {
+            sv *= 2;
+        }
+    }
+    (su, sv)
+}
+
+fn make_leaf(
+    patch: &BezierPatch,
+    sub: &BezierPatch,
+    index: usize,
+    exclude_towards: [bool; 4],
+    rational: bool,
+) -> Leaf {
+    let pts: Vec<Vector3<f64>> = sub.points().collect();
+    let mut aabb = Aabb::empty();
+    for p in &pts {
+        aabb.add(p);
+    }
+    let uc = 0.5 * (sub.u0 + sub.u1);
+    let vc = 0.5 * (sub.v0 + sub.v1);
+    let d = patch.derivs2(uc, vc);
+    let axes = match (d.su.try_normalize(0.0), d.normal()) {
+        (Some(e1), Some(n)) => {
+            let e2 = n.cross(&e1);
+            [e1, e2, n]
+        }
+        _ => [Vector3::x(), Vector3::y(), Vector3::z()],
+    };
+    let obb = Obb::from_points(&pts, axes);
+    let obb_half_diag = Vector3::new(obb.h[0], obb.h[1], obb.h[2]).norm();
+    let (cone_u, cone_v) = if rational {
+        (None, None)
+    } else {
+        let q1 = sub.q + 1;
+        let mut du = Vec::new();
+        let mut dv = Vec::new();
+        for i in 0..=sub.p {
+            for j in 0..=sub.q {
+                if i < sub.p {
+                    du.push(pts[(i + 1) * q1 + j] - pts[i * q1 + j]);
+                }
+                if j < sub.q {
+                    dv.push(pts[i * q1 + j + 1] - pts[i * q1 + j]);
+                }
+            }
+        }
+        (Cone::of(&du, &obb), Cone::of(&dv, &obb))
+    };
+    let mut samples = [(0.0, 0.0, Vector3::zeros()); 9];
+    for a in 0..3 {
+        for b in 0..3 {
+            let u = lerp(sub.u0, sub.u1, a, 2);
+            let v = lerp(sub.v0, sub.v1, b, 2);
+            samples[a * 3 + b] = (u, v, patch.point(u, v));
+        }
+    }
+    Leaf {
+        u0: sub.u0,
+        u1: sub.u1,
+        v0: sub.v0,
+        v1: sub.v1,
+        patch: index,
+        obb,
+        aabb,
+        cone_u,
+        cone_v,
+        obb_half_diag,
+        exclude_towards,
+        samples,
+    }
+}
+
+/// Median-split BVH over leaf centroids (longest axis). Node 0 is the root.
+fn build_bvh(leaves: &[Leaf]) -> Vec<Node> {
+    let mut nodes = Vec::with_capacity(2 * leaves.len());
+    let mut idx: Vec<usize> = (0..leaves.len()).collect();
+    nodes.push(Node {
+        aabb: Aabb::empty(),
+        left: 0,
+        right: u32::MAX,
+    });
+    build_rec(leaves, &mut idx, 0, &mut nodes);
+    nodes
+}
+
+fn build_rec(leaves: &[Leaf], idx: &mut [usize], at: usize, nodes: &mut Vec<Node>) {
+    let mut aabb = Aabb::empty();
+    for &i in idx.iter() {
+        aabb.merge(&leaves[i].aabb);
+    }
+    if idx.len() == 1 {
+        nodes[at] = Node {
+            aabb,
+            left: idx[0] as u32,
+            right: u32::MAX,
+        };
+        return;
+    }
+    let mut cmin = Vector3::repeat(f64::INFINITY);
+    let mut cmax = Vector3::repeat(f64::NEG_INFINITY);
+    for &i in idx.iter() {
+        let c = leaves[i].obb.c;
+        cmin = cmin.inf(&c);
+        cmax = cmax.sup(&c);
+    }
+    let ext = cmax - cmin;
+    let axis = if ext.x >= ext.y && ext.x >= ext.z {
+        0
+    } else if ext.y >= ext.z {
+        1
+    } else {
+        2
+    };
+    idx.sort_by(|&a, &b| leaves[a].obb.c[axis].total_cmp(&leaves[b].obb.c[axis]));
+    let mid = idx.len() / 2;
+    let l = nodes.len();
+    nodes.push(Node {
+        aabb: Aabb::empty(),
+        left: 0,
+        right: u32::MAX,
+    });
+    nodes.push(Node {
+        aabb: Aabb::empty(),
+        left: 0,
+        right: u32::MAX,
+    });
+    nodes[at] = Node {
+        aabb,
+        left: l as u32,
+        right: (l + 1) as u32,
+    };
+    let (a, b) = idx.split_at_mut(mid);
+    build_rec(leaves, a, l, nodes);
+    build_rec(leaves, b, l + 1, nodes);
+}

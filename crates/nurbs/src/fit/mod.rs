@@ -1,0 +1,29 @@
+//! Fitting curves and surfaces to data (The NURBS Book, chapter 9).
+//!
+//! * [`interpolate_curve`] — global interpolation through points, optionally with end
+//!   derivatives (A9.1, §9.2.1–9.2.2).
+//! * [`approximate_curve`], [`approximate_curve_to_tolerance`] — least-squares approximation
+//!   with fixed end points (§9.4.1).
+//! * [`smooth_curve`] — least squares with an added derivative energy (penalised splines).
+//! * [`interpolate_surface`] — global surface interpolation through a grid (A9.4).
+//! * [`skin`] — lofting a surface through section curves (§10.3).
+//!
+//! Dense linear algebra is done with `faer` (column-pivoted QR, rank-revealing, so a singular
+//! system is reported as [`FitError::SingularSystem`] instead of producing garbage).
+
+mod curve_approx;
+mod curve_interp;
+mod error;
+mod params;
+
+mod solve;
+mod surface_interp;
+
+pub use curve_approx::{
+    approximate_curve, approximate_curve_to_tolerance, smooth_curve, CurveFit, Energy,
+};
+pub use curve_interp::interpolate_curve;
+pub use error::FitError;
+pub use params::{averaged_knots, parameters, Parametrisation};
+
+pub use surface_interp::interpolate_surface;
