@@ -6,6 +6,7 @@
 //! is an [`ImportError`] naming the file, the line and what was expected there.
 
 pub mod error;
+pub mod fit;
 pub mod geomturbo;
 pub mod prepare;
 pub mod raw;
@@ -14,6 +15,7 @@ mod text;
 pub mod turbogrid;
 
 pub use error::ImportError;
+pub use fit::{fit, FittedBlade, FittedImpeller, DEFAULT_FIT_TOL_MM};
 pub use geomturbo::{parse_geomturbo, read_geomturbo};
 pub use prepare::{prepare, PreparedBlade, PreparedImpeller, SectionSides};
 pub use raw::{
