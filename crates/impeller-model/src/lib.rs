@@ -1,3 +1,93 @@
-//! Centrifugal impeller geometry as exact NURBS: hub, shroud, main and splitter blades, channels; builders, importers, ruled approximations.
+//! Centrifugal impeller geometry as exact NURBS: hub, shroud, main and splitter blades,
+//! channels; parametric builder, ruled and sub-ruled approximations of blades.
+//!
+//! Frame and units: millimetres and radians; the impeller axis is +Z pointing from the hub's
+//! back face toward the inlet, origin on the axis at the back face. Hub and shroud are exact
+//! NURBS surfaces of revolution of their meridional (z, r) contours; every blade side is a
+//! NURBS surface parametrised u along the flow (leading → trailing edge) and v from hub to
+//! shroud, extended a little beyond both.
+//!
+//! Entry points: [`load`] (any supported file), [`from_toml_str`] (parametric TOML),
+//! [`Impeller::from_parts`] and [`Blade::from_sides`] (for importers),
+//! [`fixtures::default_impeller`].
+//!
+//! Dependencies: `nurbs` (the project's kernel), `nalgebra` (small vectors, dense LU for
+//! interpolation), `serde` + `toml` (the parametric file), `thiserror`, `rayon` (blades are
+//! independent).
 
+pub mod blade;
+pub mod builder;
+pub mod channel;
+pub mod error;
+pub mod fit;
+pub mod fixtures;
+pub mod impeller;
 pub mod import;
+pub mod law;
+pub mod meridional;
+pub mod params;
+pub mod query;
+pub mod revolved;
+pub mod stock;
+pub mod summary;
+pub mod thickness;
+
+pub use blade::{Blade, BladeDesign, BladeKind, BladeSet, Side};
+pub use error::ModelError;
+pub use impeller::Impeller;
+pub use meridional::MeridionalCurve;
+pub use params::ImpellerSpec;
+pub use revolved::RevolvedSurface;
+pub use stock::Stock;
+pub use thickness::{EdgeShape, ThicknessLaw};
+
+use std::path::Path;
+
+/// Loads an impeller from a file, choosing the reader by extension (`.toml`: parametric).
+pub fn load(path: impl AsRef<Path>) -> Result<Impeller, ModelError> {
+    let path = path.as_ref();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("toml") => {
+            let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            from_toml_str(&text, path)
+        }
+        _ => Err(ModelError::UnsupportedFormat {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+/// 1-based line of byte offset `at` in `text`.
+fn line_of(text: &str, at: usize) -> usize {
+    text.as_bytes()[..at.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// Parses, validates and builds a parametric impeller from TOML text; `path` names the source
+/// in errors (file and line of the offending field).
+pub fn from_toml_str(text: &str, path: impl AsRef<Path>) -> Result<Impeller, ModelError> {
+    let path = path.as_ref();
+    let spec = ImpellerSpec::from_toml_str(text).map_err(|e| ModelError::Parse {
+        path: path.to_path_buf(),
+        line: e.span().map_or(0, |s| line_of(text, s.start)),
+        message: e.message().trim().to_string(),
+    })?;
+    builder::build(&spec).map_err(|e| match e {
+        ModelError::Invalid { ref field, .. } => ModelError::InFile {
+            path: path.to_path_buf(),
+            line: params::field_line(text, field),
+            source: Box::new(e),
+        },
+        other => other,
+    })
+}

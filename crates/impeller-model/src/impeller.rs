@@ -1,0 +1,120 @@
+//! The impeller: hub, shroud, main blade row, optional splitter row, fillet radius and blank.
+
+use crate::blade::{Blade, BladeSet};
+use crate::error::ModelError;
+use crate::revolved::RevolvedSurface;
+use crate::stock::Stock;
+
+/// A centrifugal impeller in the workpiece frame (axis +Z from the hub back face toward the
+/// inlet, origin on the axis at the back face; mm).
+#[derive(Debug, Clone)]
+pub struct Impeller {
+    name: String,
+    hub: RevolvedSurface,
+    shroud: RevolvedSurface,
+    main: BladeSet,
+    splitter: Option<BladeSet>,
+    fillet_radius_mm: f64,
+    stock: Stock,
+}
+
+impl Impeller {
+    /// Assembles and checks an impeller (the constructor for importers).
+    ///
+    /// Checks: non-empty name; fillet radius finite and ≥ 0; the shroud contour lies on the
+    /// channel side of the hub contour (sampled at 33 meridional fractions, gap > 0); a splitter
+    /// row has as many blades as the main row.
+    pub fn from_parts(
+        name: impl Into<String>,
+        hub: RevolvedSurface,
+        shroud: RevolvedSurface,
+        main: BladeSet,
+        splitter: Option<BladeSet>,
+        fillet_radius_mm: f64,
+        stock: Stock,
+    ) -> Result<Self, ModelError> {
+        let name = name.into();
+        if name.trim().is_empty() {
+            return Err(ModelError::invalid("name", "must not be empty"));
+        }
+        if !(fillet_radius_mm.is_finite() && fillet_radius_mm >= 0.0) {
+            return Err(ModelError::invalid("fillet_radius_mm", "must be >= 0"));
+        }
+        for k in 0..=32 {
+            let m = k as f64 / 32.0;
+            let s = shroud.meridional().point_at_fraction(m);
+            let (_, d) = hub.meridional().closest(s);
+            if d.is_nan() || d <= 0.0 {
+                return Err(ModelError::Geometry(format!(
+                    "shroud contour is not above the hub contour at meridional fraction {m:.3}"
+                )));
+            }
+        }
+        if let Some(s) = &splitter {
+            if s.count() != main.count() {
+                return Err(ModelError::Geometry(format!(
+                    "splitter count {} differs from main blade count {}",
+                    s.count(),
+                    main.count()
+                )));
+            }
+        }
+        Ok(Self {
+            name,
+            hub,
+            shroud,
+            main,
+            splitter,
+            fillet_radius_mm,
+            stock,
+        })
+    }
+
+    /// Name used in reports.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The hub (channel floor).
+    pub fn hub(&self) -> &RevolvedSurface {
+        &self.hub
+    }
+
+    /// The shroud contour surface (blade tips; channel lid).
+    pub fn shroud(&self) -> &RevolvedSurface {
+        &self.shroud
+    }
+
+    /// The main blade row.
+    pub fn main(&self) -> &BladeSet {
+        &self.main
+    }
+
+    /// The splitter row, if any.
+    pub fn splitter(&self) -> Option<&BladeSet> {
+        self.splitter.as_ref()
+    }
+
+    /// Blade-root fillet radius (mm).
+    pub fn fillet_radius_mm(&self) -> f64 {
+        self.fillet_radius_mm
+    }
+
+    /// The blank.
+    pub fn stock(&self) -> &Stock {
+        &self.stock
+    }
+
+    /// Every blade in +θ order: main 0, splitter 0, main 1, splitter 1, ... (main only when
+    /// there are no splitters), each as its own rotated surfaces.
+    pub fn blades_in_order(&self) -> Vec<Blade> {
+        let mut out = Vec::new();
+        for k in 0..self.main.count() {
+            out.push(self.main.instance(k));
+            if let Some(s) = &self.splitter {
+                out.push(s.instance(k));
+            }
+        }
+        out
+    }
+}

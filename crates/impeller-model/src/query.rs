@@ -1,0 +1,197 @@
+//! Point queries on blade sides, hub and shroud: closest point and signed distance.
+//!
+//! Closest point on a NURBS surface (NURBS Book §6.1, point inversion): minimise |S(u,v) − p|²
+//! by Newton's method on the stationarity conditions f = (S − p)·S_u = 0, g = (S − p)·S_v = 0
+//! with Jacobian [[|S_u|² + r·S_uu, S_u·S_v + r·S_uv], [·, |S_v|² + r·S_vv]], r = S − p,
+//! parameters clamped to the domain (a boundary minimum is then found with the clamped
+//! coordinate fixed). Without a hint the start is the best of a 24 × 24 parameter grid; with a
+//! hint (e.g. the same (u, v) on the opposite side) Newton starts there. Converges
+//! quadratically near a regular minimum; stops at |Δ(u,v)| < 1e-13 of the domain or 40 steps.
+//! The signed distance takes the sign of (p − S)·n_out with the outward normal of the side.
+
+use crate::blade::{Blade, Side};
+use crate::impeller::Impeller;
+use nalgebra::{Matrix2, Vector2, Vector3};
+use nurbs::NurbsSurface;
+
+/// A point found on a surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    /// Parameter u.
+    pub u: f64,
+    /// Parameter v.
+    pub v: f64,
+    /// The surface point.
+    pub point: Vector3<f64>,
+    /// Distance from the query point (mm, ≥ 0).
+    pub distance: f64,
+}
+
+const SEED_GRID: usize = 24;
+
+/// Closest point of `s` to `p` (see module docs), optionally starting from `hint` = (u, v).
+pub fn closest_point(s: &NurbsSurface, p: &Vector3<f64>, hint: Option<(f64, f64)>) -> SurfacePoint {
+    let ((u0, u1), (v0, v1)) = s.domain();
+    let (mut u, mut v) = match hint {
+        Some((u, v)) => (u.clamp(u0, u1), v.clamp(v0, v1)),
+        None => {
+            let mut best = (u0, v0, f64::INFINITY);
+            for i in 0..=SEED_GRID {
+                let uu = u0 + (u1 - u0) * i as f64 / SEED_GRID as f64;
+                for j in 0..=SEED_GRID {
+                    let vv = v0 + (v1 - v0) * j as f64 / SEED_GRID as f64;
+                    let d = (s.point(uu, vv) - p).norm_squared();
+                    if d < best.2 {
+                        best = (uu, vv, d);
+                    }
+                }
+            }
+            (best.0, best.1)
+        }
+    };
+    let tol = 1e-13 * ((u1 - u0) + (v1 - v0));
+    for _ in 0..40 {
+        let d = s.derivs2(u, v);
+        let r = d.p - p;
+        let f = Vector2::new(r.dot(&d.su), r.dot(&d.sv));
+        let j = Matrix2::new(
+            d.su.norm_squared() + r.dot(&d.suu),
+            d.su.dot(&d.sv) + r.dot(&d.suv),
+            d.su.dot(&d.sv) + r.dot(&d.suv),
+            d.sv.norm_squared() + r.dot(&d.svv),
+        );
+        // Newton step, or a gradient step when the Hessian is not positive definite.
+        let step = match j.try_inverse() {
+            Some(inv) if j.determinant() > 0.0 && j[(0, 0)] > 0.0 => -(inv * f),
+            _ => {
+                let g = Vector2::new(
+                    f[0] / d.su.norm_squared().max(1e-300),
+                    f[1] / d.sv.norm_squared().max(1e-300),
+                );
+                -g * 0.5
+            }
+        };
+        let un = (u + step[0]).clamp(u0, u1);
+        let vn = (v + step[1]).clamp(v0, v1);
+        let moved = (un - u).abs() + (vn - v).abs();
+        // Never accept a step that increases the distance: halve it instead.
+        let mut cand = (un, vn);
+        let d0 = r.norm_squared();
+        for _ in 0..20 {
+            if (s.point(cand.0, cand.1) - p).norm_squared() <= d0 {
+                break;
+            }
+            cand = (0.5 * (cand.0 + u), 0.5 * (cand.1 + v));
+        }
+        u = cand.0;
+        v = cand.1;
+        if moved < tol {
+            break;
+        }
+    }
+    let q = s.point(u, v);
+    SurfacePoint {
+        u,
+        v,
+        point: q,
+        distance: (q - p).norm(),
+    }
+}
+
+/// Closest point on one side of a blade and the signed distance (positive outside the blade
+/// material, along the side's outward normal).
+pub fn blade_side_distance(
+    blade: &Blade,
+    side: Side,
+    p: &Vector3<f64>,
+    hint: Option<(f64, f64)>,
+) -> (SurfacePoint, f64) {
+    let sp = closest_point(blade.side(side), p, hint);
+    let sign = match blade.outward_normal(side, sp.u, sp.v) {
+        Some(n) if (p - sp.point).dot(&n) < 0.0 => -1.0,
+        _ => 1.0,
+    };
+    (sp, sign * sp.distance)
+}
+
+/// Which surface of the impeller a query refers to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    /// The hub (signed distance positive in the channel).
+    Hub,
+    /// The shroud contour surface (signed distance positive outside, beyond the blade tips).
+    Shroud,
+    /// Side of main blade k.
+    Main(usize, Side),
+    /// Side of splitter k.
+    Splitter(usize, Side),
+}
+
+impl Impeller {
+    /// Signed distance of `p` to a part (see [`Part`] for the sign), with the closest point.
+    /// Blade queries rotate `p` into the reference blade's frame (no surface copies).
+    pub fn signed_distance(&self, part: Part, p: &Vector3<f64>) -> Option<(Vector3<f64>, f64)> {
+        match part {
+            Part::Hub | Part::Shroud => {
+                let s = if part == Part::Hub {
+                    self.hub()
+                } else {
+                    self.shroud()
+                };
+                let (t, phi, d) = s.closest(p);
+                Some((s.point(t, phi), d))
+            }
+            Part::Main(k, side) | Part::Splitter(k, side) => {
+                let set = if matches!(part, Part::Main(..)) {
+                    self.main()
+                } else {
+                    self.splitter()?
+                };
+                if k >= set.count() {
+                    return None;
+                }
+                let rot = set.rotation(k);
+                let local = rot.inverse() * p;
+                let (sp, d) = blade_side_distance(set.blade(), side, &local, None);
+                Some((rot * sp.point, d))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nurbs::NurbsSurface;
+
+    fn saddle() -> NurbsSurface {
+        // Bilinear-like bicubic patch z = x*y on [0,1]^2 (exact as a polynomial surface).
+        let n = 4;
+        let ctrl: Vec<Vec<Vector3<f64>>> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| {
+                        let x = i as f64 / 3.0;
+                        let y = j as f64 / 3.0;
+                        Vector3::new(x, y, x * y)
+                    })
+                    .collect()
+            })
+            .collect();
+        let k = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        NurbsSurface::new(3, 3, k.clone(), k, ctrl, None).unwrap()
+    }
+
+    #[test]
+    fn closest_point_is_orthogonal_projection() {
+        let s = saddle();
+        for (u, v, h) in [(0.3, 0.6, 0.2), (0.8, 0.1, -0.3), (0.5, 0.5, 0.05)] {
+            let d = s.derivs2(u, v);
+            let n = d.normal().unwrap();
+            let p = d.p + n * h;
+            let sp = closest_point(&s, &p, None);
+            assert!((sp.distance - h.abs()).abs() < 1e-10, "{sp:?}");
+            assert!((sp.u - u).abs() < 1e-8 && (sp.v - v).abs() < 1e-8);
+        }
+    }
+}
