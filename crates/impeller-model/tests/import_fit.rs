@@ -11,7 +11,7 @@ use impeller_model::import::{
 };
 
 fn fitted(p: &PreparedImpeller) -> FittedImpeller {
-    let f = fit(p, DEFAULT_FIT_TOL_MM).unwrap();
+    let f = fit(p, DEFAULT_FIT_TOL_MM, 0.0).unwrap();
     eprintln!(
         "{}: hub {:.2e} shroud {:.2e} mm ({} / {} ctrl)",
         p.source.display(),
@@ -38,7 +38,7 @@ fn fitted(p: &PreparedImpeller) -> FittedImpeller {
 #[test]
 fn rotor37_fits_within_tolerance() {
     let raw = read_turbogrid(&import_common::rotor37_inf()).unwrap();
-    let p = prepare(&raw).unwrap();
+    let p = prepare(&raw, None).unwrap();
     let f = fitted(&p);
     assert!(f.max_fit_mm() <= DEFAULT_FIT_TOL_MM, "{}", f.max_fit_mm());
 }
@@ -46,7 +46,7 @@ fn rotor37_fits_within_tolerance() {
 #[test]
 fn centrifugal_fits_within_tolerance() {
     let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
-    let p = prepare(&raw).unwrap();
+    let p = prepare(&raw, None).unwrap();
     let f = fitted(&p);
     assert!(f.max_fit_mm() <= DEFAULT_FIT_TOL_MM, "{}", f.max_fit_mm());
 }
@@ -58,7 +58,7 @@ fn rtzt_sample_fits() {
         LengthUnit::Millimetre,
     )
     .unwrap();
-    let f = fitted(&prepare(&raw).unwrap());
+    let f = fitted(&prepare(&raw, None).unwrap());
     assert!(f.max_fit_mm() <= DEFAULT_FIT_TOL_MM);
 }
 
@@ -67,8 +67,8 @@ fn rtzt_sample_fits() {
 #[test]
 fn centrifugal_data_points_lie_on_fitted_sides() {
     let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
-    let p = prepare(&raw).unwrap();
-    let f = fit(&p, DEFAULT_FIT_TOL_MM).unwrap();
+    let p = prepare(&raw, None).unwrap();
+    let f = fit(&p, DEFAULT_FIT_TOL_MM, 0.0).unwrap();
     for (pb, fb) in p.blades.iter().zip(&f.blades) {
         for (surf, reported, pick) in [
             (&fb.pressure, fb.pressure_fit_mm, 0usize),

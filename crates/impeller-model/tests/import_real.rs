@@ -67,7 +67,7 @@ fn z_range(p: &impeller_model::import::PreparedImpeller) -> (f64, f64) {
 #[test]
 fn centrifugal_prepared_in_workpiece_frame() {
     let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
-    let p = prepare(&raw).unwrap();
+    let p = prepare(&raw, None).unwrap();
     assert!(p.flipped, "the file's inlet is at low z");
     let (zmin, zmax) = z_range(&p);
     assert!(zmin.abs() < 1e-9, "hub back end at z = 0, got {zmin}");
@@ -101,7 +101,7 @@ fn centrifugal_prepared_in_workpiece_frame() {
 #[test]
 fn convexity_rule_matches_autogrid_labels() {
     let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
-    let labelled = prepare(&raw).unwrap();
+    let labelled = prepare(&raw, None).unwrap();
     let mut looped: RawImpeller = raw.clone();
     for b in &mut looped.blades {
         for s in &mut b.sections {
@@ -118,7 +118,7 @@ fn convexity_rule_matches_autogrid_labels() {
             };
         }
     }
-    let unlabelled = prepare(&looped).unwrap();
+    let unlabelled = prepare(&looped, None).unwrap();
     for (a, b) in labelled.blades.iter().zip(&unlabelled.blades) {
         for (sa, sb) in a.sections.iter().zip(&b.sections) {
             let mid_a = sa.suction[sa.suction.len() / 2];
@@ -135,7 +135,7 @@ fn convexity_rule_matches_autogrid_labels() {
 #[test]
 fn rotor37_prepared() {
     let raw = read_turbogrid(&import_common::rotor37_inf()).unwrap();
-    let p = prepare(&raw).unwrap();
+    let p = prepare(&raw, None).unwrap();
     assert!(p.flipped, "rotor 37's inlet is at low z in the file");
     assert_eq!(p.main_blade_count(), 36);
     for s in &p.blades[0].sections {

@@ -46,6 +46,8 @@ pub struct FittedBlade {
     pub role: BladeRole,
     /// Number of copies around the axis.
     pub count: usize,
+    /// Number of data sections (2: a ruled blade, hub and shroud sections).
+    pub sections: usize,
     /// Pressure side, u leading → trailing edge, v hub → shroud.
     pub pressure: NurbsSurface,
     /// Suction side, same parametrisation.
@@ -184,10 +186,7 @@ fn lsq_fixed_ends(
 
 /// Fits all `sections` (each LE → TE) with one shared knot vector within `tol`: returns the
 /// knot vector, each section's control points and the largest deviation.
-fn fit_compatible(
-    sections: &[Vec<Vector3<f64>>],
-    tol: f64,
-) -> Result<CompatibleFit, String> {
+fn fit_compatible(sections: &[Vec<Vector3<f64>>], tol: f64) -> Result<CompatibleFit, String> {
     let params: Vec<Vec<f64>> = sections
         .iter()
         .map(|s| chord_params(s).ok_or_else(|| "a section has zero length".to_string()))
@@ -211,9 +210,7 @@ fn fit_compatible(
         Some((kv, ctrls, worst))
     };
     let (lo_n, hi_max) = (degree + 1, m_min);
-    let passes = |r: &Option<CompatibleFit>| {
-        r.as_ref().is_some_and(|(_, _, e)| *e <= tol)
-    };
+    let passes = |r: &Option<CompatibleFit>| r.as_ref().is_some_and(|(_, _, e)| *e <= tol);
     let first = attempt(lo_n);
     if passes(&first) {
         return first.ok_or_else(|| "fit failed".into());
@@ -315,15 +312,51 @@ fn fit_contour(points: &[Vector2<f64>], tol: f64) -> Result<(Curve2, f64), Strin
     Ok((fit.curve, fit.max_error))
 }
 
-/// Turns prepared points into exact geometry within `tol_mm` (see the module docs). A fit
-/// that cannot meet the tolerance (data with a kink, too few points) is still returned; its
-/// achieved deviation is in the result, so callers compare it with the tolerance.
-pub fn fit(prepared: &PreparedImpeller, tol_mm: f64) -> Result<FittedImpeller, ImportError> {
+/// Extends compatible section nets beyond the first and last section by `ext` × the span
+/// (linear extrapolation of the section curves: C_ext(u) = C_0(u) + e·(C_0(u) − C_1(u)),
+/// exact for ruled blades). The spacing between neighbouring sections is taken as 1/(K−1) of
+/// the span.
+fn extend_sections(ctrls: &mut Vec<Vec<Vector3<f64>>>, ext: f64) {
+    let k = ctrls.len();
+    if ext <= 0.0 || k < 2 {
+        return;
+    }
+    let e = ext * (k - 1) as f64;
+    let out = |a: &[Vector3<f64>], b: &[Vector3<f64>]| -> Vec<Vector3<f64>> {
+        a.iter().zip(b).map(|(p, q)| p + (p - q) * e).collect()
+    };
+    let first = out(&ctrls[0], &ctrls[1]);
+    let last = out(&ctrls[k - 1], &ctrls[k - 2]);
+    if k == 2 {
+        ctrls[0] = first;
+        ctrls[1] = last;
+    } else {
+        ctrls.insert(0, first);
+        ctrls.push(last);
+    }
+}
+
+/// Turns prepared points into exact geometry within `tol_mm` (see the module docs), blade
+/// sides extended beyond hub and shroud by `span_extension` × the span (0 keeps them at the
+/// first and last section). A fit that cannot meet the tolerance (data with a kink, too few
+/// points) is still returned; its achieved deviation is in the result, so callers compare
+/// it with the tolerance.
+pub fn fit(
+    prepared: &PreparedImpeller,
+    tol_mm: f64,
+    span_extension: f64,
+) -> Result<FittedImpeller, ImportError> {
     let err = |entity: String, reason: String| ImportError::Geometry {
         file: prepared.source.clone(),
         entity,
         reason,
     };
+    if !(span_extension.is_finite() && (0.0..=0.5).contains(&span_extension)) {
+        return Err(err(
+            "span extension".into(),
+            format!("{span_extension} is not a fraction within 0–0.5"),
+        ));
+    }
     if !(tol_mm.is_finite() && tol_mm > 0.0) {
         return Err(err(
             "fit tolerance".into(),
@@ -339,7 +372,9 @@ pub fn fit(prepared: &PreparedImpeller, tol_mm: f64) -> Result<FittedImpeller, I
             |name: &str, pick: &dyn Fn(&super::prepare::SectionSides) -> Vec<Vector3<f64>>| {
                 let secs: Vec<Vec<Vector3<f64>>> = b.sections.iter().map(pick).collect();
                 let entity = || format!("blade {:?} {name} side", b.name);
-                let (kv, ctrls, e) = fit_compatible(&secs, tol_mm).map_err(|r| err(entity(), r))?;
+                let (kv, mut ctrls, e) =
+                    fit_compatible(&secs, tol_mm).map_err(|r| err(entity(), r))?;
+                extend_sections(&mut ctrls, span_extension);
                 let surf = skin(&kv, &ctrls).map_err(|r| err(entity(), r))?;
                 Ok::<_, ImportError>((surf, e))
             };
@@ -349,6 +384,7 @@ pub fn fit(prepared: &PreparedImpeller, tol_mm: f64) -> Result<FittedImpeller, I
             name: b.name.clone(),
             role: b.role,
             count: b.count,
+            sections: b.sections.len(),
             pressure,
             suction,
             pressure_fit_mm,

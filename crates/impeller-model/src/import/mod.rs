@@ -5,6 +5,7 @@
 //! rotation axis along +Z, still in the file's axial sense and not yet fitted. Every failure
 //! is an [`ImportError`] naming the file, the line and what was expected there.
 
+pub mod build;
 pub mod error;
 pub mod fit;
 pub mod geomturbo;
@@ -14,6 +15,9 @@ pub mod rtzt;
 mod text;
 pub mod turbogrid;
 
+pub use build::{
+    assemble, import_file, import_raw, is_import_extension, read_raw, ImportOptions, Imported,
+};
 pub use error::ImportError;
 pub use fit::{fit, FittedBlade, FittedImpeller, DEFAULT_FIT_TOL_MM};
 pub use geomturbo::{parse_geomturbo, read_geomturbo};

@@ -15,8 +15,9 @@
 //!    and 75 % of the chord on every section and summed, weighted by its size.
 //! 4. **Workpiece frame.** If the inlet lies at lower z than the outlet, the data are turned
 //!    by π about the x axis ((x, y, z) → (x, −y, −z), a rotation, so no side changes hand);
-//!    then z is shifted so the lowest hub point (the hub's back end) lies at z = 0. Hub and
-//!    shroud point lists are ordered from their inlet end.
+//!    hub and shroud point lists are ordered from their inlet end and, on request, trimmed to
+//!    the bladed part plus a margin; then z is shifted so the lowest hub point (the hub's back
+//!    end) lies at z = 0.
 
 use super::error::ImportError;
 use super::raw::{
@@ -174,9 +175,71 @@ fn convexity_vote(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
     vote
 }
 
+/// Cumulative arc length of a polyline.
+fn arc_lengths(wall: &[Vector2<f64>]) -> Vec<f64> {
+    let mut s = vec![0.0; wall.len()];
+    for k in 1..wall.len() {
+        s[k] = s[k - 1] + (wall[k] - wall[k - 1]).norm();
+    }
+    s
+}
+
+/// Arc length of the point of `wall` closest to `q`.
+fn project_arc(wall: &[Vector2<f64>], s: &[f64], q: &Vector2<f64>) -> f64 {
+    let mut best = (f64::INFINITY, 0.0);
+    for k in 1..wall.len() {
+        let (a, b) = (wall[k - 1], wall[k]);
+        let d = b - a;
+        let t = ((q - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+        let dist = (a + d * t - q).norm();
+        if dist < best.0 {
+            best = (dist, s[k - 1] + t * (s[k] - s[k - 1]));
+        }
+    }
+    best.1
+}
+
+/// Point of `wall` at arc length `at` (linear between points).
+fn point_at_arc(wall: &[Vector2<f64>], s: &[f64], at: f64) -> Vector2<f64> {
+    let k = s.partition_point(|&x| x < at).clamp(1, wall.len() - 1);
+    let t = ((at - s[k - 1]) / (s[k] - s[k - 1])).clamp(0.0, 1.0);
+    wall[k - 1] + (wall[k] - wall[k - 1]) * t
+}
+
+/// Keeps the part of a contour polyline between the blade edges projected on it, widened on
+/// both sides by `margin` × the bladed arc length (clipped to the contour's own ends). The new
+/// end points are interpolated on the polyline.
+fn trim_contour(wall: &[Vector2<f64>], edges: &[Vector2<f64>], margin: f64) -> Vec<Vector2<f64>> {
+    let s = arc_lengths(wall);
+    let total = s[s.len() - 1];
+    let proj: Vec<f64> = edges.iter().map(|q| project_arc(wall, &s, q)).collect();
+    let lo = proj.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = proj.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+        return wall.to_vec();
+    }
+    let a = (lo - margin * (hi - lo)).max(0.0);
+    let b = (hi + margin * (hi - lo)).min(total);
+    let mut out = vec![point_at_arc(wall, &s, a)];
+    out.extend(
+        wall.iter()
+            .zip(&s)
+            .filter(|(_, &x)| x > a && x < b)
+            .map(|(p, _)| *p),
+    );
+    out.push(point_at_arc(wall, &s, b));
+    out
+}
+
 /// Reduces raw export data to sides and contours in the workpiece frame (see the module
-/// docs for the rules). Errors name the blade and section that cannot be split or oriented.
-pub fn prepare(raw: &RawImpeller) -> Result<PreparedImpeller, ImportError> {
+/// docs for the rules). With `trim_margin = Some(f)` the hub and shroud contours are cut to
+/// the bladed part widened by f × its meridional length on each side (inlet ducts and
+/// vaneless diffusers are not part of the machined impeller); `None` keeps them whole.
+/// Errors name the blade and section that cannot be split or oriented.
+pub fn prepare(
+    raw: &RawImpeller,
+    trim_margin: Option<f64>,
+) -> Result<PreparedImpeller, ImportError> {
     let geom_err = |entity: String, reason: &str| ImportError::Geometry {
         file: raw.source.clone(),
         entity,
@@ -320,26 +383,12 @@ pub fn prepare(raw: &RawImpeller) -> Result<PreparedImpeller, ImportError> {
             sections,
         });
     }
-    // 4. Frame: turn the contours, shift z, order contours from the inlet.
+    // 4. Frame: turn the contours, order them from the inlet, trim, shift z.
     let turn2 = |p: &Vector2<f64>| if flip { Vector2::new(-p.x, p.y) } else { *p };
     let mut hub: Vec<Vector2<f64>> = raw.hub.iter().map(turn2).collect();
     let mut shroud: Vec<Vector2<f64>> = raw.shroud.iter().map(turn2).collect();
-    let z_shift = -hub.iter().map(|p| p.x).fold(f64::INFINITY, f64::min);
-    if !z_shift.is_finite() {
-        return Err(geom_err("hub".into(), "no points"));
-    }
-    for p in hub.iter_mut().chain(shroud.iter_mut()) {
-        p.x += z_shift;
-    }
-    for b in &mut blades {
-        for s in &mut b.sections {
-            for p in s.pressure.iter_mut().chain(s.suction.iter_mut()) {
-                p.z += z_shift;
-            }
-        }
-    }
-    let inlet_wp = turn2(&inlet) + Vector2::new(z_shift, 0.0);
-    for wall in [&mut hub, &mut shroud] {
+    let inlet_wp = turn2(&inlet);
+    for (wall, name) in [(&mut hub, "hub"), (&mut shroud, "shroud")] {
         let d_first = (wall[0] - inlet_wp).norm();
         let d_last = (wall[wall.len() - 1] - inlet_wp).norm();
         if d_last < d_first {
@@ -356,10 +405,48 @@ pub fn prepare(raw: &RawImpeller) -> Result<PreparedImpeller, ImportError> {
             wall.push(p);
         }
         if wall.len() < 2 {
+            return Err(geom_err(name.into(), "fewer than 2 distinct points"));
+        }
+    }
+    if let Some(margin) = trim_margin {
+        if !(margin.is_finite() && margin >= 0.0) {
             return Err(geom_err(
-                "hub/shroud".into(),
-                "fewer than 2 distinct points",
+                "trim margin".into(),
+                "must be a finite fraction >= 0",
             ));
+        }
+        for (wall, first_section) in [(&mut hub, true), (&mut shroud, false)] {
+            let edges: Vec<Vector2<f64>> = blades
+                .iter()
+                .filter_map(|b| {
+                    if first_section {
+                        b.sections.first()
+                    } else {
+                        b.sections.last()
+                    }
+                })
+                .flat_map(|s| {
+                    [
+                        meridional(&s.pressure[0]),
+                        meridional(&s.pressure[s.pressure.len() - 1]),
+                    ]
+                })
+                .collect();
+            *wall = trim_contour(wall, &edges, margin);
+        }
+    }
+    let z_shift = -hub.iter().map(|p| p.x).fold(f64::INFINITY, f64::min);
+    if !z_shift.is_finite() {
+        return Err(geom_err("hub".into(), "no points"));
+    }
+    for p in hub.iter_mut().chain(shroud.iter_mut()) {
+        p.x += z_shift;
+    }
+    for b in &mut blades {
+        for s in &mut b.sections {
+            for p in s.pressure.iter_mut().chain(s.suction.iter_mut()) {
+                p.z += z_shift;
+            }
         }
     }
     Ok(PreparedImpeller {
