@@ -12,6 +12,7 @@ pub mod geomturbo;
 pub mod prepare;
 pub mod raw;
 pub mod rtzt;
+pub mod spec;
 mod text;
 pub mod turbogrid;
 
@@ -27,4 +28,5 @@ pub use raw::{
     ThicknessKind,
 };
 pub use rtzt::{parse_rtzt, read_rtzt};
+pub use spec::{from_import_toml, is_import_toml, ImportSpec};
 pub use turbogrid::{read_turbogrid, turbogrid_from_bytes, TurboGridInf};
