@@ -19,6 +19,7 @@ pub mod blade;
 pub mod builder;
 pub mod channel;
 pub mod error;
+pub mod export;
 pub mod fit;
 pub mod fixtures;
 pub mod impeller;

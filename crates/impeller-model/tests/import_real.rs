@@ -70,7 +70,10 @@ fn centrifugal_prepared_in_workpiece_frame() {
     let p = prepare(&raw, None).unwrap();
     assert!(p.flipped, "the file's inlet is at low z");
     let (zmin, zmax) = z_range(&p);
-    assert!(zmin.abs() < 1e-9, "hub back end at z = 0, got {zmin}");
+    let z_end = p.hub[p.hub.len() - 1].x;
+    assert!(z_end.abs() < 1e-9, "hub outlet end at z = 0, got {z_end}");
+    // The file's hub bulges a little (under 1 mm) beyond its outlet end.
+    assert!(zmin <= 0.0 && zmin > -1.0, "{zmin}");
     // The turn keeps the hub's axial extent.
     let (rmin, rmax) = raw
         .hub
@@ -78,7 +81,7 @@ fn centrifugal_prepared_in_workpiece_frame() {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
             (a.min(q.x), b.max(q.x))
         });
-    assert!((zmax - (rmax - rmin)).abs() < 1e-9);
+    assert!((zmax - zmin - (rmax - rmin)).abs() < 1e-9);
     assert!(
         p.hub[0].x > p.hub[p.hub.len() - 1].x,
         "hub listed from the inlet"
@@ -144,5 +147,42 @@ fn rotor37_prepared() {
         }
         // LE and TE shared by both sides of the split loop.
         assert!((s.pressure[0] - s.suction[0]).norm() < 1e-12);
+    }
+}
+
+/// Pressure and suction are labelled consistently on every section: the pressure side lies
+/// on the same θ side of the suction side at mid-chord of every span (a swapped section would
+/// twist the skinned sides through each other).
+#[test]
+fn side_labels_are_consistent_across_sections() {
+    let sources = [
+        read_turbogrid(&import_common::rotor37_inf()).unwrap(),
+        read_turbogrid(&import_common::sample("tg-cylindrical/sample.inf")).unwrap(),
+        impeller_model::import::read_rtzt(
+            &import_common::sample("sample-6+6.rtzt"),
+            impeller_model::import::LengthUnit::Millimetre,
+        )
+        .unwrap(),
+        read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap(),
+    ];
+    for raw in &sources {
+        let p = prepare(raw, None).unwrap();
+        for b in &p.blades {
+            let signs: Vec<f64> = b
+                .sections
+                .iter()
+                .map(|s| {
+                    let a = s.pressure[s.pressure.len() / 2];
+                    let c = s.suction[s.suction.len() / 2];
+                    (a.y.atan2(a.x) - c.y.atan2(c.x)).signum()
+                })
+                .collect();
+            assert!(
+                signs.iter().all(|&x| x == signs[0]),
+                "{}: {}: {signs:?}",
+                raw.source.display(),
+                b.name
+            );
+        }
     }
 }

@@ -9,15 +9,16 @@
 //!    flow); when both ends have radii within 0.1 % of the meridional chord, the end with the
 //!    larger z in the file is the outlet. Every section is then ordered leading edge → trailing
 //!    edge along that direction.
-//! 3. **Pressure and suction.** Where the file does not say, the suction side is the convex
-//!    one: the camber line (mean θ of both sides) bulges away from its LE–TE chord in the
+//! 3. **Pressure and suction.** Where the file does not say, each section's sides are first
+//!    put in the same order (the side at larger mean θ first); then the suction side is the
+//!    convex one: the camber line (mean θ of both sides) bulges away from its LE–TE chord in the
 //!    (meridional fraction, θ) plane towards the suction side. The bulge is sampled at 25, 50
 //!    and 75 % of the chord on every section and summed, weighted by its size.
 //! 4. **Workpiece frame.** If the inlet lies at lower z than the outlet, the data are turned
 //!    by π about the x axis ((x, y, z) → (x, −y, −z), a rotation, so no side changes hand);
 //!    hub and shroud point lists are ordered from their inlet end and, on request, trimmed to
-//!    the bladed part plus a margin; then z is shifted so the lowest hub point (the hub's back
-//!    end) lies at z = 0.
+//!    the bladed part plus a margin; then z is shifted so the hub's outlet end (the back face
+//!    of a centrifugal impeller) lies at z = 0.
 
 use super::error::ImportError;
 use super::raw::{
@@ -65,7 +66,7 @@ pub struct PreparedImpeller {
     pub blades: Vec<PreparedBlade>,
     /// Whether the data were turned by π about x (the file's inlet was at low z).
     pub flipped: bool,
-    /// Shift added to z after the turn, mm.
+    /// Shift added to z after the turn (puts the hub's outlet end at z = 0), mm.
     pub z_shift: f64,
 }
 
@@ -143,6 +144,22 @@ fn theta_at(
         }
     }
     None
+}
+
+/// Mean θ of side `a` minus mean θ of side `b` (both relative to `a`'s first point), from
+/// their points at equal index fractions.
+fn mean_theta_offset(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
+    let Some(p0) = a.first() else { return 0.0 };
+    let th0 = p0.y.atan2(p0.x);
+    let n = 32;
+    (0..=n)
+        .map(|k| {
+            let f = k as f64 / n as f64;
+            let pa = &a[((a.len() - 1) as f64 * f).round() as usize];
+            let pb = &b[((b.len() - 1) as f64 * f).round() as usize];
+            rel_theta(pa, th0) - rel_theta(pb, th0)
+        })
+        .sum()
 }
 
 /// Weighted vote that the first side of an oriented section is the suction (convex) side:
@@ -347,6 +364,11 @@ pub fn prepare(
             if along < 0.0 {
                 c.reverse();
             }
+            // Unlabelled sides: make the first one the +θ side of its section, so the
+            // convexity vote below compares like with like across sections.
+            if !lab && mean_theta_offset(&a, &c) < 0.0 {
+                std::mem::swap(&mut a, &mut c);
+            }
             oriented.push((span, a, c, lab));
         }
         let first_is_suction = if oriented.iter().all(|o| o.3) {
@@ -435,10 +457,10 @@ pub fn prepare(
             *wall = trim_contour(wall, &edges, margin);
         }
     }
-    let z_shift = -hub.iter().map(|p| p.x).fold(f64::INFINITY, f64::min);
-    if !z_shift.is_finite() {
+    // The hub's outlet end marks the back face (robust to fitted contours that overshoot).
+    let Some(z_shift) = hub.last().map(|p| -p.x) else {
         return Err(geom_err("hub".into(), "no points"));
-    }
+    };
     for p in hub.iter_mut().chain(shroud.iter_mut()) {
         p.x += z_shift;
     }

@@ -197,7 +197,10 @@ pub fn from_cylindrical(r: f64, theta: f64, z: f64) -> Vector3<f64> {
 /// The edges are the two loop points farthest apart in the meridional (z, r) half-plane —
 /// the extreme meridional positions of the section (O(n²) in the loop size, n ≈ 300). A
 /// repeated closing point is dropped first. Both returned sides run from the first edge found
-/// (lower loop index) to the other; callers orient and label them. Returns `None` when the
+/// (lower loop index) to the other; callers orient and label them. At a blunt edge (one side
+/// leaves the extreme point across the edge face, with under 25 % of the step along the
+/// meridional chord, while the other runs along the blade, over 50 %) the face is left out of
+/// the side that crosses it. Returns `None` when the
 /// loop has fewer than 4 distinct points or its meridional extent is zero.
 pub fn split_loop(points: &[Vector3<f64>]) -> Option<SidePair> {
     let mut pts: Vec<Vector3<f64>> = points.to_vec();
@@ -228,7 +231,7 @@ pub fn split_loop(points: &[Vector3<f64>]) -> Option<SidePair> {
     if !positive(best) {
         return None;
     }
-    let side_a: Vec<Vector3<f64>> = pts[bi..=bj].to_vec();
+    let mut side_a: Vec<Vector3<f64>> = pts[bi..=bj].to_vec();
     // The other way round the loop: bi backwards (wrapping) to bj.
     let mut side_b = Vec::with_capacity(n - (bj - bi) + 1);
     let mut k = bi;
@@ -238,6 +241,44 @@ pub fn split_loop(points: &[Vector3<f64>]) -> Option<SidePair> {
             break;
         }
         k = if k == 0 { n - 1 } else { k - 1 };
+    }
+    // Blunt edges: where one side leaves the edge point across the edge face (a step with
+    // little progress along the chord) while the other runs along the blade, the face is not
+    // part of that side: it starts (or ends) at its own corner instead.
+    let d = (m[bj] - m[bi]).normalize();
+    let progress = |p: &Vector3<f64>, q: &Vector3<f64>| {
+        let step = (q - p).norm();
+        if step > 0.0 {
+            ((meridional(q) - meridional(p)).dot(&d)).abs() / step
+        } else {
+            1.0
+        }
+    };
+    let lateral = |f: f64| f < 0.25;
+    let along = |f: f64| f > 0.5;
+    for at_start in [true, false] {
+        let ends = |s: &[Vector3<f64>]| {
+            if at_start {
+                progress(&s[0], &s[1])
+            } else {
+                progress(&s[s.len() - 2], &s[s.len() - 1])
+            }
+        };
+        let (fa, fb) = (ends(&side_a), ends(&side_b));
+        let target = if lateral(fa) && along(fb) && side_a.len() > 2 {
+            Some(&mut side_a)
+        } else if lateral(fb) && along(fa) && side_b.len() > 2 {
+            Some(&mut side_b)
+        } else {
+            None
+        };
+        if let Some(side) = target {
+            if at_start {
+                side.remove(0);
+            } else {
+                side.pop();
+            }
+        }
     }
     Some((side_a, side_b))
 }
