@@ -7,7 +7,8 @@
 mod import_common;
 
 use impeller_model::import::{
-    parse_geomturbo, parse_rtzt, turbogrid_from_bytes, LengthUnit, RawImpeller,
+    import_raw, parse_geomturbo, parse_rtzt, turbogrid_from_bytes, ImportOptions, LengthUnit,
+    RawImpeller,
 };
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -105,7 +106,9 @@ fn apply(bytes: &[u8], m: &Mutation) -> Vec<u8> {
     out
 }
 
-/// What a successful import must satisfy: finite data, counts ≥ 1, ≥ 2 sections per blade.
+/// What a successful import must satisfy: finite data, counts ≥ 1, ≥ 2 sections per blade;
+/// and the whole pipeline (prepare, fit, assemble) ends in a typed error or a valid model
+/// whose reported fit deviation is finite and whose blade counts are the file's.
 fn valid(raw: &RawImpeller) {
     assert!(raw.main_blade_count() >= 1);
     assert!(raw.hub.len() >= 2 && raw.shroud.len() >= 2);
@@ -116,6 +119,14 @@ fn valid(raw: &RawImpeller) {
         .all(|p| p.iter().all(|v| v.is_finite())));
     for b in &raw.blades {
         assert!(b.count >= 1 && b.sections.len() >= 2);
+    }
+    if let Ok(imp) = import_raw(raw, &ImportOptions::default()) {
+        assert!(imp.fitted.max_fit_mm().is_finite());
+        assert_eq!(imp.impeller.main().count(), raw.main_blade_count());
+        assert_eq!(
+            imp.impeller.splitter().map_or(0, |s| s.count()),
+            raw.splitter_blade_count()
+        );
     }
 }
 

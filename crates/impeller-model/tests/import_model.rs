@@ -40,3 +40,24 @@ fn rotor37_imports() {
     assert_eq!(s.blade_kind, BladeKind::FreeForm);
     assert!(imp.fitted.max_fit_mm() <= ImportOptions::default().fit_tol_mm);
 }
+
+/// A fit that misses its data by more than the tolerance is an error naming the entity and
+/// the deviation (the fits fall back to interpolation, so this guards the singular cases).
+#[test]
+fn deviation_beyond_tolerance_is_an_error() {
+    use impeller_model::import::{check_tolerance, ImportError};
+    let imp = import_file(
+        &import_common::sample("sample-6+6.rtzt"),
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    check_tolerance(&imp.fitted).unwrap();
+    let mut bad = imp.fitted.clone();
+    bad.blades[1].suction_fit_mm = 0.25;
+    let err = check_tolerance(&bad).unwrap_err();
+    let ImportError::Geometry { entity, reason, .. } = &err else {
+        panic!("{err:?}")
+    };
+    assert_eq!(entity, "blade \"splitter 1\" suction side");
+    assert!(reason.contains("0.2500 mm"), "{reason}");
+}

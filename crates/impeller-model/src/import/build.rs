@@ -172,10 +172,39 @@ pub fn assemble(fitted: &FittedImpeller, opts: &ImportOptions) -> Result<Impelle
     .map_err(|e| err("impeller", e))
 }
 
-/// Prepares, fits and assembles raw export data.
+/// Fails when a fitted curve or surface misses its data by more than the tolerance, naming
+/// the entity and the deviation reached.
+pub fn check_tolerance(fitted: &FittedImpeller) -> Result<(), ImportError> {
+    let mut entities = vec![
+        ("hub".to_string(), fitted.hub_fit_mm),
+        ("shroud".to_string(), fitted.shroud_fit_mm),
+    ];
+    for b in &fitted.blades {
+        entities.push((
+            format!("blade {:?} pressure side", b.name),
+            b.pressure_fit_mm,
+        ));
+        entities.push((format!("blade {:?} suction side", b.name), b.suction_fit_mm));
+    }
+    match entities.into_iter().find(|(_, e)| !(*e <= fitted.tol_mm)) {
+        Some((entity, e)) => Err(ImportError::Geometry {
+            file: fitted.source.clone(),
+            entity,
+            reason: format!(
+                "the closest fit misses the data by {e:.4} mm, more than the tolerance {} mm \
+                 (an outlier or a kink in the data; a larger fit tolerance accepts it)",
+                fitted.tol_mm
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Prepares, fits and assembles raw export data; fails when the fit tolerance is not met.
 pub fn import_raw(raw: &RawImpeller, opts: &ImportOptions) -> Result<Imported, ImportError> {
     let prepared = prepare(raw, opts.trim_margin)?;
     let fitted = fit(&prepared, opts.fit_tol_mm, opts.span_extension)?;
+    check_tolerance(&fitted)?;
     let impeller = assemble(&fitted, opts)?;
     Ok(Imported { impeller, fitted })
 }

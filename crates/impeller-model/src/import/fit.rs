@@ -9,7 +9,10 @@
 //!   knot vector shared by every section, knots at quantiles of the merged chord-length
 //!   parameters of all sections (the idea of eq. 9.69: every span holds data), least squares
 //!   with fixed leading- and trailing-edge points (§9.4.1, eqs. 9.63–9.67) solved by SVD —
-//!   with the control count doubled and then bisected until every section is within `tol`.
+//!   with the control count doubled and then bisected until every section is within `tol`
+//!   (at most the point count of the smallest section, where the fit interpolates: sparse or
+//!   noisy data then are followed exactly, wiggles included; if every larger system is
+//!   singular the closest fit is returned and [`super::build::check_tolerance`] rejects it).
 //!   The compatible section curves are then skinned (§10.3): the control points of each
 //!   index are interpolated across the sections at averaged chord-length parameters v̄_k
 //!   with knots by averaging (eq. 9.8), degree min(3, sections − 1). The surface reproduces
@@ -164,7 +167,11 @@ fn lsq_fixed_ends(
                 b[(k - 1, d)] = rhs[d];
             }
         }
-        let svd = a.svd(true, true);
+        if !(a.iter().all(|x| x.is_finite()) && b.iter().all(|x| x.is_finite())) {
+            return None;
+        }
+        // Bounded iterations: never loops on pathological input.
+        let svd = a.try_svd(true, true, f64::EPSILON, 10_000)?;
         let smax = svd.singular_values.max();
         let smin = svd.singular_values.min();
         if !(smax > 0.0 && smin > 1e-10 * smax) {
@@ -210,20 +217,28 @@ fn fit_compatible(sections: &[Vec<Vector3<f64>>], tol: f64) -> Result<Compatible
         Some((kv, ctrls, worst))
     };
     let (lo_n, hi_max) = (degree + 1, m_min);
-    let passes = |r: &Option<CompatibleFit>| r.as_ref().is_some_and(|(_, _, e)| *e <= tol);
-    let first = attempt(lo_n);
-    if passes(&first) {
-        return first.ok_or_else(|| "fit failed".into());
+    // The closest non-singular fit seen, returned when the tolerance cannot be met.
+    let mut closest: Option<CompatibleFit> = None;
+    let mut try_n = |n: usize| -> Option<CompatibleFit> {
+        let r = attempt(n);
+        if let Some(f) = &r {
+            if closest.as_ref().is_none_or(|c| f.2 < c.2) {
+                closest = Some(f.clone());
+            }
+        }
+        r.filter(|f| f.2 <= tol)
+    };
+    if let Some(f) = try_n(lo_n) {
+        return Ok(f);
     }
     let (mut lo, mut hi) = (lo_n, (2 * lo_n).min(hi_max));
     let mut best = loop {
-        let r = attempt(hi);
-        if passes(&r) {
-            break r;
+        if let Some(f) = try_n(hi) {
+            break f;
         }
         if hi == hi_max {
-            // The tolerance cannot be met: return the closest fit we have, if any.
-            return r.ok_or_else(|| {
+            drop(try_n);
+            return closest.ok_or_else(|| {
                 "no compatible fit of the sections exists (singular system)".into()
             });
         }
@@ -232,15 +247,15 @@ fn fit_compatible(sections: &[Vec<Vector3<f64>>], tol: f64) -> Result<Compatible
     };
     while hi - lo > 1 {
         let mid = lo + (hi - lo) / 2;
-        let r = attempt(mid);
-        if passes(&r) {
-            hi = mid;
-            best = r;
-        } else {
-            lo = mid;
+        match try_n(mid) {
+            Some(f) => {
+                hi = mid;
+                best = f;
+            }
+            None => lo = mid,
         }
     }
-    best.ok_or_else(|| "fit failed".into())
+    Ok(best)
 }
 
 /// Skins compatible section control nets (`ctrls[k][i]`, section k) into a surface, u along

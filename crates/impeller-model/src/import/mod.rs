@@ -17,7 +17,8 @@ mod text;
 pub mod turbogrid;
 
 pub use build::{
-    assemble, import_file, import_raw, is_import_extension, read_raw, ImportOptions, Imported,
+    assemble, check_tolerance, import_file, import_raw, is_import_extension, read_raw,
+    ImportOptions, Imported,
 };
 pub use error::ImportError;
 pub use fit::{fit, FittedBlade, FittedImpeller, DEFAULT_FIT_TOL_MM};

@@ -28,6 +28,9 @@ use super::raw::{
 use nalgebra::{Vector2, Vector3};
 use std::path::PathBuf;
 
+/// Largest coordinate magnitude accepted, mm.
+const MAX_COORD_MM: f64 = 1e9;
+
 /// One blade section's two sides, each from leading to trailing edge, mm, workpiece frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SectionSides {
@@ -262,6 +265,47 @@ pub fn prepare(
         entity,
         reason: reason.to_string(),
     };
+    // Coordinates beyond 10⁹ mm are corrupt data, not an impeller; rejecting them keeps
+    // every later computation finite.
+    let sane = |v: f64| v.is_finite() && v.abs() <= MAX_COORD_MM;
+    if let Some(p) = raw
+        .hub
+        .iter()
+        .chain(&raw.shroud)
+        .find(|p| !(sane(p.x) && sane(p.y)))
+    {
+        return Err(geom_err(
+            "hub/shroud".into(),
+            &format!("coordinate {p:?} mm is not finite or beyond 1e9 mm"),
+        ));
+    }
+    for b in &raw.blades {
+        for s in &b.sections {
+            let pts: Vec<&Vector3<f64>> = match &s.shape {
+                SectionShape::Loop(p) => p.iter().collect(),
+                SectionShape::Sides { suction, pressure } => {
+                    suction.iter().chain(pressure).collect()
+                }
+                SectionShape::Camber {
+                    points, thickness, ..
+                } => {
+                    if thickness.iter().any(|&t| !sane(t)) {
+                        return Err(geom_err(
+                            format!("blade {:?} section at line {}", b.name, s.line),
+                            "thickness is not finite or beyond 1e9 mm",
+                        ));
+                    }
+                    points.iter().collect()
+                }
+            };
+            if pts.iter().any(|p| !p.iter().all(|&v| sane(v))) {
+                return Err(geom_err(
+                    format!("blade {:?} section at line {}", b.name, s.line),
+                    "a coordinate is not finite or beyond 1e9 mm",
+                ));
+            }
+        }
+    }
     // Length scale for "same point" tests: 1e-9 of the flow path's size.
     let size = raw
         .hub
