@@ -237,7 +237,6 @@ fn fit_compatible(sections: &[Vec<Vector3<f64>>], tol: f64) -> Result<Compatible
             break f;
         }
         if hi == hi_max {
-            drop(try_n);
             return closest.ok_or_else(|| {
                 "no compatible fit of the sections exists (singular system)".into()
             });
