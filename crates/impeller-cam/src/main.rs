@@ -21,6 +21,8 @@ struct Cli {
 enum Command {
     /// Run the whole pipeline on a job file (or the embedded default job).
     Run(cmd::run::Args),
+    /// Build an impeller and print its measured summary (blade counts, diameters, widths).
+    Model(cmd::model::Args),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Model(args) => cmd::model::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -278,3 +278,43 @@ impl BladeSet {
         self.blade.rotated(self.pitch_rad() * k as f64)
     }
 }
+
+/// Where the line `c + λ n` meets `s`: Newton on S(a, b) − λ n = c in (a, b, λ), from
+/// (u, v, λ0). Returns λ, or `None` if it does not converge in 30 steps to 1e-12 mm.
+pub fn line_surface_intersection(
+    s: &NurbsSurface,
+    c: &Vector3<f64>,
+    n: &Vector3<f64>,
+    start: (f64, f64, f64),
+) -> Option<f64> {
+    let ((u0, u1), (v0, v1)) = s.domain();
+    let (mut a, mut b, mut l) = start;
+    for _ in 0..30 {
+        let d = s.derivs2(a, b);
+        let r = d.p - n * l - c;
+        if r.norm() < 1e-12 {
+            return Some(l);
+        }
+        let j = nalgebra::Matrix3::from_columns(&[d.su, d.sv, -n]);
+        let step = j.lu().solve(&(-r))?;
+        a = (a + step[0]).clamp(u0, u1);
+        b = (b + step[1]).clamp(v0, v1);
+        l += step[2];
+    }
+    let r = s.point(a, b) - n * l - c;
+    (r.norm() < 1e-9).then_some(l)
+}
+
+impl Blade {
+    /// Normal thickness at camber parameters (u, v): the length of the camber-normal line
+    /// between the two sides (both met by [`line_surface_intersection`]). `None` without a
+    /// camber surface or where the line misses a side.
+    pub fn normal_thickness(&self, u: f64, v: f64) -> Option<f64> {
+        let c = self.camber.as_ref()?;
+        let p = c.point(u, v);
+        let n = c.normal(u, v)?;
+        let a = line_surface_intersection(&self.pressure, &p, &n, (u, v, 0.0))?;
+        let b = line_surface_intersection(&self.suction, &p, &n, (u, v, 0.0))?;
+        Some((a - b).abs())
+    }
+}

@@ -7,7 +7,7 @@
 //! contour and θ from the wrap-angle laws. A *ruled* camber is (1 − s) P_h + s P_s (straight
 //! rulings); a *free-form* camber puts the meridional point at (1 − s)(z_h, r_h) + s (z_s, r_s)
 //! and θ(m, s) on the natural cubic spline through the span laws. The camber NURBS interpolates
-//! this design at NU = 61 flow samples (u, clustered at rounded edges, see
+//! this design at NU = 161 flow samples (u, clustered at rounded edges, see
 //! [`crate::thickness`]) — a cubic×linear ruled surface, or cubic×cubic through 13 span rows.
 //!
 //! **Sides.** With the unit camber normal n (oriented to +θ) and half thickness h = τ/2, the
@@ -17,7 +17,7 @@
 //! stay flank-millable. Free-form sides interpolate the offset grid. The impeller turns toward
 //! −θ, so the pressure side faces −θ and a positive wrap angle sweeps the blade backward.
 //!
-//! Cost: a few thousand contour evaluations and three dense LU solves of size ≤ 61 per blade.
+//! Cost: a few thousand contour evaluations and three dense LU solves of size ≤ 161 per blade.
 
 use crate::blade::{Blade, BladeDesign, BladeKind, BladeSet};
 use crate::error::ModelError;
@@ -34,7 +34,7 @@ use nurbs::{KnotVector, NurbsCurve, NurbsSurface};
 use std::f64::consts::TAU;
 
 /// Samples along the flow for every blade surface.
-pub const FLOW_SAMPLES: usize = 61;
+pub const FLOW_SAMPLES: usize = 161;
 /// Span rows of free-form surfaces.
 pub const SPAN_SAMPLES: usize = 13;
 

@@ -29,6 +29,7 @@ pub mod meridional;
 pub mod params;
 pub mod query;
 pub mod revolved;
+pub mod ruled;
 pub mod stock;
 pub mod summary;
 pub mod thickness;

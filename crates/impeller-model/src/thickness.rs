@@ -3,9 +3,10 @@
 //! The designer tabulates the normal thickness τ(m) (mm) against the blade's own meridional
 //! fraction m ∈ [0, 1] (leading edge 0, trailing edge 1); between table points it is the
 //! natural cubic spline of [`Law`]. A **blunt** edge keeps τ up to the edge, which is then
-//! closed by a flat face. A **rounded** edge is an elliptic nose of length ℓ (in m) chosen so
-//! that it is about a half circle (ℓ · meridional length = τ/2): the half thickness is
-//! `h(d) = τ/2 · sqrt(1 − (1 − d/ℓ)²)` at distance d < ℓ from the edge.
+//! closed by a flat face. A **rounded** edge is a nose of length ℓ (in m; ℓ · meridional
+//! length = τ) with half thickness `h(d) = τ/2 · sqrt(1 − (1 − d/ℓ)⁴)` at distance d < ℓ from
+//! the edge: a parabolic tip of radius ≈ τ/2 (h² ≈ τ² d/ℓ) that joins the nominal thickness
+//! with matching first and second derivatives (C², so interpolated sides follow it closely).
 //!
 //! Because `h` has an infinite slope at the edge, blade surfaces are not parametrised by m but
 //! by a parameter u with m = μ(u) quadratic near a rounded edge ([`ThicknessLaw::m_of_u`]), so
@@ -45,8 +46,8 @@ impl ThicknessLaw {
         meridional_length_mm: f64,
     ) -> Self {
         let l = meridional_length_mm.max(1e-9);
-        let nose_le = (0.5 * law.eval(0.0) / l).clamp(1e-6, 0.25);
-        let nose_te = (0.5 * law.eval(1.0) / l).clamp(1e-6, 0.25);
+        let nose_le = (law.eval(0.0) / l).clamp(1e-6, 0.25);
+        let nose_te = (law.eval(1.0) / l).clamp(1e-6, 0.25);
         Self {
             law,
             leading,
@@ -93,11 +94,11 @@ impl ThicknessLaw {
         let (le, te) = self.nose_lengths();
         if le > 0.0 && m < le {
             let d = (m / le).clamp(0.0, 1.0);
-            t *= (1.0 - (1.0 - d) * (1.0 - d)).max(0.0).sqrt();
+            t *= (1.0 - (1.0 - d).powi(4)).max(0.0).sqrt();
         }
         if te > 0.0 && m > 1.0 - te {
             let d = ((1.0 - m) / te).clamp(0.0, 1.0);
-            t *= (1.0 - (1.0 - d) * (1.0 - d)).max(0.0).sqrt();
+            t *= (1.0 - (1.0 - d).powi(4)).max(0.0).sqrt();
         }
         t
     }
@@ -135,7 +136,7 @@ mod tests {
         assert!((t.thickness(0.5) - 0.8).abs() < 1e-15);
         assert!((t.thickness(1.0) - 0.8).abs() < 1e-15);
         let (le, te) = t.nose_lengths();
-        assert!((le * 40.0 - 0.4).abs() < 1e-12 && te == 0.0);
+        assert!((le * 40.0 - 0.8).abs() < 1e-12 && te == 0.0);
         // Thickness grows linearly with u near a rounded edge: smooth surfaces.
         let r1 = t.thickness(t.m_of_u(1e-4)) / 1e-4;
         let r2 = t.thickness(t.m_of_u(2e-4)) / 2e-4;

@@ -5,6 +5,7 @@
 use nalgebra::SVector;
 
 use crate::error::NurbsError;
+use crate::homogeneous::HSpline;
 use crate::knots::{basis_funs_fixed, clamp_param, ders_basis_fixed, KnotVector};
 use crate::util::binomial;
 use crate::MAX_ORDER;
@@ -118,7 +119,6 @@ impl<const D: usize> NurbsCurve<D> {
     /// Builds a curve from homogeneous data `(w_i P_i, w_i)` stored with stride `D + 1`
     /// (or Euclidean with stride `D` when `rational` is false). Used by the knot
     /// algorithms, which work in homogeneous space.
-    #[allow(dead_code)]
     pub(crate) fn from_homogeneous(
         knots: KnotVector,
         data: &[f64],
@@ -129,9 +129,37 @@ impl<const D: usize> NurbsCurve<D> {
     }
 
     /// Homogeneous control data, stride `D + 1` if rational else `D`.
-    #[allow(dead_code)]
     pub(crate) fn homogeneous(&self) -> Vec<f64> {
         crate::util::to_homogeneous(&self.ctrl, self.weights.as_deref())
+    }
+
+    /// The control polygon in homogeneous form for the chapter-5 algorithms.
+    pub(crate) fn to_hspline(&self) -> HSpline {
+        HSpline {
+            p: self.degree(),
+            knots: self.knots.knots().to_vec(),
+            pts: self.homogeneous(),
+            dim: if self.is_rational() { D + 1 } else { D },
+        }
+    }
+
+    /// Rebuilds a curve (validating it) from a homogeneous control polygon.
+    pub(crate) fn from_hspline(h: &HSpline, rational: bool) -> Result<Self, NurbsError> {
+        let kv = KnotVector::new(h.p, h.knots.clone())?;
+        Self::from_homogeneous(kv, &h.pts, rational)
+    }
+
+    /// Same knots and weights, control points mapped by `f` (callers guarantee `f`
+    /// keeps finite points finite, e.g. a rigid motion).
+    pub(crate) fn map_control_points(
+        &self,
+        f: impl Fn(SVector<f64, D>) -> SVector<f64, D>,
+    ) -> Self {
+        NurbsCurve {
+            knots: self.knots.clone(),
+            ctrl: self.ctrl.iter().map(|p| f(*p)).collect(),
+            weights: self.weights.clone(),
+        }
     }
 
     /// Parameter domain `[u_p, u_{m-p}]`.
@@ -177,6 +205,13 @@ impl<const D: usize> NurbsCurve<D> {
         let p = self.knots.degree();
         let kn = self.knots.knots();
         let u = clamp_param(kn, p, u);
+        let w = self.weights.as_deref();
+        match p {
+            1 => return crate::kernels::curve_point::<D, 2>(&self.knots, &self.ctrl, w, u),
+            2 => return crate::kernels::curve_point::<D, 3>(&self.knots, &self.ctrl, w, u),
+            3 => return crate::kernels::curve_point::<D, 4>(&self.knots, &self.ctrl, w, u),
+            _ => {}
+        }
         let span = crate::knots::find_span(kn, p, u);
         let n = basis_funs_fixed(kn, p, span, u);
         let first = span - p;
@@ -204,6 +239,15 @@ impl<const D: usize> NurbsCurve<D> {
     /// Point, first and second derivative `[C, C', C'']` without allocation (A3.2/A4.2
     /// specialised to order 2). Parameters outside the domain are clamped.
     pub fn derivs2(&self, u: f64) -> [SVector<f64, D>; 3] {
+        let p = self.knots.degree();
+        let u = clamp_param(self.knots.knots(), p, u);
+        let w = self.weights.as_deref();
+        match p {
+            1 => return crate::kernels::curve_derivs2::<D, 2>(&self.knots, &self.ctrl, w, u),
+            2 => return crate::kernels::curve_derivs2::<D, 3>(&self.knots, &self.ctrl, w, u),
+            3 => return crate::kernels::curve_derivs2::<D, 4>(&self.knots, &self.ctrl, w, u),
+            _ => {}
+        }
         let mut out = [SVector::<f64, D>::zeros(); 3];
         self.derivs_into(u, &mut out);
         out

@@ -21,6 +21,10 @@ use crate::{MAX_DEGREE, MAX_ORDER};
 pub struct KnotVector {
     degree: usize,
     knots: Vec<f64>,
+    /// `inv_diff[(g - 1) * len + k] = 1 / (u_{k+g} − u_k)` for gaps `g = 1..=p` (0 where
+    /// the difference vanishes or `k + g` is past the end): the denominators of A2.2/A2.3,
+    /// precomputed so evaluation multiplies instead of dividing.
+    inv_diff: Vec<f64>,
 }
 
 /// Serialised form of a [`KnotVector`] (validated when converted back).
@@ -104,7 +108,27 @@ impl KnotVector {
         if a >= b {
             return Err(NurbsError::EmptyDomain { start: a, end: b });
         }
-        Ok(KnotVector { degree, knots })
+        let len = knots.len();
+        let mut inv_diff = vec![0.0; degree * len];
+        for g in 1..=degree {
+            for k in 0..len - g {
+                let d = knots[k + g] - knots[k];
+                if d > 0.0 {
+                    inv_diff[(g - 1) * len + k] = 1.0 / d;
+                }
+            }
+        }
+        Ok(KnotVector {
+            degree,
+            knots,
+            inv_diff,
+        })
+    }
+
+    /// `1 / (u_{k+g} − u_k)`, 0 for an empty interval (`1 <= g <= p`, `k + g <= m`).
+    #[inline(always)]
+    pub(crate) fn inv_diff(&self, g: usize, k: usize) -> f64 {
+        self.inv_diff[(g - 1) * self.knots.len() + k]
     }
 
     /// Clamped uniform knot vector on `[0, 1]` for `n_ctrl` control points: `p + 1` zeros,
@@ -241,23 +265,18 @@ pub(crate) fn clamp_param(knots: &[f64], p: usize, u: f64) -> f64 {
 #[inline]
 pub(crate) fn find_span(knots: &[f64], p: usize, u: f64) -> usize {
     let n = knots.len() - p - 2;
-    if u >= knots[n + 1] {
-        return n;
+    // Largest i in [p, n] with knots[i] <= u, by a branch-free binary search (the
+    // conditional move avoids mispredictions on random queries). Below the domain and NaN
+    // give p; at or above the domain end, n.
+    let mut lo = p;
+    let mut len = n + 1 - p;
+    while len > 1 {
+        let half = len / 2;
+        let mid = lo + half;
+        lo = if knots[mid] <= u { mid } else { lo };
+        len -= half;
     }
-    if u <= knots[p] || u.is_nan() {
-        return p;
-    }
-    let (mut low, mut high) = (p, n + 1);
-    let mut mid = (low + high) / 2;
-    while u < knots[mid] || u >= knots[mid + 1] {
-        if u < knots[mid] {
-            high = mid;
-        } else {
-            low = mid;
-        }
-        mid = (low + high) / 2;
-    }
-    mid
+    lo
 }
 
 /// A2.2 into a fixed stack array (entries `0..=p` are valid).

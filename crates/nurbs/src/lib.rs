@@ -46,14 +46,27 @@
 // The kernels transcribe The NURBS Book index by index; iterator rewrites would obscure that.
 #![allow(clippy::needless_range_loop)]
 
+mod arcs;
+mod bezier;
+mod curvature;
 mod curve;
+mod degree_elevation;
 mod error;
+mod homogeneous;
+mod iso_curves;
+mod kernels;
+mod knot_insertion;
 mod knots;
+mod reparam;
+mod revolution;
+mod ruled;
 mod surface;
 mod traits;
-#[allow(dead_code)] // homogeneous helpers are used by the knot algorithms landing next
+mod transform;
 mod util;
 
+pub use bezier::BezierPatch;
+pub use curvature::PrincipalCurvatures;
 pub use curve::{Curve2, Curve3, NurbsCurve, NurbsCurveData};
 pub use error::{Direction, NurbsError};
 pub use knots::{KnotVector, KnotVectorData};
@@ -69,3 +82,5 @@ pub const MAX_ORDER: usize = MAX_DEGREE + 1;
 pub mod closest;
 pub mod discretise;
 pub mod fit;
+pub mod project;
+pub mod tessellate;

@@ -5,6 +5,8 @@
 use nalgebra::Vector3;
 
 use crate::error::{Direction, NurbsError};
+use crate::homogeneous::HSpline;
+use crate::kernels;
 use crate::knots::{basis_funs_fixed, clamp_param, ders_basis_fixed, find_span, KnotVector};
 use crate::util::binomial;
 use crate::MAX_ORDER;
@@ -46,13 +48,15 @@ pub struct SurfaceDerivs2 {
 }
 
 impl SurfaceDerivs2 {
-    /// Unit normal `su × sv / |su × sv|`, or `None` where the surface is singular
-    /// (`|su × sv| <= 1e-14 · |su| |sv|`, or either tangent vanishes, e.g. at a pole).
+    /// Unit normal `su × sv / |su × sv|`, or `None` where the parametrisation is singular:
+    /// `|su × sv| <= 1e-12 · max(|su|, |sv|)²` (parallel tangents, or one tangent vanishing
+    /// relative to the other as at the pole of a surface of revolution, where rounding
+    /// leaves `|su| ≈ 1e-16 |sv|`), or non-finite derivatives.
     pub fn normal(&self) -> Option<Vector3<f64>> {
         let n = self.su.cross(&self.sv);
         let len = n.norm();
-        let scale = self.su.norm() * self.sv.norm();
-        if len > 0.0 && len > 1e-14 * scale {
+        let big = self.su.norm().max(self.sv.norm());
+        if len > 0.0 && len > 1e-12 * big * big {
             Some(n / len)
         } else {
             None
@@ -238,6 +242,30 @@ impl NurbsSurface {
         })
     }
 
+    /// Same knots and weights, control points mapped by `f` (callers guarantee `f`
+    /// keeps finite points finite, e.g. a rigid motion).
+    pub(crate) fn map_control_points(&self, f: impl Fn(Vector3<f64>) -> Vector3<f64>) -> Self {
+        NurbsSurface {
+            knots_u: self.knots_u.clone(),
+            knots_v: self.knots_v.clone(),
+            n_u: self.n_u,
+            n_v: self.n_v,
+            ctrl: self.ctrl.iter().map(|p| f(*p)).collect(),
+            weights: self.weights.clone(),
+        }
+    }
+
+    #[inline]
+    fn view(&self) -> kernels::SurfaceView<'_> {
+        kernels::SurfaceView {
+            ku: &self.knots_u,
+            kv: &self.knots_v,
+            n_v: self.n_v,
+            ctrl: &self.ctrl,
+            weights: self.weights.as_deref(),
+        }
+    }
+
     /// Parameter domain `((u_min, u_max), (v_min, v_max))`.
     #[inline]
     pub fn domain(&self) -> ((f64, f64), (f64, f64)) {
@@ -314,6 +342,16 @@ impl NurbsSurface {
         let (pu, pv) = (self.degree_u(), self.degree_v());
         let (ku, kv) = (self.knots_u.knots(), self.knots_v.knots());
         let (u, v) = (clamp_param(ku, pu, u), clamp_param(kv, pv, v));
+        let view = self.view();
+        macro_rules! fast {
+            ($($a:literal, $b:literal);*) => {
+                match (pu, pv) {
+                    $(($a, $b) => return kernels::surface_point::<{ $a + 1 }, { $b + 1 }>(view, u, v),)*
+                    _ => {}
+                }
+            };
+        }
+        fast!(1, 1; 1, 2; 1, 3; 2, 1; 2, 2; 2, 3; 3, 1; 3, 2; 3, 3);
         let su = find_span(ku, pu, u);
         let sv = find_span(kv, pv, v);
         let nu = basis_funs_fixed(ku, pu, su, u);
@@ -361,6 +399,16 @@ impl NurbsSurface {
         let (pu, pv) = (self.degree_u(), self.degree_v());
         let (ku, kv) = (self.knots_u.knots(), self.knots_v.knots());
         let (u, v) = (clamp_param(ku, pu, u), clamp_param(kv, pv, v));
+        let view = self.view();
+        macro_rules! fast {
+            ($($a:literal, $b:literal);*) => {
+                match (pu, pv) {
+                    $(($a, $b) => return kernels::surface_derivs2::<{ $a + 1 }, { $b + 1 }>(view, u, v),)*
+                    _ => {}
+                }
+            };
+        }
+        fast!(1, 1; 1, 2; 1, 3; 2, 1; 2, 2; 2, 3; 3, 1; 3, 2; 3, 3);
         let su = find_span(ku, pu, u);
         let sv = find_span(kv, pv, v);
         let du = pu.min(2);
@@ -423,21 +471,7 @@ impl NurbsSurface {
                 }
             }
         }
-        let inv = 1.0 / w[0][0];
-        let s00 = a[0][0] * inv;
-        let s10 = (a[1][0] - s00 * w[1][0]) * inv;
-        let s01 = (a[0][1] - s00 * w[0][1]) * inv;
-        let s20 = (a[2][0] - s10 * (2.0 * w[1][0]) - s00 * w[2][0]) * inv;
-        let s02 = (a[0][2] - s01 * (2.0 * w[0][1]) - s00 * w[0][2]) * inv;
-        let s11 = (a[1][1] - s01 * w[1][0] - s10 * w[0][1] - s00 * w[1][1]) * inv;
-        SurfaceDerivs2 {
-            p: s00,
-            su: s10,
-            sv: s01,
-            suu: s20,
-            suv: s11,
-            svv: s02,
-        }
+        kernels::rational_correction(&a, &w)
     }
 
     /// All partial derivatives `SKL[k][l] = ∂^{k+l} S / ∂u^k ∂v^l` for `k + l <= n`
@@ -511,8 +545,64 @@ impl NurbsSurface {
         self.derivs2(u, v).normal()
     }
 
+    /// Applies a knot algorithm to every control line running along `dir` (columns for
+    /// `U`, rows for `V`) in homogeneous space and reassembles the surface. All lines get
+    /// the same new knot vector because the algorithms depend on the knots only.
+    pub(crate) fn map_lines(
+        &self,
+        dir: Direction,
+        f: impl Fn(&HSpline) -> HSpline,
+    ) -> Result<NurbsSurface, NurbsError> {
+        let (kv, count) = match dir {
+            Direction::U => (&self.knots_u, self.n_v),
+            Direction::V => (&self.knots_v, self.n_u),
+        };
+        let dim = if self.weights.is_some() { 4 } else { 3 };
+        let lines: Vec<HSpline> = (0..count)
+            .map(|idx| {
+                f(&HSpline {
+                    p: kv.degree(),
+                    knots: kv.knots().to_vec(),
+                    pts: self.homogeneous_line(dir, idx),
+                    dim,
+                })
+            })
+            .collect();
+        let Some(first) = lines.first() else {
+            return Ok(self.clone());
+        };
+        let new_kv =
+            KnotVector::new(first.p, first.knots.clone()).map_err(|e| e.in_direction(dir))?;
+        let len = first.n_ctrl();
+        let (n_u, n_v) = match dir {
+            Direction::U => (len, self.n_v),
+            Direction::V => (self.n_u, len),
+        };
+        let mut ctrl = vec![Vector3::zeros(); n_u * n_v];
+        let mut weights = self.weights.as_ref().map(|_| vec![1.0; n_u * n_v]);
+        for (line_idx, line) in lines.iter().enumerate() {
+            for (k, c) in line.pts.chunks_exact(dim).enumerate() {
+                let idx = match dir {
+                    Direction::U => k * n_v + line_idx,
+                    Direction::V => line_idx * n_v + k,
+                };
+                match weights.as_mut() {
+                    None => ctrl[idx] = Vector3::new(c[0], c[1], c[2]),
+                    Some(w) => {
+                        ctrl[idx] = Vector3::new(c[0] / c[3], c[1] / c[3], c[2] / c[3]);
+                        w[idx] = c[3];
+                    }
+                }
+            }
+        }
+        let (ku, kv) = match dir {
+            Direction::U => (new_kv, self.knots_v.clone()),
+            Direction::V => (self.knots_u.clone(), new_kv),
+        };
+        NurbsSurface::from_flat_checked(ku, kv, n_u, n_v, ctrl, weights)
+    }
+
     /// Homogeneous data of column `j` (points along `u`) or row `i` (along `v`).
-    #[allow(dead_code)]
     pub(crate) fn homogeneous_line(&self, dir: Direction, index: usize) -> Vec<f64> {
         let (count, stride, start) = match dir {
             Direction::U => (self.n_u, self.n_v, index),

@@ -221,3 +221,34 @@ fn degenerate_normal_is_none() {
     assert_eq!(s.normal(0.0, 0.5), None);
     assert!(s.normal(0.5, 0.5).is_some());
 }
+
+proptest! {
+    /// The degree-specialised kernels (degrees 1–3) agree with the general A2.3/A3.6 path
+    /// at the domain corners and exactly on knots, where span selection matters.
+    #[test]
+    fn fast_kernels_agree_with_general_path_on_knots(s in surface(true), iu in 0usize..20, iv in 0usize..20) {
+        let ku = s.knots_u().knots();
+        let kv = s.knots_v().knots();
+        let u = ku[iu % ku.len()];
+        let v = kv[iv % kv.len()];
+        let d = s.derivs2(u, v);
+        let full = s.derivs(u, v, 2);
+        for (a, b) in [(d.p, full[0][0]), (d.su, full[1][0]), (d.sv, full[0][1]),
+                       (d.suu, full[2][0]), (d.suv, full[1][1]), (d.svv, full[0][2])] {
+            prop_assert!((a - b).norm() <= 1e-11 * (1.0 + b.norm()), "{:?} vs {:?}", a, b);
+        }
+        prop_assert!((s.point(u, v) - full[0][0]).norm() <= 1e-12 * (1.0 + full[0][0].norm()));
+    }
+
+    #[test]
+    fn fast_curve_point_agrees_with_derivs_on_knots(c in curve3(true), i in 0usize..30) {
+        let k = c.knots().knots();
+        let u = k[i % k.len()];
+        let d = c.derivs(u, 2);
+        prop_assert!((c.point(u) - d[0]).norm() <= 1e-12 * (1.0 + d[0].norm()));
+        let d2 = c.derivs2(u);
+        for k in 0..3 {
+            prop_assert!((d2[k] - d[k]).norm() <= 1e-11 * (1.0 + d[k].norm()), "order {}", k);
+        }
+    }
+}

@@ -82,6 +82,85 @@ pub(crate) fn bernstein0(n: usize, t: f64, b0: &mut [f64; MAX_ORDER]) {
     }
 }
 
+/// Bernstein polynomials of order `N` (degree `N − 1`) with first and second derivatives,
+/// for compile-time `N` (the loops unroll).
+#[inline(always)]
+fn bernstein2_fixed<const N: usize>(t: f64) -> ([f64; N], [f64; N], [f64; N]) {
+    let s = 1.0 - t;
+    let n = N - 1;
+    // Levels of the triangle: keep degree n-2, n-1, n.
+    let mut lvl = [0.0; N];
+    let mut l1 = [0.0; N];
+    let mut l2 = [0.0; N];
+    lvl[0] = 1.0;
+    if n == 1 {
+        l1[0] = 1.0;
+    }
+    if n == 2 {
+        l2[0] = 1.0;
+    }
+    for k in 1..N {
+        let mut prev = 0.0;
+        for i in 0..N {
+            if i <= k {
+                let cur = lvl[i];
+                lvl[i] = s * cur + t * prev;
+                prev = cur;
+            }
+        }
+        if k + 2 == n {
+            l2 = lvl;
+        }
+        if k + 1 == n {
+            l1 = lvl;
+        }
+    }
+    let nf = n as f64;
+    let mut b1 = [0.0; N];
+    let mut b2 = [0.0; N];
+    for i in 0..N {
+        let a = if i >= 1 { l1[i - 1] } else { 0.0 };
+        let b = if i < n { l1[i] } else { 0.0 };
+        b1[i] = nf * (a - b);
+        if n >= 2 {
+            let a = if i >= 2 { l2[i - 2] } else { 0.0 };
+            let b = if i >= 1 && i < n { l2[i - 1] } else { 0.0 };
+            let d = if i + 2 <= n { l2[i] } else { 0.0 };
+            b2[i] = nf * (nf - 1.0) * (a - 2.0 * b + d);
+        }
+    }
+    (lvl, b1, b2)
+}
+
+/// Turns the homogeneous tensor sums `a = [A, A_t, A_s, A_tt, A_ts, A_ss]` into Euclidean
+/// derivatives (quotient rule, NURBS Book eq. 4.20) scaled from local to global parameters.
+#[inline(always)]
+fn finish_derivs(a: &[[f64; 4]; 6], rational: bool, du: f64, dv: f64) -> SurfaceDerivs2 {
+    let v3 = |x: &[f64; 4]| Vector3::new(x[0], x[1], x[2]);
+    let (p, su, sv, suu, suv, svv) = if rational {
+        let wt = a[0][3];
+        let (wu, wv, wuu, wuv, wvv) = (a[1][3], a[2][3], a[3][3], a[4][3], a[5][3]);
+        let inv = 1.0 / wt;
+        let p = v3(&a[0]) * inv;
+        let su = (v3(&a[1]) - p * wu) * inv;
+        let sv = (v3(&a[2]) - p * wv) * inv;
+        let suu = (v3(&a[3]) - su * (2.0 * wu) - p * wuu) * inv;
+        let suv = (v3(&a[4]) - su * wv - sv * wu - p * wuv) * inv;
+        let svv = (v3(&a[5]) - sv * (2.0 * wv) - p * wvv) * inv;
+        (p, su, sv, suu, suv, svv)
+    } else {
+        (v3(&a[0]), v3(&a[1]), v3(&a[2]), v3(&a[3]), v3(&a[4]), v3(&a[5]))
+    };
+    SurfaceDerivs2 {
+        p,
+        su: su * du,
+        sv: sv * dv,
+        suu: suu * (du * du),
+        suv: suv * (du * dv),
+        svv: svv * (dv * dv),
+    }
+}
+
 /// One rational (or polynomial) Bézier patch on the parameter box `[u0,u1]×[v0,v1]`.
 #[derive(Debug, Clone)]
 pub(crate) struct BezierPatch {
@@ -105,9 +184,66 @@ impl BezierPatch {
     }
 
     /// Point and derivatives up to order two at global parameters `(u, v)` (extrapolates
-    /// polynomially outside the box). O((p+1)(q+1)), no allocation.
+    /// polynomially outside the box). O((p+1)(q+1)), no allocation. Degrees up to 3 run a
+    /// kernel specialised at compile time (fully unrolled).
     #[inline]
     pub fn derivs2(&self, u: f64, v: f64) -> SurfaceDerivs2 {
+        macro_rules! fixed {
+            ($($p:literal, $q:literal);*) => {
+                match (self.p, self.q, self.rational) {
+                    $(($p, $q, false) => return self.derivs2_fixed::<{ $p + 1 }, { $q + 1 }, false>(u, v),
+                      ($p, $q, true) => return self.derivs2_fixed::<{ $p + 1 }, { $q + 1 }, true>(u, v),)*
+                    _ => {}
+                }
+            };
+        }
+        fixed!(1, 1; 1, 2; 1, 3; 2, 1; 2, 2; 2, 3; 3, 1; 3, 2; 3, 3);
+        self.derivs2_generic(u, v)
+    }
+
+    /// [`Self::derivs2`] for compile-time orders `PU = p + 1`, `QV = q + 1`.
+    #[inline(always)]
+    fn derivs2_fixed<const PU: usize, const QV: usize, const R: bool>(
+        &self,
+        u: f64,
+        v: f64,
+    ) -> SurfaceDerivs2 {
+        let du = 1.0 / (self.u1 - self.u0);
+        let dv = 1.0 / (self.v1 - self.v0);
+        let (bu0, bu1, bu2) = bernstein2_fixed::<PU>((u - self.u0) * du);
+        let (bv0, bv1, bv2) = bernstein2_fixed::<QV>((v - self.v0) * dv);
+        let mut a = [[0.0f64; 4]; 6];
+        let pw = &self.pw[..PU * QV];
+        for i in 0..PU {
+            let mut t0 = [0.0f64; 4];
+            let mut t1 = [0.0f64; 4];
+            let mut t2 = [0.0f64; 4];
+            for j in 0..QV {
+                let c = &pw[i * QV + j];
+                for k in 0..4 {
+                    if k < 3 || R {
+                        t0[k] += bv0[j] * c[k];
+                        t1[k] += bv1[j] * c[k];
+                        t2[k] += bv2[j] * c[k];
+                    }
+                }
+            }
+            for k in 0..4 {
+                if k < 3 || R {
+                    a[0][k] += bu0[i] * t0[k];
+                    a[1][k] += bu1[i] * t0[k];
+                    a[2][k] += bu0[i] * t1[k];
+                    a[3][k] += bu2[i] * t0[k];
+                    a[4][k] += bu1[i] * t1[k];
+                    a[5][k] += bu0[i] * t2[k];
+                }
+            }
+        }
+        finish_derivs(&a, R, du, dv)
+    }
+
+    /// Generic-degree version of [`Self::derivs2`].
+    fn derivs2_generic(&self, u: f64, v: f64) -> SurfaceDerivs2 {
         let du = 1.0 / (self.u1 - self.u0);
         let dv = 1.0 / (self.v1 - self.v0);
         let t = (u - self.u0) * du;
@@ -141,41 +277,7 @@ impl BezierPatch {
                 a[5][k] += bu0[i] * t2[k];
             }
         }
-        let v3 = |x: &[f64; 4]| Vector3::new(x[0], x[1], x[2]);
-        let (p, mut su, mut sv, mut suu, mut suv, mut svv) = if self.rational {
-            let wt = a[0][3];
-            let (wu, wv, wuu, wuv, wvv) = (a[1][3], a[2][3], a[3][3], a[4][3], a[5][3]);
-            let inv = 1.0 / wt;
-            let p = v3(&a[0]) * inv;
-            let su = (v3(&a[1]) - p * wu) * inv;
-            let sv = (v3(&a[2]) - p * wv) * inv;
-            let suu = (v3(&a[3]) - su * (2.0 * wu) - p * wuu) * inv;
-            let suv = (v3(&a[4]) - su * wv - sv * wu - p * wuv) * inv;
-            let svv = (v3(&a[5]) - sv * (2.0 * wv) - p * wvv) * inv;
-            (p, su, sv, suu, suv, svv)
-        } else {
-            (
-                v3(&a[0]),
-                v3(&a[1]),
-                v3(&a[2]),
-                v3(&a[3]),
-                v3(&a[4]),
-                v3(&a[5]),
-            )
-        };
-        su *= du;
-        sv *= dv;
-        suu *= du * du;
-        suv *= du * dv;
-        svv *= dv * dv;
-        SurfaceDerivs2 {
-            p,
-            su,
-            sv,
-            suu,
-            suv,
-            svv,
-        }
+        finish_derivs(&a, self.rational, du, dv)
     }
 
     /// Point at global parameters `(u, v)`.

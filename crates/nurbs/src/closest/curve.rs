@@ -266,6 +266,9 @@ impl<const D: usize> CurveProjector<D> {
                 break;
             }
             let du = -g / h;
+            if (e[1] * ((u + du).clamp(lo, hi) - u)).norm() <= self.step_tol {
+                break;
+            }
             let mut t = 1.0;
             let mut accepted = None;
             for _ in 0..12 {

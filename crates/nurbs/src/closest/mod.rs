@@ -12,6 +12,11 @@ pub(crate) mod decompose;
 mod newton;
 mod surface;
 
+/// Bounding volumes shared with the projection module.
+pub(crate) mod surface_bounds {
+    pub(crate) use super::surface::Obb;
+}
+
 pub use curve::{closest_point_on_curve, CurvePoint, CurveProjector};
 pub use surface::{SurfacePoint, SurfaceProjector};
 

@@ -110,6 +110,14 @@ pub(crate) fn minimise<F: Fn(f64, f64) -> SurfaceDerivs2>(
                 }
             }
         };
+        // Stop when the (projected) Newton step is below the tolerance: the iteration
+        // converges quadratically, so the error left is far below `step_tol`.
+        let pu = (u + du).clamp(lo.0, hi.0) - u;
+        let pv = (v + dv).clamp(lo.1, hi.1) - v;
+        if (e.su * pu + e.sv * pv).norm() <= step_tol {
+            converged = true;
+            break;
+        }
         // Backtracking on the projected step.
         let mut t = 1.0;
         let mut accepted = false;

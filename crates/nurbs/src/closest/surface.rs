@@ -379,17 +379,19 @@ impl SurfaceProjector {
                 best = Some((l, l.converged));
             }
         }
-        let mut stack = [0u32; 64];
+        // Depth-first walk, nearer child first; each stack entry keeps its box distance so
+        // it is re-tested against the (possibly improved) bound when popped.
+        let mut stack = [(0u32, 0.0f64); 64];
         let mut sp = 1usize;
-        stack[0] = 0;
         let mut solves = 0usize;
         while sp > 0 {
             sp -= 1;
-            let node = self.nodes[stack[sp] as usize];
+            let (index, d2) = stack[sp];
             let bound = best.map_or(f64::INFINITY, |b| b.0.d2);
-            if node.aabb.dist2(q) >= bound {
+            if d2 >= bound {
                 continue;
             }
+            let node = &self.nodes[index as usize];
             if node.right == u32::MAX {
                 if solves >= MAX_LEAF_SOLVES {
                     continue;
@@ -402,16 +404,16 @@ impl SurfaceProjector {
                 }
                 continue;
             }
-            let (l, r) = (node.left as usize, node.right as usize);
-            let dl = self.nodes[l].aabb.dist2(q);
-            let dr = self.nodes[r].aabb.dist2(q);
-            let (near, far, dfar) = if dl <= dr { (l, r, dr) } else { (r, l, dl) };
-            if dfar < bound && sp < stack.len() {
-                stack[sp] = far as u32;
+            let (l, r) = (node.left, node.right);
+            let dl = self.nodes[l as usize].aabb.dist2(q);
+            let dr = self.nodes[r as usize].aabb.dist2(q);
+            let ((near, dn), (far, df)) = if dl <= dr { ((l, dl), (r, dr)) } else { ((r, dr), (l, dl)) };
+            if df < bound && sp < stack.len() {
+                stack[sp] = (far, df);
                 sp += 1;
             }
-            if sp < stack.len() {
-                stack[sp] = near as u32;
+            if dn < bound && sp < stack.len() {
+                stack[sp] = (near, dn);
                 sp += 1;
             }
         }
@@ -473,8 +475,19 @@ impl SurfaceProjector {
                 _ => {}
             }
         }
+        let patch = &self.patches[leaf.patch];
         let mut start = (leaf.samples[0].0, leaf.samples[0].1);
         let mut d_start = f64::INFINITY;
+        if let Some((b, _)) = best {
+            // The current best clamped into the leaf: near a shared edge this starts Newton
+            // next to the leaf's own minimum.
+            let cu = b.u.clamp(leaf.u0, leaf.u1);
+            let cv = b.v.clamp(leaf.v0, leaf.v1);
+            if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0) && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0) {
+                start = (cu, cv);
+                d_start = (patch.point(cu, cv) - q).norm_squared();
+            }
+        }
         for (u, v, p) in &leaf.samples {
             let d = (p - q).norm_squared();
             if d < d_start {
@@ -482,7 +495,6 @@ impl SurfaceProjector {
                 start = (*u, *v);
             }
         }
-        let patch = &self.patches[leaf.patch];
         let l = minimise(
             |u, v| patch.derivs2(u, v),
             q,

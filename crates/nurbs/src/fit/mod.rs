@@ -15,6 +15,7 @@ mod curve_approx;
 mod curve_interp;
 mod error;
 mod params;
+mod skin;
 
 mod solve;
 mod surface_interp;
@@ -25,5 +26,6 @@ pub use curve_approx::{
 pub use curve_interp::interpolate_curve;
 pub use error::FitError;
 pub use params::{averaged_knots, parameters, Parametrisation};
+pub use skin::skin;
 
 pub use surface_interp::interpolate_surface;

@@ -44,3 +44,28 @@ pub(crate) fn solve_lstsq(a: &Mat<f64>, b: &Mat<f64>) -> Result<Mat<f64>, FitErr
     }
     Ok(x)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rank_deficiency_is_reported() {
+        // Second column zero: rank 1 of 2.
+        let a = Mat::from_fn(3, 2, |i, j| if j == 0 { 1.0 + i as f64 } else { 0.0 });
+        let b = Mat::from_fn(3, 1, |i, _| i as f64);
+        assert_eq!(
+            solve_lstsq(&a, &b).unwrap_err(),
+            FitError::SingularSystem { rank: 1, cols: 2 }
+        );
+        // Fewer rows than unknowns.
+        let a = Mat::from_fn(1, 2, |_, j| 1.0 + j as f64);
+        let b = Mat::from_fn(1, 1, |_, _| 1.0);
+        assert!(matches!(solve_lstsq(&a, &b), Err(FitError::SingularSystem { .. })));
+        // A regular system is solved.
+        let a = Mat::from_fn(2, 2, |i, j| if i == j { 2.0 } else { 0.0 });
+        let b = Mat::from_fn(2, 1, |i, _| 4.0 * (i + 1) as f64);
+        let x = solve_lstsq(&a, &b).unwrap();
+        assert!((x[(0, 0)] - 2.0).abs() < 1e-15 && (x[(1, 0)] - 4.0).abs() < 1e-15);
+    }
+}

@@ -22,20 +22,44 @@ pub fn knots_from(degree: usize, n_ctrl: usize, gaps: &[f64], a: f64, b: f64) ->
     knots
 }
 
+/// Clamped knot vector on [a, b] with `spans` non-empty spans of relative sizes `gaps` and
+/// interior multiplicities `mult` (each clipped to `degree`).
+pub fn knots_with_mult(degree: usize, gaps: &[f64], mult: &[usize], a: f64, b: f64) -> Vec<f64> {
+    let total: f64 = gaps.iter().sum();
+    let mut knots = vec![a; degree + 1];
+    let mut acc = 0.0;
+    for (gi, m) in gaps[..gaps.len() - 1].iter().zip(mult) {
+        acc += gi;
+        let k = a + (b - a) * acc / total;
+        knots.extend(std::iter::repeat_n(k, (*m).clamp(1, degree)));
+    }
+    knots.extend(std::iter::repeat_n(b, degree + 1));
+    knots
+}
+
+/// Random valid curve: degree 1..=5, 1..=5 spans, interior multiplicities 1..=degree
+/// (multiplicity > 1 with probability ~1/4), control points in [-10, 10]³, weights in
+/// [0.5, 2] when rational.
 pub fn curve3(rational: bool) -> impl Strategy<Value = NurbsCurve<3>> {
-    (1usize..=5, 0usize..=5).prop_flat_map(move |(p, extra)| {
-        let n = p + 1 + extra;
+    (1usize..=5, 1usize..=5).prop_flat_map(move |(p, spans)| {
+        let max_ctrl = p + 1 + (spans - 1) * p;
         (
             Just(p),
-            prop::collection::vec(1.0f64..4.0, n),
-            prop::collection::vec(prop::array::uniform3(-10.0f64..10.0), n),
-            prop::collection::vec(0.5f64..2.0, n),
+            prop::collection::vec(1.0f64..4.0, spans),
+            prop::collection::vec(prop_oneof![3 => Just(1usize), 1 => 2usize..=5], spans),
+            prop::collection::vec(prop::array::uniform3(-10.0f64..10.0), max_ctrl),
+            prop::collection::vec(0.5f64..2.0, max_ctrl),
             -3.0f64..3.0,
             0.5f64..4.0,
         )
-            .prop_map(move |(p, gaps, pts, w, a, len)| {
-                let knots = knots_from(p, pts.len(), &gaps, a, a + len);
-                let ctrl = pts.iter().map(|c| SVector::<f64, 3>::from(*c)).collect();
+            .prop_map(move |(p, gaps, mult, pts, w, a, len)| {
+                let knots = knots_with_mult(p, &gaps, &mult, a, a + len);
+                let n = knots.len() - p - 1;
+                let ctrl = pts[..n]
+                    .iter()
+                    .map(|c| SVector::<f64, 3>::from(*c))
+                    .collect();
+                let w = w[..n].to_vec();
                 NurbsCurve::new(p, knots, ctrl, rational.then_some(w)).unwrap()
             })
     })
