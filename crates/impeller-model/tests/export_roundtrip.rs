@@ -1,0 +1,102 @@
+//! Import → export (TurboGrid curve files) → import reproduces the geometry within the fit
+//! tolerance.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)]
+
+mod import_common;
+
+use impeller_model::channel::edge_v;
+use impeller_model::export::{write_curves, CurveSampling};
+use impeller_model::import::{import_file, ImportOptions, Imported};
+use impeller_model::{Impeller, Side};
+use nurbs::closest::SurfaceProjector;
+use std::path::{Path, PathBuf};
+
+fn tmp_dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("impeller-export-rt-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// Largest distance from points of `a` (blade sides between hub and shroud, contours) to
+/// the corresponding geometry of `b`.
+fn deviation(a: &Impeller, b: &Impeller) -> f64 {
+    let mut worst: f64 = 0.0;
+    for (ma, mb) in [
+        (a.hub().meridional(), b.hub().meridional()),
+        (a.shroud().meridional(), b.shroud().meridional()),
+    ] {
+        for k in 0..=50 {
+            let p = ma.point_at_fraction(k as f64 / 50.0);
+            worst = worst.max(mb.closest(p).1.abs());
+        }
+    }
+    let rows = [(a.main().blade(), b.main().blade())];
+    let split = a
+        .splitter()
+        .map(|s| s.blade())
+        .zip(b.splitter().map(|s| s.blade()));
+    for (ba, bb) in rows.into_iter().chain(split) {
+        for side in [Side::Pressure, Side::Suction] {
+            let sa = ba.side(side);
+            let proj = SurfaceProjector::new(bb.side(side));
+            let ((u0, u1), (v0, v1)) = sa.domain();
+            for i in 1..20 {
+                let u = u0 + (u1 - u0) * i as f64 / 20.0;
+                let vh = edge_v(ba, side, a.hub(), u).unwrap_or(v0);
+                let vs = edge_v(ba, side, a.shroud(), u).unwrap_or(v1);
+                for j in 0..=6 {
+                    let v = vh + (vs - vh) * j as f64 / 6.0;
+                    worst = worst.max(proj.closest_point(&sa.point(u, v)).distance);
+                }
+            }
+        }
+    }
+    worst
+}
+
+fn round_trip(path: &Path, tag: &str, opts: &ImportOptions) -> (Imported, Imported, f64) {
+    let first = import_file(path, opts).unwrap();
+    let dir = tmp_dir(tag);
+    let files = write_curves(&first.impeller, &dir, "export", &CurveSampling::default()).unwrap();
+    let second = import_file(&files.inf, opts).unwrap();
+    let dev = deviation(&first.impeller, &second.impeller);
+    eprintln!(
+        "{tag}: round-trip deviation {dev:.2e} mm (fits {:.2e} / {:.2e} mm)",
+        first.fitted.max_fit_mm(),
+        second.fitted.max_fit_mm()
+    );
+    // No temporary files are left behind.
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(!name.contains(".tmp-"), "{name}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    (first, second, dev)
+}
+
+#[test]
+fn centrifugal_round_trip() {
+    let opts = ImportOptions::default();
+    let (a, b, dev) = round_trip(&import_common::centrifugal_geomturbo(), "cc", &opts);
+    let (sa, sb) = (a.impeller.summary(), b.impeller.summary());
+    assert_eq!(
+        (sa.main_blade_count, sa.splitter_blade_count),
+        (sb.main_blade_count, sb.splitter_blade_count)
+    );
+    assert!(dev <= opts.fit_tol_mm, "{dev}");
+}
+
+#[test]
+fn rtzt_sample_round_trip() {
+    let opts = ImportOptions::default();
+    let (_, _, dev) = round_trip(&import_common::sample("sample-6+6.rtzt"), "rtzt", &opts);
+    assert!(dev <= opts.fit_tol_mm, "{dev}");
+}
+
+#[test]
+fn rotor37_round_trip() {
+    let opts = ImportOptions::default();
+    let (_, _, dev) = round_trip(&import_common::rotor37_inf(), "r37", &opts);
+    assert!(dev <= opts.fit_tol_mm, "{dev}");
+}
