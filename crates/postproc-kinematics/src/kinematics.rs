@@ -1,0 +1,380 @@
+//! Forward and inverse kinematics of the three machine structures, solution choice by limits
+//! and continuity, singularity handling and unwinding of continuous axes.
+//!
+//! Every structure shares one orientation chain: the tool axis in the workpiece frame is
+//! `u = Rz(ψ)·R_k(θ)·u₀` with `ψ = s_c·C`, `θ = s_t·T` (T the tilt angle A or B about the unit
+//! direction `k` = X or Y, `u₀` the spindle direction at zero angles, `s_c`, `s_t` = ±1 the
+//! axis senses). Positions:
+//!
+//! * table-table (LinuxCNC `xyzac-trt` / `xyzbc-trt`, `trtfuncs.c`): the table-fixed world
+//!   point is `P = r + Rz(ψ)·(o + R_k(θ)·(J − r − o))` with `r` the C-axis rotation point, `o`
+//!   the tilt-axis offset and `s_c = s_t = +1` for `conventional_directions`, `−1` otherwise
+//!   (LinuxCNC's default). Tool length does not enter (G43 active: J is the tool tip).
+//! * head-table (the B-C turn-milling centre, paper 003 eqs. 3–6): the tip in the machine
+//!   frame is `T = J + L·(u₀ − R_k(θ)u₀)` with `L` = pivot length + tool length, and the
+//!   table-fixed point `P = r + Rz(ψ)·(T − r)`.
+//! * head-head (fork head): `P = J + L·(u₀ − u)`.
+//!
+//! In all three `P` is the tip in the machine frame at zero table angles; the CL tip is
+//! `P − workpiece_origin`.
+//!
+//! Inverse: `u_z = u₀_z·cos θ + (k×u₀)_z·sin θ` (rotation about Z keeps the z component) gives
+//! the two tilt solutions `θ = φ ± acos(u_z/R)`; for each, `ψ = atan2(u_y,u_x) − atan2(v_y,v_x)`
+//! with `v = R_k(θ)u₀`; positions follow in closed form. Constant time per pose, no
+//! allocation.
+
+use crate::error::KinematicsError;
+use crate::joints::{AxisId, Joints};
+use crate::machine::{AxisSpec, Kinematics, Machine, RotaryMode, TiltAxis};
+use cam_core::{CutterLocation, Point3, UnitVector3, Vector3};
+use std::f64::consts::TAU;
+
+/// Slack when testing limits (mm for linear axes, rad for rotary axes): values within it of
+/// a limit count as inside.
+pub const LIMIT_SLACK: f64 = 1e-9;
+
+#[inline]
+fn rot_z(psi: f64, v: &Vector3) -> Vector3 {
+    let (s, c) = psi.sin_cos();
+    Vector3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
+}
+
+#[inline]
+fn rot_tilt(axis: TiltAxis, theta: f64, v: &Vector3) -> Vector3 {
+    let (s, c) = theta.sin_cos();
+    match axis {
+        TiltAxis::A => Vector3::new(v.x, c * v.y - s * v.z, s * v.y + c * v.z),
+        TiltAxis::B => Vector3::new(c * v.x + s * v.z, v.y, -s * v.x + c * v.z),
+    }
+}
+
+/// Orientation chain constants of a machine.
+#[derive(Debug, Clone, Copy)]
+struct Chain {
+    tilt: TiltAxis,
+    u0: Vector3,
+    s_t: f64,
+    s_c: f64,
+}
+
+impl Machine {
+    fn chain(&self) -> Chain {
+        match &self.kinematics {
+            Kinematics::TableTable(k) => {
+                let s = if k.conventional_directions { 1.0 } else { -1.0 };
+                Chain {
+                    tilt: k.tilt_axis,
+                    u0: Vector3::z(),
+                    s_t: s,
+                    s_c: s,
+                }
+            }
+            Kinematics::HeadTable(k) => Chain {
+                tilt: k.tilt_axis,
+                u0: k.spindle_direction.into_inner(),
+                s_t: k.tilt_sign,
+                s_c: k.rotary_sign,
+            },
+            Kinematics::HeadHead(k) => Chain {
+                tilt: k.tilt_axis,
+                u0: k.spindle_direction.into_inner(),
+                s_t: k.tilt_sign,
+                s_c: k.rotary_sign,
+            },
+        }
+    }
+
+    /// Tool axis (tip → spindle) in the machine frame at zero rotary angles (`u₀`): +Z for
+    /// table-table machines, the configured `spindle_direction` for head machines. Joint X Y Z
+    /// of head machines assume tool length compensation along it; a program without tool
+    /// length compensation adds `tool_length·u₀` to X Y Z.
+    pub fn zero_spindle_direction(&self) -> UnitVector3 {
+        UnitVector3::new_normalize(self.chain().u0)
+    }
+
+    /// Tool axis (tip → spindle, workpiece frame) produced by the rotary angles (rad).
+    pub fn tool_axis(&self, tilt: f64, rotate: f64) -> UnitVector3 {
+        let ch = self.chain();
+        let u = rot_z(ch.s_c * rotate, &rot_tilt(ch.tilt, ch.s_t * tilt, &ch.u0));
+        UnitVector3::new_normalize(u)
+    }
+
+    /// The tool tip in the machine frame at zero table angles (`cl.tip + workpiece_origin`):
+    /// the X Y Z a controller in tool-centre-point mode expects (LinuxCNC `xyzac-trt` /
+    /// `xyzbc-trt` world coordinates with G43 active and a zero work offset; Fanuc G43.4,
+    /// Sinumerik TRAORI, Heidenhain M128 likewise program the tip in the workpiece frame).
+    pub fn tcp_point(&self, cl: &CutterLocation) -> Point3 {
+        Point3::from(cl.tip.coords + self.workpiece_origin)
+    }
+
+    /// Forward kinematics: the cutter location (tip in the workpiece frame, tool axis) that
+    /// the joint values produce with a tool of length `tool_length` (mm, gauge line to tip;
+    /// ignored by table-table machines, whose X Y Z are tool-tip coordinates).
+    pub fn forward(&self, j: &Joints, tool_length: f64) -> CutterLocation {
+        let ch = self.chain();
+        let theta = ch.s_t * j.tilt;
+        let psi = ch.s_c * j.rotate;
+        let jv = Vector3::new(j.x, j.y, j.z);
+        let (p, u) = match &self.kinematics {
+            Kinematics::TableTable(k) => {
+                let r = k.rot_point.coords;
+                let o = k.offset;
+                let p = r + rot_z(psi, &(o + rot_tilt(ch.tilt, theta, &(jv - r - o))));
+                let u = rot_z(psi, &rot_tilt(ch.tilt, theta, &ch.u0));
+                (p, u)
+            }
+            Kinematics::HeadTable(k) => {
+                let l = k.pivot_length + tool_length;
+                let vm = rot_tilt(ch.tilt, theta, &ch.u0);
+                let t = jv + (ch.u0 - vm) * l;
+                let r = k.rot_point.coords;
+                (r + rot_z(psi, &(t - r)), rot_z(psi, &vm))
+            }
+            Kinematics::HeadHead(k) => {
+                let l = k.pivot_length + tool_length;
+                let u = rot_z(psi, &rot_tilt(ch.tilt, theta, &ch.u0));
+                (jv + (ch.u0 - u) * l, u)
+            }
+        };
+        CutterLocation {
+            tip: Point3::from(p - self.workpiece_origin),
+            axis: UnitVector3::new_normalize(u),
+        }
+    }
+
+    /// Linear-axis values that put the tool tip on `tip` (workpiece frame) when the rotary
+    /// axes stand at `tilt`, `rotate` (rad); the tool axis is then
+    /// [`Machine::tool_axis`]`(tilt, rotate)`. Used to recompute positions after the angles
+    /// were changed (reverse-motion smoothing).
+    pub fn joints_for_angles(
+        &self,
+        tip: &Point3,
+        tool_length: f64,
+        tilt: f64,
+        rotate: f64,
+    ) -> Joints {
+        let ch = self.chain();
+        let theta = ch.s_t * tilt;
+        let psi = ch.s_c * rotate;
+        let p = tip.coords + self.workpiece_origin;
+        let jv = match &self.kinematics {
+            Kinematics::TableTable(k) => {
+                let r = k.rot_point.coords;
+                let o = k.offset;
+                r + o + rot_tilt(ch.tilt, -theta, &(rot_z(-psi, &(p - r)) - o))
+            }
+            Kinematics::HeadTable(k) => {
+                let l = k.pivot_length + tool_length;
+                let r = k.rot_point.coords;
+                let t = r + rot_z(-psi, &(p - r));
+                let vm = rot_tilt(ch.tilt, theta, &ch.u0);
+                t - (ch.u0 - vm) * l
+            }
+            Kinematics::HeadHead(k) => {
+                let l = k.pivot_length + tool_length;
+                let u = rot_z(psi, &rot_tilt(ch.tilt, theta, &ch.u0));
+                p - (ch.u0 - u) * l
+            }
+        };
+        Joints {
+            x: jv.x,
+            y: jv.y,
+            z: jv.z,
+            tilt,
+            rotate,
+        }
+    }
+
+    /// The raw rotary solutions `(tilt, rotate)` (rad, not yet shifted by multiples of 2π) for
+    /// a tool axis: two tilt signs. At a singular pose (tool axis within
+    /// [`Machine::singularity_tol`] of the C axis) the rotate angle is `hold_rotate`.
+    pub fn rotary_solutions(
+        &self,
+        axis: &UnitVector3,
+        hold_rotate: f64,
+    ) -> Result<[(f64, f64); 2], KinematicsError> {
+        let ch = self.chain();
+        let u = axis.into_inner();
+        let k = ch.tilt.direction();
+        let w = k.cross(&ch.u0);
+        let r = ch.u0.z.hypot(w.z);
+        let phi = w.z.atan2(ch.u0.z);
+        let ratio = u.z / r;
+        if ratio.is_nan() || ratio.abs() > 1.0 + 1e-12 {
+            return Err(KinematicsError::UnreachableOrientation(u.x, u.y, u.z));
+        }
+        let delta = ratio.clamp(-1.0, 1.0).acos();
+        let ru = u.x.hypot(u.y);
+        let singular = ru < self.singularity_tol.sin();
+        let mut out = [(0.0, 0.0); 2];
+        for (slot, theta) in out.iter_mut().zip([phi + delta, phi - delta]) {
+            let psi = if singular {
+                ch.s_c * hold_rotate
+            } else {
+                let v = rot_tilt(ch.tilt, theta, &ch.u0);
+                u.y.atan2(u.x) - v.y.atan2(v.x)
+            };
+            *slot = (ch.s_t * theta, ch.s_c * psi);
+        }
+        Ok(out)
+    }
+
+    /// Inverse kinematics: joint values that put the tool tip on `cl.tip` with the tool axis
+    /// `cl.axis`.
+    ///
+    /// Of the two tilt-sign solutions and the 2π-equivalents of each rotary angle, the choice
+    /// is (1) within all axis limits, then (2) the smallest rotary travel
+    /// `|ΔT| + |ΔC|` from `prev` (or from the home position when `prev` is `None`). At a
+    /// singular pose (tool axis parallel to the C axis) C keeps its previous value. Continuous
+    /// axes take the equivalent angle nearest the previous one (they unwind only where the
+    /// caller asks, see [`Machine::unwind`]).
+    ///
+    /// Errors: non-finite input; an orientation the rotary axes cannot produce; no solution
+    /// within limits — the error names the violated axis of the closest solution.
+    pub fn inverse(
+        &self,
+        cl: &CutterLocation,
+        tool_length: f64,
+        prev: Option<&Joints>,
+    ) -> Result<Joints, KinematicsError> {
+        match self.inverse_best_effort(cl, tool_length, prev)? {
+            (j, None) => Ok(j),
+            (_, Some(e)) => Err(e),
+        }
+    }
+
+    /// Like [`Machine::inverse`], but when no solution lies within the limits it still returns
+    /// the closest one (by the same choice rule) together with the limit error, so a caller
+    /// can report violations instead of stopping.
+    pub fn inverse_best_effort(
+        &self,
+        cl: &CutterLocation,
+        tool_length: f64,
+        prev: Option<&Joints>,
+    ) -> Result<(Joints, Option<KinematicsError>), KinematicsError> {
+        if !(cl.tip.x.is_finite() && cl.tip.y.is_finite() && cl.tip.z.is_finite()) {
+            return Err(KinematicsError::NonFinite("tool tip"));
+        }
+        let a = cl.axis.into_inner();
+        if !(a.x.is_finite() && a.y.is_finite() && a.z.is_finite()) {
+            return Err(KinematicsError::NonFinite("tool axis"));
+        }
+        if !tool_length.is_finite() {
+            return Err(KinematicsError::NonFinite("tool length"));
+        }
+        let reference = prev.copied().unwrap_or(self.home);
+        let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
+        let tilt_spec = self.axis(AxisId::Tilt);
+        let rot_spec = self.axis(AxisId::Rotate);
+        let mut best: Option<(f64, Joints)> = None;
+        let mut fallback: Option<(f64, Joints)> = None;
+        for (t, c) in sols {
+            let (t, t_ok) = equivalent_angle(t, tilt_spec, reference.tilt);
+            let (c, c_ok) = equivalent_angle(c, rot_spec, reference.rotate);
+            let j = self.joints_for_angles(&cl.tip, tool_length, t, c);
+            let cost = (t - reference.tilt).abs() + (c - reference.rotate).abs();
+            let feasible = t_ok && c_ok && self.check_limits(&j, LIMIT_SLACK).is_ok();
+            let slot = if feasible { &mut best } else { &mut fallback };
+            if slot.as_ref().is_none_or(|(bc, _)| cost < *bc) {
+                *slot = Some((cost, j));
+            }
+        }
+        match (best, fallback) {
+            (Some((_, j)), _) => Ok((j, None)),
+            (None, Some((_, j))) => match self.check_limits(&j, LIMIT_SLACK) {
+                Err(e) => Ok((j, Some(e))),
+                Ok(()) => Err(KinematicsError::UnreachableOrientation(a.x, a.y, a.z)),
+            },
+            (None, None) => Err(KinematicsError::UnreachableOrientation(a.x, a.y, a.z)),
+        }
+    }
+
+    /// All postures that reach `cl` within the limits: both tilt signs and, for each, the
+    /// 2π-equivalents of the rotary angles next to the one nearest `reference` (at most three
+    /// per axis). Used to look ahead along a path when the greedy choice runs into a limit.
+    pub fn inverse_candidates(
+        &self,
+        cl: &CutterLocation,
+        tool_length: f64,
+        reference: &Joints,
+    ) -> Result<Vec<Joints>, KinematicsError> {
+        let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
+        let tilt_spec = self.axis(AxisId::Tilt);
+        let rot_spec = self.axis(AxisId::Rotate);
+        let mut out = Vec::new();
+        for (t, c) in sols {
+            let (t0, _) = equivalent_angle(t, tilt_spec, reference.tilt);
+            let (c0, _) = equivalent_angle(c, rot_spec, reference.rotate);
+            for dt in [-TAU, 0.0, TAU] {
+                for dc in [-TAU, 0.0, TAU] {
+                    let (tt, cc) = (t0 + dt, c0 + dc);
+                    if !tilt_spec.contains(tt, LIMIT_SLACK) || !rot_spec.contains(cc, LIMIT_SLACK) {
+                        continue;
+                    }
+                    if matches!(tilt_spec.mode, RotaryMode::Continuous) && dt != 0.0 {
+                        continue;
+                    }
+                    if matches!(rot_spec.mode, RotaryMode::Continuous) && dc != 0.0 {
+                        continue;
+                    }
+                    let j = self.joints_for_angles(&cl.tip, tool_length, tt, cc);
+                    if self.check_limits(&j, LIMIT_SLACK).is_ok()
+                        && !out.iter().any(|o: &Joints| {
+                            (o.tilt - tt).abs() < 1e-12 && (o.rotate - cc).abs() < 1e-12
+                        })
+                    {
+                        out.push(j);
+                    }
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Reduces continuous rotary axes to the equivalent angle in (−π, π] and recomputes the
+    /// linear axes (unchanged for a pure 2π shift). Returns `true` when a value changed.
+    pub fn unwind(&self, j: &mut Joints) -> bool {
+        let mut changed = false;
+        for a in [AxisId::Tilt, AxisId::Rotate] {
+            if matches!(self.axis(a).mode, RotaryMode::Continuous) {
+                let v = j.get(a);
+                let w = wrap_pi(v);
+                if w != v {
+                    j.set(a, w);
+                    changed = true;
+                }
+            }
+        }
+        changed
+    }
+}
+
+/// Angle in (−π, π].
+pub fn wrap_pi(a: f64) -> f64 {
+    let w = a - TAU * (a / TAU).round();
+    if w <= -std::f64::consts::PI {
+        w + TAU
+    } else {
+        w
+    }
+}
+
+/// The 2π-equivalent of `angle` nearest `reference` within the axis travel; `false` when no
+/// equivalent lies within the travel (then the one nearest the travel is returned).
+fn equivalent_angle(angle: f64, spec: &AxisSpec, reference: f64) -> (f64, bool) {
+    let k_ref = ((reference - angle) / TAU).round();
+    match spec.mode {
+        RotaryMode::Continuous => (angle + TAU * k_ref, true),
+        RotaryMode::Limited { min, max } => {
+            let kmin = ((min - LIMIT_SLACK - angle) / TAU).ceil();
+            let kmax = ((max + LIMIT_SLACK - angle) / TAU).floor();
+            if kmin <= kmax {
+                let k = k_ref.clamp(kmin, kmax);
+                (angle + TAU * k, true)
+            } else {
+                let k = ((reference.clamp(min, max) - angle) / TAU).round();
+                (angle + TAU * k, false)
+            }
+        }
+    }
+}

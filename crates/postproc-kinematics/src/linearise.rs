@@ -1,0 +1,149 @@
+//! Linearisation control: a controller without tool-centre-point control interpolates the
+//! joints linearly between two blocks, so the tool tip leaves the intended straight line (and
+//! the tool axis the intended great-circle sweep). This module measures the largest tip
+//! deviation of a block by sampling the interpolated joints through forward kinematics and
+//! inserts intermediate blocks (bisection of the intended segment, tip linear, axis spherical
+//! linear) until the deviation is within tolerance.
+//!
+//! Cost: `samples` forward evaluations per segment; bisection to depth `d` creates at most
+//! `2^d − 1` extra blocks per source block. No allocation besides the output blocks.
+
+use crate::error::KinematicsError;
+use crate::joints::Joints;
+use crate::machine::Machine;
+use cam_core::{CutterLocation, Point3, UnitVector3};
+
+/// Spherical linear interpolation of two unit tool axes (`s ∈ [0,1]`); falls back to
+/// normalised linear interpolation for (nearly) equal axes.
+pub fn slerp_axis(a: &UnitVector3, b: &UnitVector3, s: f64) -> UnitVector3 {
+    let d = a.dot(b).clamp(-1.0, 1.0);
+    let w = d.acos();
+    let sw = w.sin();
+    if sw < 1e-9 {
+        return UnitVector3::new_normalize(a.into_inner() * (1.0 - s) + b.into_inner() * s);
+    }
+    let ka = ((1.0 - s) * w).sin() / sw;
+    let kb = (s * w).sin() / sw;
+    UnitVector3::new_normalize(a.into_inner() * ka + b.into_inner() * kb)
+}
+
+/// The intended cutter location at `s ∈ [0,1]` between two blocks: tip on the straight line,
+/// axis on the great circle.
+pub fn interpolate_cl(a: &CutterLocation, b: &CutterLocation, s: f64) -> CutterLocation {
+    CutterLocation {
+        tip: Point3::from(a.tip.coords + (b.tip.coords - a.tip.coords) * s),
+        axis: slerp_axis(&a.axis, &b.axis, s),
+    }
+}
+
+/// Distance from `p` to the segment `[a, b]` (mm).
+pub fn point_segment_distance(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    let ab = b - a;
+    let l2 = ab.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * t)).norm()
+}
+
+/// Largest distance (mm) of the tool tip from the intended segment `[p0, p1]` while the
+/// joints move linearly from `j0` to `j1`: sampled at `samples` interior parameters
+/// `s = i/(samples+1)`, then refined by the vertex of the parabola through the largest sample
+/// and its neighbours (the deviation vanishes at both ends and is smooth in `s`).
+pub fn segment_deviation(
+    machine: &Machine,
+    j0: &Joints,
+    j1: &Joints,
+    p0: &Point3,
+    p1: &Point3,
+    tool_length: f64,
+    samples: usize,
+) -> f64 {
+    let n = samples.max(1);
+    let h = 1.0 / (n + 1) as f64;
+    let dev =
+        |s: f64| point_segment_distance(&machine.forward(&j0.lerp(j1, s), tool_length).tip, p0, p1);
+    let (mut worst, mut at, mut prev, mut left, mut right) =
+        (0.0f64, 0usize, 0.0f64, 0.0f64, 0.0f64);
+    for i in 1..=n {
+        let d = dev(i as f64 * h);
+        if d > worst {
+            worst = d;
+            at = i;
+            left = prev;
+            right = f64::NAN;
+        } else if i == at + 1 {
+            right = d;
+        }
+        prev = d;
+    }
+    if at == 0 {
+        return 0.0;
+    }
+    if right.is_nan() {
+        right = 0.0; // the neighbour after the last sample is the end point (deviation 0)
+    }
+    let den = left - 2.0 * worst + right;
+    if den < 0.0 {
+        let off = 0.5 * (left - right) / den; // in units of h, within (−1, 1)
+        if off.abs() < 1.0 {
+            worst = worst.max(dev(((at as f64) + off) * h));
+        }
+    }
+    worst
+}
+
+/// Settings of [`subdivide`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearisationSettings {
+    /// Largest allowed tip deviation (mm).
+    pub tol: f64,
+    /// Interior samples per segment.
+    pub samples: usize,
+    /// Largest bisection depth.
+    pub max_depth: u32,
+}
+
+/// Bisects the block `cl0/j0 → cl1/j1` until every piece deviates at most `tol`, appending
+/// the inserted blocks (not `cl0`, not `cl1`) in path order to `out` with the deviation of
+/// the piece each one ends. Returns the deviation of the final piece ending at `cl1` —
+/// together with the values in `out` the largest remaining deviation (it may exceed `tol`
+/// only when `max_depth` was reached).
+#[allow(clippy::too_many_arguments)]
+pub fn subdivide(
+    machine: &Machine,
+    cl0: &CutterLocation,
+    j0: &Joints,
+    cl1: &CutterLocation,
+    j1: &Joints,
+    tool_length: f64,
+    settings: &LinearisationSettings,
+    out: &mut Vec<(CutterLocation, Joints, f64)>,
+) -> Result<f64, KinematicsError> {
+    subdivide_rec(machine, cl0, j0, cl1, j1, tool_length, settings, 0, out)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn subdivide_rec(
+    machine: &Machine,
+    cl0: &CutterLocation,
+    j0: &Joints,
+    cl1: &CutterLocation,
+    j1: &Joints,
+    tool_length: f64,
+    st: &LinearisationSettings,
+    depth: u32,
+    out: &mut Vec<(CutterLocation, Joints, f64)>,
+) -> Result<f64, KinematicsError> {
+    let dev = segment_deviation(machine, j0, j1, &cl0.tip, &cl1.tip, tool_length, st.samples);
+    if dev <= st.tol || depth >= st.max_depth {
+        return Ok(dev);
+    }
+    let mid = interpolate_cl(cl0, cl1, 0.5);
+    let jm = machine.inverse(&mid, tool_length, Some(j0))?;
+    let d0 = subdivide_rec(machine, cl0, j0, &mid, &jm, tool_length, st, depth + 1, out)?;
+    out.push((mid, jm, d0));
+    subdivide_rec(machine, &mid, &jm, cl1, j1, tool_length, st, depth + 1, out)
+}

@@ -1,0 +1,502 @@
+//! Path-level post-processing: cutter locations → joint blocks for one machine, with solution
+//! continuity, limit checking, unwinding, reverse-motion smoothing, linearisation control,
+//! feeds and the post-processing metrics of the report.
+
+use crate::error::{KinematicsError, PostError};
+use crate::feed::inverse_time_feed;
+use crate::joints::AxisId;
+use crate::joints::Joints;
+use crate::linearise::{segment_deviation, subdivide, LinearisationSettings};
+use crate::machine::{Machine, RotaryMode};
+use crate::reverse_motion::{
+    count_path_reverse_motions, remove_reverse_motions, AccessibilityChecker, ReverseMotionOptions,
+    ReverseMotionReport,
+};
+use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
+use serde::{Deserialize, Serialize};
+
+/// What to do when a block cannot be reached within the axis limits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LimitPolicy {
+    /// Stop with [`PostError::Block`] naming the block index and the axis.
+    Error,
+    /// Keep the closest solution, mark the block and count it in
+    /// [`PostMetrics::limit_violations`].
+    Report,
+}
+
+/// Options of [`post_path`]. `PostOptions::default()` gives the documented defaults.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PostOptions {
+    /// Tool length, gauge line to tip (mm); enters the transform of head machines only.
+    pub tool_length: f64,
+    /// Limit handling.
+    pub limit_policy: LimitPolicy,
+    /// Largest tool-tip deviation (mm) caused by joint interpolation between blocks
+    /// (default 0.005); `None` for controllers in tool-centre-point mode (no subdivision,
+    /// the metric then reports the deviation a joint-interpolating controller would have).
+    pub linearisation_tol: Option<f64>,
+    /// Interior samples per segment for the deviation (default 8).
+    pub linearisation_samples: usize,
+    /// Largest bisection depth per block (default 10).
+    pub max_subdivision_depth: u32,
+    /// Also subdivide rapid moves (default `false`).
+    pub linearise_rapids: bool,
+    /// Unwind continuous rotary axes to (−180°, 180°] on rapid moves (default `true`).
+    pub unwind_on_rapid: bool,
+    /// Feed (mm/min) of cutting blocks that carry none and follow none (default 1000).
+    pub default_feed_mm_per_min: f64,
+    /// Posture before the first block (default: the machine's home position).
+    pub initial: Option<Joints>,
+    /// Reverse-motion removal on the rotary axes (default `None`: only count them).
+    pub reverse_motion: Option<ReverseMotionOptions>,
+}
+
+impl Default for PostOptions {
+    fn default() -> Self {
+        Self {
+            tool_length: 0.0,
+            limit_policy: LimitPolicy::Error,
+            linearisation_tol: Some(0.005),
+            linearisation_samples: 8,
+            max_subdivision_depth: 10,
+            linearise_rapids: false,
+            unwind_on_rapid: true,
+            default_feed_mm_per_min: 1000.0,
+            initial: None,
+            reverse_motion: None,
+        }
+    }
+}
+
+impl PostOptions {
+    fn validate(&self) -> Result<(), PostError> {
+        let bad = |field: &'static str, message: &str| {
+            Err(PostError::InvalidOption {
+                field,
+                message: message.to_string(),
+            })
+        };
+        if !self.tool_length.is_finite() || self.tool_length < 0.0 {
+            return bad("tool_length", "must be finite and >= 0");
+        }
+        if let Some(t) = self.linearisation_tol {
+            if !(t.is_finite() && t > 0.0) {
+                return bad("linearisation_tol", "must be finite and > 0");
+            }
+        }
+        if self.linearisation_samples == 0 {
+            return bad("linearisation_samples", "must be >= 1");
+        }
+        if self.max_subdivision_depth > 30 {
+            return bad("max_subdivision_depth", "must be <= 30");
+        }
+        if let Some(r) = &self.reverse_motion {
+            r.validate()?;
+        }
+        if !(self.default_feed_mm_per_min.is_finite() && self.default_feed_mm_per_min > 0.0) {
+            return bad("default_feed_mm_per_min", "must be finite and > 0");
+        }
+        Ok(())
+    }
+}
+
+/// One output block.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PostedBlock {
+    /// Axis values (mm, rad).
+    pub joints: Joints,
+    /// Cutter location the block reaches (workpiece frame). After reverse-motion smoothing the
+    /// axis is the smoothed one; for inserted blocks it is the intended interpolated CL.
+    pub cl: CutterLocation,
+    /// Kind of the source move.
+    pub kind: MoveKind,
+    /// Tool-tip feed (mm/min) of non-rapid blocks (source feed, else the last one, else the
+    /// default).
+    pub feed_mm_per_min: Option<f64>,
+    /// Inverse-time feed (G93 `F`, 1/min) of non-rapid blocks.
+    pub inverse_time_feed: Option<f64>,
+    /// Index of the source move / cutter location.
+    pub source_index: usize,
+    /// Inserted by linearisation control.
+    pub inserted: bool,
+    /// A continuous axis was unwound on this (rapid) block.
+    pub unwound: bool,
+    /// Tip deviation (mm) of the joint-interpolated segment ending at this block (0 for the
+    /// first block and for rapids that are not linearised).
+    pub linearisation_error_mm: f64,
+    /// Limit violation of this block (only with [`LimitPolicy::Report`]).
+    pub limit_violation: Option<KinematicsError>,
+}
+
+/// Post-processing metrics (field names fixed by the report contract).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct PostMetrics {
+    /// Direction changes of the rotary axes (summed over both) along cutting runs before
+    /// reverse-motion removal.
+    pub reverse_motions_before: usize,
+    /// The same after removal (equals `before` without removal).
+    pub reverse_motions_after: usize,
+    /// Largest tool-tip deviation (mm) of any joint-interpolated cutting block after
+    /// linearisation control.
+    pub max_linearisation_error_mm: f64,
+    /// Blocks outside the axis limits (only non-zero with [`LimitPolicy::Report`]).
+    pub limit_violations: usize,
+    /// Output blocks.
+    pub blocks: usize,
+    /// Blocks inserted by linearisation control.
+    pub inserted_blocks: usize,
+    /// Blocks unwound.
+    pub unwound_blocks: usize,
+    /// Non-rapid blocks whose rotary step exceeds [`RECONFIGURATION_STEP_RAD`] (a forced
+    /// change of solution branch, e.g. at a travel limit, that look-ahead could not avoid).
+    pub reconfigurations: usize,
+}
+
+/// Result of [`post_path`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PostedPath {
+    /// Machine name.
+    pub machine: String,
+    /// Tool length used (mm).
+    pub tool_length: f64,
+    /// Blocks in program order.
+    pub blocks: Vec<PostedBlock>,
+    /// Metrics.
+    pub metrics: PostMetrics,
+    /// Reverse-motion removal details (when it ran), with the displacement curves.
+    pub reverse_motion: Option<ReverseMotionReport>,
+}
+
+/// Posts a tool path (see [`post_path`]).
+pub fn post_tool_path(
+    machine: &Machine,
+    path: &ToolPath,
+    options: &PostOptions,
+) -> Result<PostedPath, PostError> {
+    post_path(machine, &path.moves, options)
+}
+
+/// Posts bare cutter locations as feed moves at the default feed (see [`post_path`]).
+pub fn post_locations(
+    machine: &Machine,
+    cls: &[CutterLocation],
+    options: &PostOptions,
+) -> Result<PostedPath, PostError> {
+    let moves: Vec<Move> = cls.iter().map(|cl| Move::feed(*cl)).collect();
+    post_path(machine, &moves, options)
+}
+
+/// Turns moves into joint blocks:
+///
+/// 1. inverse kinematics block by block, each choosing the solution nearest the previous
+///    block (continuity) within the limits ([`Machine::inverse`]); continuous axes are
+///    unwound on rapids when asked. The path is split into groups (a move and the non-rapid
+///    moves after it); when the greedy choice inside a group meets a limit or needs a
+///    reconfiguration, every posture of the group's first move
+///    ([`Machine::inverse_candidates`]) is tried and the one with the fewest problems kept;
+/// 2. reverse motions of the rotary axes are counted and, with
+///    [`PostOptions::reverse_motion`], removed ([`crate::reverse_motion`]);
+/// 3. linearisation control inserts blocks until the joint-interpolated tip deviates at most
+///    the tolerance ([`crate::linearise`]);
+/// 4. tool-tip and inverse-time feeds ([`crate::feed`]).
+///
+/// Errors: invalid options; a block outside the limits (with [`LimitPolicy::Error`]) or with
+/// an unreachable orientation — [`PostError::Block`] names the source index and the axis.
+/// Cost: O(n) inverse solutions plus the subdivision work.
+pub fn post_path(
+    machine: &Machine,
+    moves: &[Move],
+    options: &PostOptions,
+) -> Result<PostedPath, PostError> {
+    post_path_checked(machine, moves, options, None)
+}
+
+/// [`post_path`] with a caller-supplied accessibility checker (gouge and collision) that
+/// reverse-motion removal uses to re-check changed postures.
+pub fn post_path_checked(
+    machine: &Machine,
+    moves: &[Move],
+    options: &PostOptions,
+    checker: Option<&dyn AccessibilityChecker>,
+) -> Result<PostedPath, PostError> {
+    options.validate()?;
+    let tl = options.tool_length;
+    let mut blocks: Vec<PostedBlock> = Vec::with_capacity(moves.len());
+    let mut prev = options.initial.unwrap_or(machine.home());
+    let mut last_feed = options.default_feed_mm_per_min;
+    let mut start = 0;
+    while start < moves.len() {
+        // A group: one move (typically a rapid) and the non-rapid moves that follow it.
+        let mut end = start + 1;
+        while end < moves.len() && moves[end].kind != MoveKind::Rapid {
+            end += 1;
+        }
+        let (mut solved, mut problems) =
+            solve_group(machine, moves, start..end, &prev, None, options)?;
+        if problems > 0 {
+            // Look ahead: the greedy start ran into a limit or a reconfiguration; try every
+            // posture of the first move and keep the one with the fewest problems, then the
+            // least travel from the previous posture.
+            let first = &moves[start];
+            let candidates =
+                machine
+                    .inverse_candidates(&first.cl, tl, &prev)
+                    .map_err(|source| PostError::Block {
+                        index: start,
+                        source,
+                    })?;
+            let mut best_travel = f64::INFINITY;
+            for c in candidates {
+                let (sol, p) = solve_group(machine, moves, start..end, &prev, Some(c), options)?;
+                let travel = (c.tilt - prev.tilt).abs() + (c.rotate - prev.rotate).abs();
+                if p < problems || (p == problems && p > 0 && travel < best_travel) {
+                    best_travel = travel;
+                    solved = sol;
+                    problems = p;
+                }
+                if problems == 0 {
+                    break;
+                }
+            }
+        }
+        for (k, (j, violation, unwound)) in solved.into_iter().enumerate() {
+            let index = start + k;
+            let m = &moves[index];
+            if let Some(source) = &violation {
+                if options.limit_policy == LimitPolicy::Error {
+                    return Err(PostError::Block {
+                        index,
+                        source: source.clone(),
+                    });
+                }
+            }
+            let feed = if m.kind == MoveKind::Rapid {
+                None
+            } else {
+                if let Some(f) = m.feed_mm_per_min.filter(|f| f.is_finite() && *f > 0.0) {
+                    last_feed = f;
+                }
+                Some(last_feed)
+            };
+            blocks.push(PostedBlock {
+                joints: j,
+                cl: m.cl,
+                kind: m.kind,
+                feed_mm_per_min: feed,
+                inverse_time_feed: None,
+                source_index: index,
+                inserted: false,
+                unwound,
+                linearisation_error_mm: 0.0,
+                limit_violation: violation,
+            });
+            prev = j;
+        }
+        start = end;
+    }
+
+    let reverse_motions_before = count_path_reverse_motions(&blocks);
+    let reverse_report = match &options.reverse_motion {
+        Some(rm) => Some(remove_reverse_motions(
+            machine,
+            &mut blocks,
+            tl,
+            rm,
+            checker,
+        )?),
+        None => None,
+    };
+    let reverse_motions_after = count_path_reverse_motions(&blocks);
+
+    // Linearisation control and feeds.
+    let mut out: Vec<PostedBlock> = Vec::with_capacity(blocks.len());
+    let mut inserted_blocks = 0;
+    let mut max_err: f64 = 0.0;
+    let settings = LinearisationSettings {
+        tol: options.linearisation_tol.unwrap_or(f64::INFINITY),
+        samples: options.linearisation_samples,
+        max_depth: if options.linearisation_tol.is_some() {
+            options.max_subdivision_depth
+        } else {
+            0
+        },
+    };
+    let mut scratch: Vec<(CutterLocation, Joints, f64)> = Vec::new();
+    let initial = options.initial.unwrap_or(machine.home());
+    for b in blocks {
+        let Some(p) = out.last().cloned() else {
+            // the first block starts from the initial posture
+            let mut b = b;
+            if let Some(f) = b.feed_mm_per_min {
+                let len = (b.cl.tip - machine.forward(&initial, tl).tip).norm();
+                b.inverse_time_feed = Some(inverse_time_feed(machine, &initial, &b.joints, len, f));
+            }
+            out.push(b);
+            continue;
+        };
+        // Segments touching a block outside the limits (Report policy) are not subdivided.
+        let linearise = (b.kind != MoveKind::Rapid || options.linearise_rapids)
+            && !b.unwound
+            && b.limit_violation.is_none()
+            && p.limit_violation.is_none();
+        let mut b = b;
+        if linearise {
+            scratch.clear();
+            let sub = subdivide(
+                machine,
+                &p.cl,
+                &p.joints,
+                &b.cl,
+                &b.joints,
+                tl,
+                &settings,
+                &mut scratch,
+            );
+            let last = match sub {
+                Ok(last) => last,
+                Err(e @ KinematicsError::OutOfLimits { .. })
+                    if options.limit_policy == LimitPolicy::Report =>
+                {
+                    // an intermediate posture leaves the travel: keep the block unsubdivided
+                    scratch.clear();
+                    b.limit_violation = Some(e);
+                    segment_deviation(
+                        machine,
+                        &p.joints,
+                        &b.joints,
+                        &p.cl.tip,
+                        &b.cl.tip,
+                        tl,
+                        options.linearisation_samples,
+                    )
+                }
+                Err(source) => {
+                    return Err(PostError::Block {
+                        index: b.source_index,
+                        source,
+                    })
+                }
+            };
+            let mut from = p.clone();
+            for (cl, j, err) in scratch.drain(..) {
+                let mut nb = PostedBlock {
+                    joints: j,
+                    cl,
+                    kind: b.kind,
+                    feed_mm_per_min: b.feed_mm_per_min,
+                    inverse_time_feed: None,
+                    source_index: b.source_index,
+                    inserted: true,
+                    unwound: false,
+                    linearisation_error_mm: err,
+                    limit_violation: None,
+                };
+                if let Err(e) = machine.check_limits(&j, crate::kinematics::LIMIT_SLACK) {
+                    if options.limit_policy == LimitPolicy::Error {
+                        return Err(PostError::Block {
+                            index: b.source_index,
+                            source: e,
+                        });
+                    }
+                    nb.limit_violation = Some(e);
+                }
+                set_feed(machine, &from, &mut nb);
+                max_err = max_err.max(err);
+                inserted_blocks += 1;
+                from = nb.clone();
+                out.push(nb);
+            }
+            b.linearisation_error_mm = last;
+            max_err = max_err.max(last);
+            set_feed(machine, &from, &mut b);
+        } else {
+            set_feed(machine, &p, &mut b);
+        }
+        out.push(b);
+    }
+    let metrics = PostMetrics {
+        reverse_motions_before,
+        reverse_motions_after,
+        max_linearisation_error_mm: max_err,
+        limit_violations: out.iter().filter(|b| b.limit_violation.is_some()).count(),
+        blocks: out.len(),
+        inserted_blocks,
+        unwound_blocks: out.iter().filter(|b| b.unwound).count(),
+        reconfigurations: out
+            .windows(2)
+            .filter(|w| {
+                w[1].kind != MoveKind::Rapid
+                    && ((w[1].joints.tilt - w[0].joints.tilt).abs() > RECONFIGURATION_STEP_RAD
+                        || (w[1].joints.rotate - w[0].joints.rotate).abs()
+                            > RECONFIGURATION_STEP_RAD)
+            })
+            .count(),
+    };
+    Ok(PostedPath {
+        machine: machine.name().to_string(),
+        tool_length: tl,
+        blocks: out,
+        metrics,
+        reverse_motion: reverse_report,
+    })
+}
+
+fn set_feed(machine: &Machine, from: &PostedBlock, b: &mut PostedBlock) {
+    if let Some(f) = b.feed_mm_per_min {
+        let len = (b.cl.tip - from.cl.tip).norm();
+        b.inverse_time_feed = Some(inverse_time_feed(machine, &from.joints, &b.joints, len, f));
+    }
+}
+
+/// A rotary step larger than this (rad) inside a group counts as a reconfiguration (the
+/// machine would swing the table or head around between two neighbouring cutter locations).
+pub const RECONFIGURATION_STEP_RAD: f64 = std::f64::consts::FRAC_PI_2;
+
+type Solved = (Joints, Option<KinematicsError>, bool);
+
+/// Inverse kinematics of `moves[range]` with continuity from `prev` (the first posture may be
+/// forced); returns the postures and the number of problems (blocks outside the limits plus
+/// reconfiguration steps).
+fn solve_group(
+    machine: &Machine,
+    moves: &[Move],
+    range: std::ops::Range<usize>,
+    prev: &Joints,
+    first: Option<Joints>,
+    options: &PostOptions,
+) -> Result<(Vec<Solved>, usize), PostError> {
+    let tl = options.tool_length;
+    let continuous = matches!(machine.axis(AxisId::Rotate).mode, RotaryMode::Continuous)
+        || matches!(machine.axis(AxisId::Tilt).mode, RotaryMode::Continuous);
+    let mut out: Vec<Solved> = Vec::with_capacity(range.len());
+    let mut problems = 0;
+    let mut prev = *prev;
+    for index in range.clone() {
+        let m = &moves[index];
+        let (mut j, violation) = match (index == range.start, first) {
+            (true, Some(f)) => (f, None),
+            _ => machine
+                .inverse_best_effort(&m.cl, tl, Some(&prev))
+                .map_err(|source| PostError::Block { index, source })?,
+        };
+        let mut unwound = false;
+        if options.unwind_on_rapid && continuous && m.kind == MoveKind::Rapid {
+            unwound = machine.unwind(&mut j);
+            if unwound {
+                j = machine.joints_for_angles(&m.cl.tip, tl, j.tilt, j.rotate);
+            }
+        }
+        problems += usize::from(violation.is_some());
+        if index > range.start
+            && ((j.tilt - prev.tilt).abs() > RECONFIGURATION_STEP_RAD
+                || (j.rotate - prev.rotate).abs() > RECONFIGURATION_STEP_RAD)
+        {
+            problems += 1;
+        }
+        out.push((j, violation, unwound));
+        prev = j;
+    }
+    Ok((out, problems))
+}

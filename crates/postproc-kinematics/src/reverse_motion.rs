@@ -1,0 +1,470 @@
+//! Reverse motions of the rotary axes: places along a cutting run where the angular
+//! displacement of an axis changes direction (paper 004: such reversals leave tool marks,
+//! because the feed drive stops and backlash acts).
+
+use crate::bspline_fit::fit_least_squares;
+use crate::error::PostError;
+use crate::joints::{AxisId, Joints};
+use crate::kinematics::LIMIT_SLACK;
+use crate::machine::Machine;
+use crate::post::PostedBlock;
+use cam_core::{CutterLocation, MoveKind};
+use serde::{Deserialize, Serialize};
+
+/// Angular steps smaller than this (rad) count as standing still when looking for direction
+/// changes.
+pub const REVERSE_DEAD_BAND_RAD: f64 = 1e-6;
+
+/// Number of direction changes in a sequence of angles (rad): sign changes between
+/// consecutive non-negligible steps (steps within `dead_band` are skipped). O(n).
+pub fn count_reverse_motions(angles: &[f64], dead_band: f64) -> usize {
+    let mut last_sign = 0.0;
+    let mut count = 0;
+    for w in angles.windows(2) {
+        let d = w[1] - w[0];
+        if d.abs() <= dead_band {
+            continue;
+        }
+        let s = d.signum();
+        if last_sign != 0.0 && s != last_sign {
+            count += 1;
+        }
+        last_sign = s;
+    }
+    count
+}
+
+/// Index ranges `[start, end)` of the cutting runs of a block list: maximal runs of
+/// consecutive non-rapid blocks, each including the block it starts from.
+pub fn cutting_runs(blocks: &[PostedBlock]) -> Vec<(usize, usize)> {
+    let mut runs = Vec::new();
+    let mut i = 0;
+    while i < blocks.len() {
+        if i + 1 < blocks.len() && blocks[i + 1].kind != MoveKind::Rapid {
+            let start = i;
+            let mut end = i + 1;
+            while end < blocks.len() && blocks[end].kind != MoveKind::Rapid {
+                end += 1;
+            }
+            runs.push((start, end));
+            i = end;
+        } else {
+            i += 1;
+        }
+    }
+    runs
+}
+
+/// Reverse motions of one rotary axis over all cutting runs.
+pub fn count_axis_reverse_motions(blocks: &[PostedBlock], axis: AxisId) -> usize {
+    let mut angles = Vec::new();
+    cutting_runs(blocks)
+        .into_iter()
+        .map(|(s, e)| {
+            angles.clear();
+            angles.extend(blocks[s..e].iter().map(|b| b.joints.get(axis)));
+            count_reverse_motions(&angles, REVERSE_DEAD_BAND_RAD)
+        })
+        .sum()
+}
+
+/// Reverse motions of both rotary axes over all cutting runs.
+pub fn count_path_reverse_motions(blocks: &[PostedBlock]) -> usize {
+    count_axis_reverse_motions(blocks, AxisId::Tilt)
+        + count_axis_reverse_motions(blocks, AxisId::Rotate)
+}
+
+// ---------------------------------------------------------------------------------------
+// Removal (paper 004, "Modification of reverse movements" and steps 3–7 of its procedure).
+
+/// Caller-supplied 5-axis accessibility test (gouge and collision) of a cutter location,
+/// used to re-check postures changed by reverse-motion removal.
+pub trait AccessibilityChecker {
+    /// `true` when the cutter location is free of gouge and collision.
+    fn is_accessible(&self, cl: &CutterLocation) -> bool;
+}
+
+impl<F: Fn(&CutterLocation) -> bool> AccessibilityChecker for F {
+    fn is_accessible(&self, cl: &CutterLocation) -> bool {
+        self(cl)
+    }
+}
+
+/// Settings of reverse-motion removal (angles in rad).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ReverseMotionOptions {
+    /// Shift `φ_L` applied per iteration to angles lying behind the direction of motion
+    /// (default 0.5°).
+    pub shift: f64,
+    /// Control values of the least-squares cubic B-spline per cutting run (default 4, as in
+    /// the paper: four cubic B-spline basis functions).
+    pub control_points: usize,
+    /// Largest shift-and-smooth iterations before the control values are projected onto a
+    /// monotone sequence (default 50).
+    pub max_iterations: usize,
+    /// Largest change of any angle (default 10°); a run needing more keeps its angles.
+    pub max_angle_change: f64,
+    /// C increment `ΔC` for the accessibility repair (default 1.5°, paper: 1–2°).
+    pub c_step: f64,
+    /// Largest C change of the repair `C_max` (default 10°).
+    pub c_max: f64,
+}
+
+impl Default for ReverseMotionOptions {
+    fn default() -> Self {
+        Self {
+            shift: 0.5f64.to_radians(),
+            control_points: 4,
+            max_iterations: 50,
+            max_angle_change: 10f64.to_radians(),
+            c_step: 1.5f64.to_radians(),
+            c_max: 10f64.to_radians(),
+        }
+    }
+}
+
+impl ReverseMotionOptions {
+    pub(crate) fn validate(&self) -> Result<(), PostError> {
+        let bad = |field: &'static str, message: &str| {
+            Err(PostError::InvalidOption {
+                field,
+                message: message.to_string(),
+            })
+        };
+        let pos = |v: f64| v.is_finite() && v > 0.0;
+        if !pos(self.shift) {
+            return bad("reverse_motion.shift", "must be finite and > 0");
+        }
+        if self.control_points < 2 {
+            return bad("reverse_motion.control_points", "must be >= 2");
+        }
+        if !pos(self.max_angle_change) {
+            return bad("reverse_motion.max_angle_change", "must be finite and > 0");
+        }
+        if !(pos(self.c_step) && self.c_max.is_finite() && self.c_max >= 0.0) {
+            return bad("reverse_motion.c_step", "c_step must be > 0 and c_max >= 0");
+        }
+        Ok(())
+    }
+}
+
+/// Axis displacement curves along a path (for plots): one row per block, values in mm for
+/// linear axes and degrees for rotary axes, against the cumulative tool-tip path length.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct DisplacementCurves {
+    /// Axis letters in column order (X Y Z tilt C).
+    pub letters: Vec<char>,
+    /// Cumulative tip path length (mm) per block.
+    pub path_length_mm: Vec<f64>,
+    /// Axis values per block (mm / deg).
+    pub values: Vec<[f64; 5]>,
+}
+
+impl DisplacementCurves {
+    /// Curves of a block list.
+    pub fn of_blocks(machine: &Machine, blocks: &[PostedBlock]) -> Self {
+        let mut s = 0.0;
+        let mut path_length_mm = Vec::with_capacity(blocks.len());
+        let mut values = Vec::with_capacity(blocks.len());
+        for (i, b) in blocks.iter().enumerate() {
+            if i > 0 {
+                s += (b.cl.tip - blocks[i - 1].cl.tip).norm();
+            }
+            path_length_mm.push(s);
+            let w = machine.axis_words(&b.joints);
+            values.push(std::array::from_fn(|k| w[k].1));
+        }
+        Self {
+            letters: AxisId::ALL.iter().map(|a| machine.letter(*a)).collect(),
+            path_length_mm,
+            values,
+        }
+    }
+}
+
+/// Outcome of reverse-motion removal.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct ReverseMotionReport {
+    /// Reverse motions of the tilt axis before / after.
+    pub tilt_before: usize,
+    /// See `tilt_before`.
+    pub tilt_after: usize,
+    /// Reverse motions of C before / after.
+    pub rotate_before: usize,
+    /// See `rotate_before`.
+    pub rotate_after: usize,
+    /// Cutting runs whose angles were changed.
+    pub runs_changed: usize,
+    /// Cutting runs left unchanged because the change exceeded `max_angle_change`, left the
+    /// axis limits or could not be made accessible.
+    pub runs_kept: usize,
+    /// Shift-and-smooth iterations (summed over runs and axes).
+    pub iterations: usize,
+    /// Runs × axes that needed the monotone projection of the control values.
+    pub projections: usize,
+    /// Runs whose C was turned by a multiple of `c_step` to restore accessibility.
+    pub c_repaired_runs: usize,
+    /// The C offsets applied to those runs (deg).
+    pub c_offsets_deg: Vec<f64>,
+    /// Source index of the first inaccessible (or out-of-limits) posture of each run that
+    /// could not be repaired (the run was kept unchanged).
+    pub inaccessible_blocks: Vec<usize>,
+    /// Largest angle change applied (deg).
+    pub max_angle_change_deg: f64,
+    /// Displacement curves before removal.
+    pub before: DisplacementCurves,
+    /// Displacement curves after removal.
+    pub after: DisplacementCurves,
+}
+
+/// Parameters of a run for the B-spline fit: normalised cumulative tip path length, or the
+/// normalised index when the tip does not move.
+fn run_parameters(blocks: &[PostedBlock]) -> Vec<f64> {
+    let mut t = Vec::with_capacity(blocks.len());
+    let mut s = 0.0;
+    for (i, b) in blocks.iter().enumerate() {
+        if i > 0 {
+            s += (b.cl.tip - blocks[i - 1].cl.tip).norm();
+        }
+        t.push(s);
+    }
+    let n = blocks.len();
+    if s > 1e-9 {
+        t.iter_mut().for_each(|v| *v /= s);
+    } else {
+        for (i, v) in t.iter_mut().enumerate() {
+            *v = if n > 1 {
+                i as f64 / (n - 1) as f64
+            } else {
+                0.0
+            };
+        }
+    }
+    t
+}
+
+/// Shift-and-smooth of one angle sequence (paper 004): angles lying behind the running extreme
+/// in the direction of motion are shifted by at most `φ_L` toward it, the sequence is smoothed
+/// by the least-squares cubic B-spline, and this repeats until no reverse motion is left; after
+/// `max_iterations` the control values are projected onto a monotone sequence, which makes the
+/// spline monotone. Returns the new angles, the iterations and whether the projection ran.
+pub fn smooth_monotone(
+    t: &[f64],
+    angles: &[f64],
+    opts: &ReverseMotionOptions,
+) -> Option<(Vec<f64>, usize, bool)> {
+    let m = angles.len();
+    if m < 3 {
+        return None;
+    }
+    let net = angles[m - 1] - angles[0];
+    let dir = if net.abs() > REVERSE_DEAD_BAND_RAD {
+        net.signum()
+    } else {
+        let up: f64 = angles.windows(2).map(|w| (w[1] - w[0]).max(0.0)).sum();
+        let down: f64 = angles.windows(2).map(|w| (w[0] - w[1]).max(0.0)).sum();
+        if up >= down {
+            1.0
+        } else {
+            -1.0
+        }
+    };
+    let uniform: Vec<f64> = (0..m).map(|i| i as f64 / (m - 1) as f64).collect();
+    let fit = |y: &[f64]| {
+        fit_least_squares(t, y, opts.control_points)
+            .or_else(|| fit_least_squares(&uniform, y, opts.control_points))
+    };
+    let params = if fit_least_squares(t, angles, opts.control_points).is_some() {
+        t
+    } else {
+        &uniform[..]
+    };
+    let mut cur = angles.to_vec();
+    let mut last = None;
+    for iter in 1..=opts.max_iterations {
+        let mut ext = cur[0];
+        for v in cur.iter_mut().skip(1) {
+            let behind = dir * (ext - *v);
+            if behind > 0.0 {
+                *v += dir * behind.min(opts.shift);
+            }
+            ext = if dir > 0.0 { ext.max(*v) } else { ext.min(*v) };
+        }
+        let spline = fit(&cur)?;
+        cur = params.iter().map(|&ti| spline.eval(ti)).collect();
+        if count_reverse_motions(&cur, REVERSE_DEAD_BAND_RAD) == 0 {
+            return Some((cur, iter, false));
+        }
+        last = Some(spline);
+    }
+    let spline = last?.monotone(dir);
+    let out: Vec<f64> = params.iter().map(|&ti| spline.eval(ti)).collect();
+    Some((out, opts.max_iterations, true))
+}
+
+/// Removes reverse motions of the rotary axes run by run (paper 004 procedure steps 2–7):
+/// shift-and-smooth each reversing axis ([`smooth_monotone`]); recompute the linear axes for
+/// the changed postures keeping the tool tips ([`Machine::joints_for_angles`]); check limits
+/// and re-check every changed posture with `checker`; where one fails, turn C of the whole run
+/// by `±k·c_step` (smallest first, up to `c_max`; a constant offset keeps the run monotone)
+/// and re-check. A run that cannot be repaired, or whose smoothing changes an angle by more
+/// than `max_angle_change`, keeps its original angles.
+/// Blocks' `cl.axis` becomes the smoothed tool axis.
+///
+/// Cost: O(m·n²) per run for the fit (n control points), plus `c_max / c_step` checker calls
+/// per run whose smoothed postures fail.
+pub fn remove_reverse_motions(
+    machine: &Machine,
+    blocks: &mut [PostedBlock],
+    tool_length: f64,
+    opts: &ReverseMotionOptions,
+    checker: Option<&dyn AccessibilityChecker>,
+) -> Result<ReverseMotionReport, PostError> {
+    opts.validate()?;
+    let mut rep = ReverseMotionReport {
+        tilt_before: count_axis_reverse_motions(blocks, AxisId::Tilt),
+        rotate_before: count_axis_reverse_motions(blocks, AxisId::Rotate),
+        before: DisplacementCurves::of_blocks(machine, blocks),
+        ..Default::default()
+    };
+    for (s, e) in cutting_runs(blocks) {
+        let run = &mut blocks[s..e];
+        let original: Vec<(Joints, CutterLocation)> =
+            run.iter().map(|b| (b.joints, b.cl)).collect();
+        let t = run_parameters(run);
+        let mut changed = false;
+        let mut ok = true;
+        let mut run_max_change: f64 = 0.0;
+        for axis in [AxisId::Tilt, AxisId::Rotate] {
+            let angles: Vec<f64> = run.iter().map(|b| b.joints.get(axis)).collect();
+            if count_reverse_motions(&angles, REVERSE_DEAD_BAND_RAD) == 0 {
+                continue;
+            }
+            let Some((new, iters, projected)) = smooth_monotone(&t, &angles, opts) else {
+                ok = false;
+                break;
+            };
+            rep.iterations += iters;
+            rep.projections += usize::from(projected);
+            let change = angles
+                .iter()
+                .zip(&new)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            if change > opts.max_angle_change {
+                ok = false;
+                break;
+            }
+            run_max_change = run_max_change.max(change);
+            for (b, v) in run.iter_mut().zip(new) {
+                b.joints.set(axis, v);
+            }
+            changed = true;
+        }
+        if ok && changed {
+            // Recompute the positions for the changed postures and re-check them; when a
+            // posture is not accessible, turn C of the whole run by ±k·ΔC (k = 1, 2, … up to
+            // C_max) — a constant offset keeps the run free of reverse motions.
+            let smoothed: Vec<(f64, f64)> = run
+                .iter()
+                .map(|b| (b.joints.tilt, b.joints.rotate))
+                .collect();
+            let steps = (opts.c_max / opts.c_step).floor() as usize;
+            let offsets = std::iter::once(0.0).chain((1..=steps).flat_map(|k| {
+                let d = k as f64 * opts.c_step;
+                [d, -d]
+            }));
+            let mut accepted: Option<(f64, Vec<(Joints, CutterLocation)>)> = None;
+            let mut first_failure: Option<usize> = None;
+            'offsets: for off in offsets {
+                let mut placed = Vec::with_capacity(run.len());
+                for (b, ((tilt, rot), (oj, ocl))) in run.iter().zip(smoothed.iter().zip(&original))
+                {
+                    let rot = rot + off;
+                    if *tilt == oj.tilt && rot == oj.rotate {
+                        placed.push((*oj, *ocl));
+                        continue;
+                    }
+                    let j = machine.joints_for_angles(&b.cl.tip, tool_length, *tilt, rot);
+                    let cl = CutterLocation {
+                        tip: b.cl.tip,
+                        axis: machine.tool_axis(*tilt, rot),
+                    };
+                    let fits = machine.check_limits(&j, LIMIT_SLACK).is_ok();
+                    if !fits || !checker.is_none_or(|c| c.is_accessible(&cl)) {
+                        if first_failure.is_none() {
+                            first_failure = Some(b.source_index);
+                        }
+                        continue 'offsets;
+                    }
+                    placed.push((j, cl));
+                }
+                accepted = Some((off, placed));
+                break;
+            }
+            match accepted {
+                Some((off, placed)) => {
+                    for (b, (j, cl)) in run.iter_mut().zip(placed) {
+                        b.joints = j;
+                        b.cl = cl;
+                    }
+                    rep.runs_changed += 1;
+                    if off != 0.0 {
+                        rep.c_repaired_runs += 1;
+                        rep.c_offsets_deg.push(off.to_degrees());
+                    }
+                    let change = run_max_change + off.abs();
+                    rep.max_angle_change_deg = rep.max_angle_change_deg.max(change.to_degrees());
+                }
+                None => {
+                    rep.inaccessible_blocks.extend(first_failure);
+                    ok = false;
+                }
+            }
+        }
+        if !ok {
+            rep.runs_kept += 1;
+            for (b, (j, cl)) in run.iter_mut().zip(original) {
+                b.joints = j;
+                b.cl = cl;
+            }
+        }
+    }
+    rep.tilt_after = count_axis_reverse_motions(blocks, AxisId::Tilt);
+    rep.rotate_after = count_axis_reverse_motions(blocks, AxisId::Rotate);
+    rep.after = DisplacementCurves::of_blocks(machine, blocks);
+    Ok(rep)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_direction_changes() {
+        assert_eq!(count_reverse_motions(&[0.0, 1.0, 2.0, 3.0], 1e-9), 0);
+        assert_eq!(count_reverse_motions(&[0.0, 1.0, 0.5, 2.0], 1e-9), 2);
+        // standing still does not count, nor does a step within the dead band
+        assert_eq!(
+            count_reverse_motions(&[0.0, 1.0, 1.0, 1.0 - 1e-12, 2.0], 1e-9),
+            0
+        );
+        assert_eq!(
+            count_reverse_motions(&[3.0, 2.0, 2.5, 1.0, 0.0, 0.2], 1e-9),
+            3
+        );
+    }
+
+    #[test]
+    fn smoothing_removes_a_swing() {
+        let t: Vec<f64> = (0..100).map(|i| i as f64 / 99.0).collect();
+        let a: Vec<f64> = t
+            .iter()
+            .map(|&x| x - 0.15 * (-((x - 0.5) / 0.05f64).powi(2)).exp() * (x - 0.5) / 0.05)
+            .collect();
+        assert!(count_reverse_motions(&a, REVERSE_DEAD_BAND_RAD) >= 2);
+        let (s, _, _) = smooth_monotone(&t, &a, &ReverseMotionOptions::default()).unwrap();
+        assert_eq!(count_reverse_motions(&s, REVERSE_DEAD_BAND_RAD), 0);
+        assert!((s[0] - a[0]).abs() < 0.2 && (s[99] - a[99]).abs() < 0.2);
+    }
+}

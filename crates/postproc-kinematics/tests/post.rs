@@ -1,0 +1,374 @@
+//! Path-level post-processing: limits errors naming block and axis, reverse-motion removal,
+//! linearisation control checked by dense sampling, feeds, metrics.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use cam_core::{CutterLocation, Move, Point3, Vector3};
+use postproc_kinematics::linearise::point_segment_distance;
+use postproc_kinematics::plot::displacement_svg;
+use postproc_kinematics::{
+    post_locations, post_path, post_path_checked, AccessibilityChecker, AxisId, Joints,
+    KinematicsError, LimitPolicy, Machine, PostError, PostOptions, ReverseMotionOptions,
+};
+
+fn fixture(name: &str) -> Machine {
+    let path = format!(
+        "{}/../../fixtures/machines/{name}.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    Machine::from_file(&path).unwrap()
+}
+
+fn axis_from_angles(m: &Machine, a_deg: f64, c_deg: f64) -> Vector3 {
+    m.tool_axis(a_deg.to_radians(), c_deg.to_radians())
+        .into_inner()
+}
+
+#[test]
+fn limit_violation_names_block_and_axis() {
+    let m = fixture("xyzac-trt");
+    let mut cls: Vec<CutterLocation> = (0..10)
+        .map(|i| CutterLocation::vertical(Point3::new(i as f64, 0.0, 0.0)))
+        .collect();
+    let t = 120f64.to_radians();
+    cls[6] = CutterLocation::new(
+        Point3::new(6.0, 0.0, 0.0),
+        Vector3::new(0.0, t.sin(), t.cos()),
+    )
+    .unwrap();
+    let err = post_locations(&m, &cls, &PostOptions::default()).unwrap_err();
+    match &err {
+        PostError::Block {
+            index,
+            source: KinematicsError::OutOfLimits { axis, .. },
+        } => {
+            assert_eq!(*index, 6);
+            assert_eq!(*axis, 'A');
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    let msg = err.to_string();
+    assert!(msg.contains("block 6") && msg.contains("axis A"), "{msg}");
+    // Report policy: the path is posted, the violation counted and marked.
+    let opts = PostOptions {
+        limit_policy: LimitPolicy::Report,
+        ..Default::default()
+    };
+    let posted = post_locations(&m, &cls, &opts).unwrap();
+    assert_eq!(posted.metrics.limit_violations, 1);
+    assert!(posted
+        .blocks
+        .iter()
+        .any(|b| b.source_index == 6 && b.limit_violation.is_some()));
+    // every other block is inside the limits
+    for b in posted.blocks.iter().filter(|b| b.limit_violation.is_none()) {
+        assert!(m.check_limits(&b.joints, 1e-9).is_ok());
+    }
+}
+
+/// A finishing pass whose C angle rises, swings back by 6° and rises again (the reversal of
+/// paper 004 fig. 12) while A tilts steadily.
+fn swing_path(m: &Machine) -> Vec<Move> {
+    let n = 120;
+    let mut moves = vec![Move::rapid(
+        CutterLocation::new(
+            Point3::new(-30.0, 0.0, 40.0),
+            axis_from_angles(m, -20.0, 0.0),
+        )
+        .unwrap(),
+    )];
+    for i in 0..n {
+        let s = i as f64 / (n - 1) as f64;
+        let c = 60.0 * s - 10.0 * (-((s - 0.5) / 0.06).powi(2)).exp() * ((s - 0.5) / 0.06) * 2.0;
+        let a = -20.0 - 10.0 * s;
+        let tip = Point3::new(-30.0 + 60.0 * s, 10.0 * (3.0 * s).sin(), 5.0 + 3.0 * s);
+        let mut mv = Move::feed(CutterLocation::new(tip, axis_from_angles(m, a, c)).unwrap());
+        mv.feed_mm_per_min = Some(800.0);
+        moves.push(mv);
+    }
+    moves
+}
+
+#[test]
+fn reverse_motion_removal_leaves_none() {
+    let m = fixture("xyzac-trt");
+    let moves = swing_path(&m);
+    let plain = post_path(&m, &moves, &PostOptions::default()).unwrap();
+    assert!(
+        plain.metrics.reverse_motions_before >= 2,
+        "the path reverses C: {:?}",
+        plain.metrics
+    );
+    assert_eq!(
+        plain.metrics.reverse_motions_after,
+        plain.metrics.reverse_motions_before
+    );
+
+    let opts = PostOptions {
+        reverse_motion: Some(ReverseMotionOptions::default()),
+        ..Default::default()
+    };
+    let all_ok = |_cl: &CutterLocation| true;
+    let checker: &dyn AccessibilityChecker = &all_ok;
+    let posted = post_path_checked(&m, &moves, &opts, Some(checker)).unwrap();
+    assert_eq!(
+        posted.metrics.reverse_motions_after, 0,
+        "{:?}",
+        posted.reverse_motion
+    );
+    let rep = posted.reverse_motion.as_ref().unwrap();
+    assert!(rep.rotate_before >= 2 && rep.rotate_after == 0 && rep.runs_changed == 1);
+    assert!(rep.max_angle_change_deg > 0.5 && rep.max_angle_change_deg <= 10.0);
+    // C along the output (including inserted blocks) is monotone within the cutting run
+    let cs: Vec<f64> = posted
+        .blocks
+        .iter()
+        .skip(1)
+        .map(|b| b.joints.get(AxisId::Rotate))
+        .collect();
+    assert!(cs.windows(2).all(|w| w[1] >= w[0] - 1e-6), "C not monotone");
+    // tips are kept and the joints reach the (smoothed) CLs
+    for b in &posted.blocks {
+        let f = m.forward(&b.joints, 0.0);
+        assert!((f.tip - b.cl.tip).norm() < 1e-9);
+        assert!((f.axis.into_inner() - b.cl.axis.into_inner()).norm() < 1e-9);
+    }
+    for b in posted.blocks.iter().filter(|b| !b.inserted) {
+        assert!((b.cl.tip - moves[b.source_index].cl.tip).norm() < 1e-12);
+    }
+    // plot
+    let svg = displacement_svg(&rep.after, Some(&rep.before), true, 640, 360);
+    assert!(
+        svg.starts_with("<svg")
+            && svg.trim_end().ends_with("</svg>")
+            && svg.matches("<polyline").count() == 4
+    );
+}
+
+#[test]
+fn accessibility_recheck_steps_c_or_keeps_run() {
+    let m = fixture("xyzac-trt");
+    let moves = swing_path(&m);
+    let opts = PostOptions {
+        reverse_motion: Some(ReverseMotionOptions::default()),
+        ..Default::default()
+    };
+    // A checker that forbids turning C back by more than 1° from the CAM posture of the
+    // same tip (a stand-in for a blade gouge on that side): the smoothing alone violates it,
+    // turning the whole run by a few ΔC repairs it.
+    let plain = post_path(&m, &moves, &PostOptions::default()).unwrap();
+    let original: Vec<(Point3, f64)> = plain
+        .blocks
+        .iter()
+        .map(|b| (b.cl.tip, b.joints.rotate))
+        .collect();
+    let checker = |cl: &CutterLocation| {
+        let (_, c0) = original
+            .iter()
+            .min_by(|a, b| (a.0 - cl.tip).norm().total_cmp(&(b.0 - cl.tip).norm()))
+            .unwrap();
+        let j = m
+            .inverse(
+                cl,
+                0.0,
+                Some(&Joints {
+                    rotate: *c0,
+                    tilt: -0.4,
+                    ..Default::default()
+                }),
+            )
+            .unwrap();
+        j.rotate >= c0 - 1f64.to_radians()
+    };
+    let posted = post_path_checked(&m, &moves, &opts, Some(&checker)).unwrap();
+    let rep = posted.reverse_motion.as_ref().unwrap();
+    assert_eq!(rep.c_repaired_runs, 1, "{rep:?}");
+    assert!(rep.c_offsets_deg[0] > 0.0 && rep.c_offsets_deg[0] <= 10.0);
+    assert_eq!(posted.metrics.reverse_motions_after, 0);
+    for b in posted.blocks.iter().filter(|b| !b.inserted) {
+        assert!(checker(&b.cl), "every posted posture passes the checker");
+    }
+    // A checker that rejects every changed posture: the run keeps its angles.
+    let never = |_: &CutterLocation| false;
+    let posted = post_path_checked(&m, &moves, &opts, Some(&never)).unwrap();
+    let rep = posted.reverse_motion.unwrap();
+    assert_eq!(rep.runs_kept, 1);
+    assert!(!rep.inaccessible_blocks.is_empty());
+    assert_eq!(
+        posted.metrics.reverse_motions_after,
+        posted.metrics.reverse_motions_before
+    );
+}
+
+#[test]
+fn linearisation_deviation_below_tolerance_by_dense_sampling() {
+    for name in ["xyzac-trt", "xyzbc-trt", "turnmill-bc", "headhead-ac"] {
+        let m = fixture(name);
+        let tool = 60.0;
+        let u0 = m.tool_axis(-0.3, 0.2).into_inner();
+        let u1 = m.tool_axis(-0.8, 1.4).into_inner();
+        let u0 = if name == "turnmill-bc" {
+            m.tool_axis(-1.2, 0.2).into_inner()
+        } else {
+            u0
+        };
+        let u1 = if name == "turnmill-bc" {
+            m.tool_axis(-1.0, 1.4).into_inner()
+        } else {
+            u1
+        };
+        let cls = vec![
+            CutterLocation::new(Point3::new(-20.0, 5.0, 10.0), u0).unwrap(),
+            CutterLocation::new(Point3::new(25.0, -10.0, 20.0), u1).unwrap(),
+            CutterLocation::new(Point3::new(30.0, 20.0, 15.0), u0).unwrap(),
+        ];
+        let opts = PostOptions {
+            tool_length: tool,
+            ..Default::default()
+        };
+        let unsub = PostOptions {
+            linearisation_tol: None,
+            ..opts.clone()
+        };
+        let raw = post_locations(&m, &cls, &unsub).unwrap();
+        assert!(
+            raw.metrics.max_linearisation_error_mm > 0.1,
+            "{name}: test path must deviate: {:?}",
+            raw.metrics
+        );
+        let posted = post_locations(&m, &cls, &opts).unwrap();
+        assert!(posted.metrics.inserted_blocks > 0);
+        let tol = opts.linearisation_tol.unwrap();
+        assert!(posted.metrics.max_linearisation_error_mm <= tol);
+        // dense check: 400 samples per output segment against the intended straight segment
+        let mut worst: f64 = 0.0;
+        for w in posted.blocks.windows(2) {
+            for k in 1..400 {
+                let s = k as f64 / 400.0;
+                let tip = m.forward(&w[0].joints.lerp(&w[1].joints, s), tool).tip;
+                // the intended segment is the source segment the blocks lie on
+                let src = w[1].source_index;
+                worst = worst.max(point_segment_distance(
+                    &tip,
+                    &cls[src - 1].tip,
+                    &cls[src].tip,
+                ));
+            }
+        }
+        assert!(
+            worst <= tol * 1.0001,
+            "{name}: dense deviation {worst} > {tol}"
+        );
+    }
+}
+
+#[test]
+fn inverse_time_feed_and_speed_limits() {
+    let m = fixture("xyzac-trt");
+    // pure linear move of 10 mm at 500 mm/min: G93 F = 50 (1/min)
+    let mut a = Move::feed(CutterLocation::vertical(Point3::new(0.0, 0.0, 0.0)));
+    let mut b = Move::feed(CutterLocation::vertical(Point3::new(10.0, 0.0, 0.0)));
+    a.feed_mm_per_min = Some(500.0);
+    b.feed_mm_per_min = Some(500.0);
+    let p = post_path(&m, &[a, b], &PostOptions::default()).unwrap();
+    let f = p.blocks[1].inverse_time_feed.unwrap();
+    assert!((f - 50.0).abs() < 1e-9, "{f}");
+    assert_eq!(p.blocks[1].feed_mm_per_min, Some(500.0));
+    // a 90° C turn in place: limited by C's 1800 °/min → 1/20 min → F = 20
+    let u0 = axis_from_angles(&m, -30.0, 0.0);
+    let u1 = axis_from_angles(&m, -30.0, 90.0);
+    let a = Move::feed(CutterLocation::new(Point3::origin(), u0).unwrap());
+    let b = Move::feed(CutterLocation::new(Point3::origin(), u1).unwrap());
+    let opts = PostOptions {
+        linearisation_tol: None,
+        ..Default::default()
+    };
+    let p = post_path(&m, &[a, b], &opts).unwrap();
+    let f = p.blocks[1].inverse_time_feed.unwrap();
+    assert!((f - 20.0).abs() < 1e-9, "{f}");
+}
+
+#[test]
+fn metrics_serialise_with_report_names() {
+    let m = fixture("headhead-ac");
+    let cls: Vec<CutterLocation> = (0..5)
+        .map(|i| CutterLocation::vertical(Point3::new(i as f64, 0.0, 0.0)))
+        .collect();
+    let p = post_locations(&m, &cls, &PostOptions::default()).unwrap();
+    let json = serde_json::to_value(p.metrics).unwrap();
+    for key in [
+        "reverse_motions_before",
+        "reverse_motions_after",
+        "max_linearisation_error_mm",
+        "limit_violations",
+    ] {
+        assert!(json.get(key).is_some(), "{key}");
+    }
+}
+
+#[test]
+fn rapid_unwinds_continuous_axis() {
+    let m = fixture("xyzbc-trt");
+    let mut moves = Vec::new();
+    for i in 0..=200 {
+        let phi = (i as f64 * 4.0).to_radians();
+        let u = Vector3::new(phi.cos() * 0.5, phi.sin() * 0.5, 0.75f64.sqrt());
+        moves.push(Move::feed(
+            CutterLocation::new(Point3::new(1.0, 2.0, 3.0), u).unwrap(),
+        ));
+    }
+    let last = moves.last().unwrap().cl;
+    moves.push(Move::rapid(
+        CutterLocation::new(
+            last.tip + Vector3::new(0.0, 0.0, 50.0),
+            last.axis.into_inner(),
+        )
+        .unwrap(),
+    ));
+    let opts = PostOptions {
+        linearisation_tol: None,
+        ..Default::default()
+    };
+    let p = post_path(&m, &moves, &opts).unwrap();
+    let before = p.blocks[p.blocks.len() - 2].joints.rotate;
+    let after = p.blocks.last().unwrap();
+    assert!(before.abs() > 2.0 * std::f64::consts::PI);
+    assert!(after.unwound && after.joints.rotate.abs() <= std::f64::consts::PI);
+    assert!((m.forward(&after.joints, 0.0).tip - after.cl.tip).norm() < 1e-9);
+    assert_eq!(p.metrics.unwound_blocks, 1);
+}
+
+#[test]
+fn look_ahead_avoids_forced_reconfiguration() {
+    // C runs from −240° to +240° while A swings in [−59°, 9°]: starting greedily from home
+    // (C = 0) picks the mirrored branch (A > 0), which later runs into A's +50° limit and
+    // would force a 180° C swing inside the cut. Look-ahead starts on the right branch.
+    for name in ["xyzac-trt", "turnmill-bc"] {
+        let m = fixture(name);
+        let (tlo, thi) = m.axis(AxisId::Tilt).limits();
+        let (tmid, tamp) = (0.5 * (tlo + thi), 0.3 * (thi - tlo).min(2.0));
+        let n = 3000;
+        let moves: Vec<Move> = (0..n)
+            .map(|i| {
+                let s = i as f64 / (n - 1) as f64;
+                let tilt = tmid + tamp * (6.0 * std::f64::consts::PI * s).sin();
+                let rotate = (-240.0 + 480.0 * s).to_radians();
+                let (r, a) = (20.0 + 15.0 * s, 40.0 * std::f64::consts::PI * s);
+                Move::feed(CutterLocation {
+                    tip: Point3::new(r * a.cos(), r * a.sin(), 10.0 + 20.0 * s),
+                    axis: m.tool_axis(tilt, rotate),
+                })
+            })
+            .collect();
+        let opts = PostOptions {
+            tool_length: 60.0,
+            ..Default::default()
+        };
+        let p = post_path(&m, &moves, &opts).unwrap();
+        assert_eq!(p.metrics.reconfigurations, 0, "{name}");
+        assert!(
+            p.metrics.max_linearisation_error_mm <= 0.005,
+            "{name}: {:?}",
+            p.metrics
+        );
+    }
+}
