@@ -1,1 +1,85 @@
-//! G-code dialects (LinuxCNC, Fanuc, Sinumerik 840D, Heidenhain) and APT CLDATA read/write.
+//! G-code dialects (LinuxCNC, Fanuc, Sinumerik 840D, Heidenhain ISO) and APT CLDATA
+//! read/write.
+//!
+//! - [`cldata`]: read any CAM system's APT CL file into `cam-core` tool paths with their
+//!   cutters and technology ([`read_cl`]), and write them back ([`write_cl`]).
+//! - [`program`]: the NC program model ([`NcProgram`]) — blocks already carrying joint values
+//!   or tool-tip coordinates — that a [`Dialect`] formats.
+//! - [`dialect`]: the [`Dialect`] trait, [`dialect_by_name`] and [`write_program_file`]
+//!   (temporary file + rename).
+//! - [`assemble`]: CL operations + a `postproc-kinematics` machine → [`NcProgram`].
+//! - [`NumberFormat`]: fixed decimals, never an exponent, `-0` printed as `0`.
+//! - [`gcode_read`]: a small LinuxCNC G-code reader returning joint blocks, for verification
+//!   by forward kinematics ([`gcode_read::joints_of`]).
+//!
+//! Work offsets: joint output ([`OutputMode::Joint`]) writes machine joint values computed
+//! with the machine file's rotary centres and workpiece origin, so the controller's work
+//! offset must be the machine zero those centres refer to; tool-tip output
+//! ([`OutputMode::TcpAngles`], [`OutputMode::TcpVector`], 3+2 planes) writes workpiece
+//! coordinates, so the work offset must hold the workpiece origin.
+//!
+//! ```
+//! use gcode_emit::{assemble_program, read_cl, AssembleOptions, ClReadOptions, Dialect,
+//!     LinuxCnc, ProgramOptions};
+//! use postproc_kinematics::Machine;
+//!
+//! let cl = read_cl("MULTAX/ON\nLOADTL/1\nCUTTER/6,3,0,3,0,0,30\nFEDRAT/MMPM,500\n\
+//!     GOTO/20,0,5,0,0,1\nGOTO/20,5,5,0,0.1736482,0.9848078\nFINI\n",
+//!     "demo.cls", &ClReadOptions::default()).unwrap();
+//! let machine = Machine::from_toml_str(r#"
+//! name = "trt"
+//! [kinematics]
+//! type = "table-table"
+//! tilt_axis = "A"
+//! [axes.X]
+//! min = -500.0
+//! max = 500.0
+//! [axes.Y]
+//! min = -500.0
+//! max = 500.0
+//! [axes.Z]
+//! min = -500.0
+//! max = 500.0
+//! [axes.A]
+//! min = -120.0
+//! max = 120.0
+//! [axes.C]
+//! mode = "continuous"
+//! "#, "trt.toml").unwrap();
+//! let dialect = LinuxCnc::default();
+//! let posted = assemble_program("demo", &cl.operations, &machine, &dialect,
+//!     &AssembleOptions::default()).unwrap();
+//! let text = dialect.write(&posted.program, &ProgramOptions::default()).unwrap();
+//! assert!(text.contains("G93 G1"));
+//! assert!(text.trim_end().ends_with('%'));
+//! ```
+
+mod apt_cutter;
+pub mod assemble;
+mod atomic_write;
+pub mod cldata;
+pub mod dialect;
+mod dialects;
+mod error;
+pub mod gcode_read;
+mod number;
+pub mod program;
+pub mod tilted_plane;
+
+pub use apt_cutter::{apt_from_cl_params, apt_to_cl_params};
+pub use assemble::{assemble_program, AssembleOptions, AssembledProgram};
+pub use atomic_write::write_atomic;
+pub use cldata::{
+    read_cl, read_cl_file, write_cl, write_cl_file, ClOperation, ClProgram, ClReadOptions,
+    ClWarning, ClWriteOptions, Coolant, Spindle,
+};
+pub use dialect::{dialect_by_name, write_program_file, Dialect, DIALECT_NAMES};
+pub use dialects::{Fanuc, HeidenhainIso, LinuxCnc, Sinumerik};
+pub use error::GcodeError;
+pub use gcode_read::{read_gcode, read_gcode_file, GcodeBlock, GcodeFeed, GcodeMotion};
+pub use number::NumberFormat;
+pub use program::{
+    Feed, LineNumbers, Motion, NcMove, NcOperation, NcProgram, OutputMode, ProgramOptions,
+    RotaryWord, ToolCall,
+};
+pub use tilted_plane::TiltedPlane;

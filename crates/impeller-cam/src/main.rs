@@ -29,6 +29,8 @@ enum Command {
     Stiffness(cmd::stiffness::Args),
     /// Build an impeller and print its measured summary (blade counts, diameters, widths).
     Model(cmd::model::Args),
+    /// Post-process an APT CLDATA file into a program for a machine and controller.
+    Post(cmd::post::Args),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +47,7 @@ fn main() -> ExitCode {
         Command::Run(args) => cmd::run::run(args),
         Command::Stiffness(args) => cmd::stiffness::run(args),
         Command::Model(args) => cmd::model::run(args),
+        Command::Post(args) => cmd::post::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
 pub mod model;
+pub mod post;
 pub mod run;
 pub mod stiffness;

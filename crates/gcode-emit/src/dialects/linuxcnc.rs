@@ -1,0 +1,147 @@
+//! LinuxCNC (rs274ngc) output.
+//!
+//! - Joint output ([`OutputMode::Joint`]) for trivial/identity kinematics: X Y Z A/B C are
+//!   the machine's joints, tool length compensation by `G43 H<tool>`, moves that turn a
+//!   rotary axis in inverse time (`G93`, an `F` on every block), back to `G94` after.
+//! - Tool-tip output ([`OutputMode::TcpAngles`]) for a machine running LinuxCNC's switchable
+//!   `xyzac-trt-kins` / `xyzbc-trt-kins`: the kinematics are switched to TCP with the
+//!   configuration's remapped M code (`M428` in LinuxCNC's sample configurations) after the
+//!   rotary axes are pre-positioned, and back to identity (`M429`) at the operation's end;
+//!   X Y Z are then the tool tip in the workpiece frame and F is mm/min at the tip.
+//!   LinuxCNC has no `G43.4`; TCP is a kinematics switch.
+//! - Retract between operations with `G53 G0 Z<safe>` (machine coordinates), rotary axes
+//!   pre-positioned alone before X Y, program end `M2` (or `M30`), `%` delimiters.
+//! - Checked by running LinuxCNC's own interpreter `rs274` on our output (tests/rs274.rs).
+
+use super::common::{
+    coolant_word, op_comment, rotary_words, simultaneous, spindle_words, write_moves,
+};
+use crate::dialect::{
+    num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
+};
+use crate::program::{NcProgram, OutputMode, ProgramOptions};
+use crate::{GcodeError, NumberFormat};
+
+/// LinuxCNC dialect settings.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LinuxCnc {
+    /// M code switching the kinematics to tool-centre-point (`M428` in LinuxCNC's
+    /// `xyzac-trt` sample configuration).
+    pub tcp_on: String,
+    /// M code switching back to identity kinematics (`M429`).
+    pub tcp_off: String,
+    /// Program end code (`M2` or `M30`).
+    pub program_end: String,
+}
+
+impl Default for LinuxCnc {
+    fn default() -> Self {
+        Self {
+            tcp_on: "M428".into(),
+            tcp_off: "M429".into(),
+            program_end: "M2".into(),
+        }
+    }
+}
+
+impl LinuxCnc {
+    fn style(o: &ProgramOptions) -> MotionStyle {
+        MotionStyle {
+            rapid: "G0",
+            linear: "G1",
+            feed_modes: ("G93", "G94"),
+            vector_words: ["I", "J", "K"],
+            linear_fmt: NumberFormat::trimmed(o.linear_decimals),
+            angular_fmt: NumberFormat::trimmed(o.angular_decimals),
+            feed_fmt: NumberFormat::trimmed(o.feed_decimals),
+            inverse_fmt: NumberFormat::trimmed(o.inverse_time_decimals),
+        }
+    }
+}
+
+impl Dialect for LinuxCnc {
+    fn name(&self) -> &'static str {
+        "linuxcnc"
+    }
+    fn extension(&self) -> &'static str {
+        "ngc"
+    }
+    fn supports(&self, mode: OutputMode) -> bool {
+        matches!(mode, OutputMode::Joint | OutputMode::TcpAngles)
+    }
+    fn supports_indexed(&self) -> bool {
+        false
+    }
+
+    fn write(&self, program: &NcProgram, o: &ProgramOptions) -> Result<String, GcodeError> {
+        o.validate()?;
+        let style = Self::style(o);
+        let lin = style.linear_fmt;
+        let mut w = BlockWriter::new(o.line_numbers, "");
+        let mut mw = MotionWriter::new(style);
+        w.raw("%");
+        if o.comments {
+            w.raw(&format!("({})", program_name(&program.name)));
+        }
+        w.block(&format!("G21 G17 G90 G94 G40 G49 G{}", 53 + o.work_offset));
+        let at0 = At {
+            op: "program",
+            block: 0,
+        };
+        let safe = format!("G53 G0 Z{}", num(lin, o.safe_z_machine, "Z", at0)?);
+        let mut tool: Option<u32> = None;
+        for op in &program.operations {
+            let (mode, moves) =
+                simultaneous(op, self.name(), &[OutputMode::Joint, OutputMode::TcpAngles])?;
+            let Some(first) = moves.first() else { continue };
+            let at = At {
+                op: &op.name,
+                block: 0,
+            };
+            if o.comments {
+                w.raw(&format!("({})", sanitize(&op_comment(op), false)));
+            }
+            w.block(&safe);
+            if tool != Some(op.tool.number) {
+                w.block(&format!("T{} M6", op.tool.number));
+                w.block(&format!("G43 H{}", op.tool.number));
+                tool = Some(op.tool.number);
+            }
+            w.block(&spindle_words(
+                op.tool.spindle,
+                NumberFormat::trimmed(0),
+                at,
+            )?);
+            w.block(coolant_word(op.tool.coolant));
+            mw.forget_positions();
+            if !first.rotary.is_empty() {
+                w.block(&format!(
+                    "G0 {}",
+                    rotary_words(first, style.angular_fmt, at)?
+                ));
+            }
+            if mode == OutputMode::TcpAngles {
+                w.block(&self.tcp_on);
+            } else {
+                w.block(&format!(
+                    "G0 X{} Y{}",
+                    num(lin, first.xyz[0], "X", at)?,
+                    num(lin, first.xyz[1], "Y", at)?
+                ));
+            }
+            write_moves(&mut w, &mut mw, &op.name, mode, moves, "")?;
+            if let Some(g94) = mw.leave_inverse_time() {
+                w.block(g94);
+            }
+            if mode == OutputMode::TcpAngles {
+                w.block(&self.tcp_off);
+            }
+            mw.forget_positions();
+        }
+        w.block(&safe);
+        w.block("M5 M9");
+        w.block(&self.program_end);
+        w.raw("%");
+        Ok(w.finish())
+    }
+}
