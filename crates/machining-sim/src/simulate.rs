@@ -1,0 +1,408 @@
+//! The verification driver: sweep every operation through the stock, collect collisions, then
+//! measure overcut and residual over the design surfaces.
+//!
+//! Each move is sampled at the positions of [`crate::motion::positions_for_move`] (sweep
+//! tolerance default `h/4` for cell `h`); positions are applied in batches with
+//! [`crate::removal::apply_batch`] (parallel over ray rows, exact sequential semantics), and
+//! each batch's shank/holder placements are checked against the design mesh in parallel
+//! ([`crate::collision`]). A rapid move never cuts; any contact of the tool with material
+//! during a rapid is a collision. The first move of a tool path is a single position.
+
+use crate::collision::{DesignCollider, PartShapes};
+use crate::design::DesignModel;
+use crate::dexel::TriDexel;
+use crate::error::SimError;
+use crate::measure::{extremum, measure_maps, Extremum, SurfaceMap};
+use crate::motion::{positions_for_move, Interpolation};
+use crate::removal::{apply_batch, PartKind, Placement, ToolBody};
+use cam_core::{Cutter, MoveKind, ToolPath};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Options of [`simulate`] / [`cut`].
+#[derive(Debug, Clone)]
+pub struct SimOptions {
+    /// Largest swept-volume error between sampled positions (mm); default: cell / 4.
+    pub sweep_tol_mm: Option<f64>,
+    /// How the controller moves between cutter locations.
+    pub interpolation: Interpolation,
+    /// Check shank/holder against stock and design (rapids are always checked).
+    pub check_collisions: bool,
+    /// Material overlap (mm, along a ray) below which a contact is not reported; default:
+    /// twice the sweep tolerance (the scallops left between sampled positions).
+    pub collision_tol_mm: Option<f64>,
+    /// Largest thickness measured by the overcut/residual probes (mm).
+    pub probe_depth_mm: f64,
+    /// Positions per batch.
+    pub batch_positions: usize,
+    /// Print progress on stderr.
+    pub progress: bool,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        Self {
+            sweep_tol_mm: None,
+            interpolation: Interpolation::Tcp,
+            check_collisions: true,
+            collision_tol_mm: None,
+            probe_depth_mm: 5.0,
+            batch_positions: 4096,
+            progress: false,
+        }
+    }
+}
+
+/// The verification metrics with the names fixed by DESIGN.md §4.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Metrics {
+    /// Largest overcut over all design samples (mm).
+    pub max_overcut_mm: f64,
+    /// Largest residual over all design samples (mm).
+    pub max_residual_mm: f64,
+    /// Number of moves with at least one collision.
+    pub collisions: usize,
+}
+
+/// What a colliding part hit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CollisionTarget {
+    /// The in-process stock.
+    Stock,
+    /// The design part.
+    Design,
+}
+
+/// A collision of one part during one move (deepest contact over the move's positions).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Collision {
+    /// Operation (tool path) name.
+    pub operation: String,
+    /// Move index within the tool path.
+    pub move_index: usize,
+    /// Kind of the move.
+    pub move_kind: MoveKind,
+    /// Part of the tool.
+    pub part: PartKind,
+    /// What it hit.
+    pub target: CollisionTarget,
+    /// Depth (mm): longest material overlap along a dexel ray (stock) or parry's
+    /// penetration depth (design).
+    pub depth_mm: f64,
+    /// Where (mm).
+    pub point: [f64; 3],
+}
+
+/// Counters and timings.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SimStats {
+    /// Moves simulated.
+    pub moves: usize,
+    /// Cutter positions applied.
+    pub positions: usize,
+    /// Dexel cell size (mm).
+    pub resolution_mm: f64,
+    /// Sweep tolerance used (mm).
+    pub sweep_tol_mm: f64,
+    /// Rays in the three grids.
+    pub rays: usize,
+    /// Stock memory after the simulation (bytes).
+    pub stock_memory_bytes: usize,
+    /// Material removed (mm³).
+    pub removed_volume_mm3: f64,
+    /// Wall-clock time of the removal and stock collision checks (ms).
+    pub removal_ms: f64,
+    /// Wall-clock time of the design collision checks (ms).
+    pub design_collision_ms: f64,
+    /// Wall-clock time of the overcut/residual measurement (ms).
+    pub measure_ms: f64,
+}
+
+/// Outcome of sweeping the tool paths through the stock.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CutOutcome {
+    /// Collisions, sorted by operation, move, part.
+    pub collisions: Vec<Collision>,
+    /// Counters.
+    pub stats: SimStats,
+}
+
+/// Full verification report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// DESIGN metric names.
+    pub metrics: Metrics,
+    /// Where the largest overcut is.
+    pub max_overcut: Option<Extremum>,
+    /// Where the largest residual is.
+    pub max_residual: Option<Extremum>,
+    /// Collisions per move.
+    pub collisions: Vec<Collision>,
+    /// Counters and timings.
+    pub stats: SimStats,
+    /// Per-surface maps.
+    pub maps: Vec<SurfaceMap>,
+}
+
+type Key = (usize, usize, PartKind, CollisionTarget);
+
+struct Acc {
+    map: BTreeMap<Key, (f64, [f64; 3])>,
+}
+
+impl Acc {
+    fn add(&mut self, key: Key, depth: f64, point: [f64; 3]) {
+        let e = self.map.entry(key).or_insert((f64::NEG_INFINITY, point));
+        if depth > e.0 {
+            *e = (depth, point);
+        }
+    }
+}
+
+/// Sweeps the tool paths through the stock (and checks the design mesh for shank/holder
+/// collisions when `design` is given). Each operation is a cutter with its tool path.
+pub fn cut(
+    stock: &mut TriDexel,
+    design: Option<&dyn DesignModel>,
+    ops: &[(Cutter, ToolPath)],
+    options: &SimOptions,
+) -> Result<CutOutcome, SimError> {
+    let cell = stock.cell();
+    let tol = options.sweep_tol_mm.unwrap_or(cell / 4.0);
+    if !(tol.is_finite() && tol > 0.0) {
+        return Err(SimError::InvalidOption {
+            name: "sweep_tol_mm",
+            value: tol,
+            reason: "must be finite and > 0",
+        });
+    }
+    let ctol = options.collision_tol_mm.unwrap_or(2.0 * tol);
+    if !(ctol.is_finite() && ctol >= 0.0) {
+        return Err(SimError::InvalidOption {
+            name: "collision_tol_mm",
+            value: ctol,
+            reason: "must be finite and >= 0",
+        });
+    }
+    let mut bodies = Vec::with_capacity(ops.len());
+    for (cutter, path) in ops {
+        cutter
+            .validate()
+            .map_err(|source| SimError::InvalidCutter {
+                operation: path.name.clone(),
+                source,
+            })?;
+        bodies.push(ToolBody::new(cutter));
+    }
+    let collider = match design {
+        Some(d) if options.check_collisions => Some(DesignCollider::new(&d.triangle_mesh())?),
+        _ => None,
+    };
+    let shapes: Vec<(PartShapes, PartShapes)> = bodies
+        .iter()
+        .map(|b| (PartShapes::new(b, false), PartShapes::new(b, true)))
+        .collect();
+
+    let mut acc = Acc {
+        map: BTreeMap::new(),
+    };
+    let mut stats = SimStats {
+        resolution_mm: cell,
+        sweep_tol_mm: tol,
+        rays: stock.ray_count(),
+        ..SimStats::default()
+    };
+    let cap = options.batch_positions.max(1);
+    let mut batch: Vec<Placement> = Vec::with_capacity(cap);
+    let mut meta: Vec<(usize, usize)> = Vec::with_capacity(cap);
+    let total_moves: usize = ops.iter().map(|(_, p)| p.moves.len()).sum();
+    let mut last_report = Instant::now();
+    let start = Instant::now();
+    let mut design_ms = 0.0;
+
+    let flush = |batch: &mut Vec<Placement>,
+                 meta: &mut Vec<(usize, usize)>,
+                 stock: &mut TriDexel,
+                 acc: &mut Acc,
+                 stats: &mut SimStats,
+                 design_ms: &mut f64| {
+        let out = apply_batch(stock, &bodies, batch, options.check_collisions, ctol);
+        stats.removed_volume_mm3 += out.removed_volume;
+        stats.positions += batch.len();
+        for h in out.hits {
+            let (op, mv) = meta[h.placement];
+            acc.add((op, mv, h.part, CollisionTarget::Stock), h.depth, h.point);
+        }
+        if let (Some(collider), Some(design)) = (&collider, design) {
+            let t = Instant::now();
+            let hits: Vec<(usize, crate::collision::DesignHit)> = batch
+                .par_iter()
+                .enumerate()
+                .flat_map_iter(|(k, pl)| {
+                    let parts = if pl.rapid {
+                        &shapes[pl.tool].1
+                    } else {
+                        &shapes[pl.tool].0
+                    };
+                    collider
+                        .check(design, parts, &pl.tip, &pl.axis)
+                        .into_iter()
+                        .map(move |h| (k, h))
+                })
+                .collect();
+            for (k, h) in hits {
+                let (op, mv) = meta[k];
+                acc.add((op, mv, h.part, CollisionTarget::Design), h.depth, h.point);
+            }
+            *design_ms += t.elapsed().as_secs_f64() * 1e3;
+        }
+        batch.clear();
+        meta.clear();
+    };
+
+    let mut done_moves = 0usize;
+    for (oi, (cutter, path)) in ops.iter().enumerate() {
+        for (mi, mv) in path.moves.iter().enumerate() {
+            let cl = mv.cl;
+            let finite =
+                cl.tip.iter().all(|x| x.is_finite()) && cl.axis.iter().all(|x| x.is_finite());
+            if !finite {
+                return Err(SimError::NonFiniteMove {
+                    operation: path.name.clone(),
+                    index: mi,
+                });
+            }
+            let rapid = mv.kind == MoveKind::Rapid;
+            let mut push = |c: &cam_core::CutterLocation| {
+                batch.push(Placement {
+                    tip: [c.tip.x, c.tip.y, c.tip.z],
+                    axis: [c.axis.x, c.axis.y, c.axis.z],
+                    tool: oi,
+                    rapid,
+                });
+                meta.push((oi, mi));
+            };
+            if mi == 0 {
+                push(&cl);
+            } else {
+                let from = path.moves[mi - 1].cl;
+                let n = positions_for_move(cutter, &options.interpolation, oi, mi, &from, &cl, tol);
+                for k in 1..=n {
+                    let c = if k == n {
+                        cl
+                    } else {
+                        options
+                            .interpolation
+                            .at(oi, mi, &from, &cl, k as f64 / n as f64)
+                    };
+                    push(&c);
+                }
+            }
+            done_moves += 1;
+            if batch.len() >= cap {
+                flush(
+                    &mut batch,
+                    &mut meta,
+                    stock,
+                    &mut acc,
+                    &mut stats,
+                    &mut design_ms,
+                );
+                if options.progress && last_report.elapsed().as_secs_f64() > 2.0 {
+                    eprintln!(
+                        "verify: {}: {done_moves}/{total_moves} moves, {} positions, {:.1} s",
+                        path.name,
+                        stats.positions,
+                        start.elapsed().as_secs_f64()
+                    );
+                    last_report = Instant::now();
+                }
+            }
+        }
+    }
+    flush(
+        &mut batch,
+        &mut meta,
+        stock,
+        &mut acc,
+        &mut stats,
+        &mut design_ms,
+    );
+    stats.moves = done_moves;
+    stats.removal_ms = start.elapsed().as_secs_f64() * 1e3 - design_ms;
+    stats.design_collision_ms = design_ms;
+    stats.stock_memory_bytes = stock.memory_bytes();
+
+    let collisions = acc
+        .map
+        .into_iter()
+        .map(|((op, mv, part, target), (depth, point))| Collision {
+            operation: ops[op].1.name.clone(),
+            move_index: mv,
+            move_kind: ops[op].1.moves[mv].kind,
+            part,
+            target,
+            depth_mm: depth,
+            point,
+        })
+        .collect();
+    Ok(CutOutcome { collisions, stats })
+}
+
+/// Number of distinct (operation, move) pairs with a collision.
+pub fn colliding_moves(collisions: &[Collision]) -> usize {
+    let mut keys: Vec<(&str, usize)> = collisions
+        .iter()
+        .map(|c| (c.operation.as_str(), c.move_index))
+        .collect();
+    keys.sort_unstable();
+    keys.dedup();
+    keys.len()
+}
+
+/// Verifies tool paths against a design: sweeps them through `stock` (modified in place to
+/// the final stock), checks collisions, and measures overcut and residual maps over the
+/// design's surface samples. A copy of the initial stock is kept for the measurement
+/// (memory ×2 during `simulate`).
+pub fn simulate(
+    stock: &mut TriDexel,
+    design: &dyn DesignModel,
+    ops: &[(Cutter, ToolPath)],
+    options: &SimOptions,
+) -> Result<Report, SimError> {
+    if !(options.probe_depth_mm.is_finite() && options.probe_depth_mm > 0.0) {
+        return Err(SimError::InvalidOption {
+            name: "probe_depth_mm",
+            value: options.probe_depth_mm,
+            reason: "must be finite and > 0",
+        });
+    }
+    let initial = stock.clone();
+    let outcome = cut(stock, Some(design), ops, options)?;
+    let t = Instant::now();
+    if options.progress {
+        eprintln!("verify: measuring overcut and residual over the design surfaces");
+    }
+    let grids = design.surface_grids();
+    let maps = measure_maps(stock, &initial, design, &grids, options.probe_depth_mm);
+    let max_overcut = extremum(&maps, false, options.probe_depth_mm);
+    let max_residual = extremum(&maps, true, options.probe_depth_mm);
+    let mut stats = outcome.stats;
+    stats.measure_ms = t.elapsed().as_secs_f64() * 1e3;
+    let metrics = Metrics {
+        max_overcut_mm: max_overcut.as_ref().map_or(0.0, |e| e.value_mm),
+        max_residual_mm: max_residual.as_ref().map_or(0.0, |e| e.value_mm),
+        collisions: colliding_moves(&outcome.collisions),
+    };
+    Ok(Report {
+        metrics,
+        max_overcut,
+        max_residual,
+        collisions: outcome.collisions,
+        stats,
+        maps,
+    })
+}

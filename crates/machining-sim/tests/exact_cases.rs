@@ -1,0 +1,320 @@
+//! Exact cases: plunge of a flat end (volume, floor), ball-end groove profile, a deliberate
+//! gouge into a blade-like plate, the resolution study and collisions.
+
+use cam_core::{
+    Cutter, CutterLocation, CutterShape, HolderSegment, Move, MoveKind, Point3, ToolPath,
+};
+use machining_sim::{
+    cut, simulate, BoxDesign, BoxStock, CollisionTarget, PartKind, SimOptions, TriDexel,
+};
+
+fn vertical(x: f64, y: f64, z: f64) -> CutterLocation {
+    CutterLocation::vertical(Point3::new(x, y, z))
+}
+
+fn path(moves: Vec<(MoveKind, CutterLocation)>) -> ToolPath {
+    let mut p = ToolPath::new("op", "t");
+    p.moves = moves
+        .into_iter()
+        .map(|(kind, cl)| Move {
+            kind,
+            cl,
+            feed_mm_per_min: None,
+        })
+        .collect();
+    p
+}
+
+#[test]
+fn flat_end_plunge_removes_exact_cylinder() {
+    let h = 0.2;
+    let block = BoxStock::new([0.0, 0.0, 0.0], [20.0, 20.0, 10.0]).unwrap();
+    let mut stock = TriDexel::from_shape(&block, h).unwrap();
+    let v0 = stock.volume();
+    assert!((v0 - 4000.0).abs() < 1e-6 * 4000.0 + 1e-3, "{v0}");
+    let r = 3.0;
+    let cutter = Cutter::new("f6", CutterShape::FlatEnd { radius: r }, 20.0, r, 40.0).unwrap();
+    let p = path(vec![
+        (MoveKind::Rapid, vertical(10.0, 10.0, 15.0)),
+        (MoveKind::Plunge, vertical(10.0, 10.0, 6.0)),
+        (MoveKind::Retract, vertical(10.0, 10.0, 15.0)),
+    ]);
+    let out = cut(&mut stock, None, &[(cutter, p)], &SimOptions::default()).unwrap();
+    let exact = std::f64::consts::PI * r * r * 4.0;
+    // Volume error bounded by one cell over the cut's boundary (wall + floor).
+    let bound = (2.0 * std::f64::consts::PI * r * 4.0 + std::f64::consts::PI * r * r) * h;
+    let removed = v0 - stock.volume();
+    assert!(
+        (removed - exact).abs() < bound,
+        "removed {removed} vs {exact} (bound {bound})"
+    );
+    assert!((out.stats.removed_volume_mm3 - exact).abs() < bound);
+    // Floor: every Z ray well inside the cutter ends at z = 6, every ray well outside at 10.
+    let g = stock.grid(2);
+    let (nu, nv) = g.size();
+    let mut inside = 0;
+    for j in 0..nv {
+        for i in 0..nu {
+            let (x, y) = g.ray_uv(i, j);
+            let rho = ((x - 10.0).powi(2) + (y - 10.0).powi(2)).sqrt();
+            let segs = g.ray(i, j).as_slice();
+            if !(0.0..=20.0).contains(&x) || !(0.0..=20.0).contains(&y) {
+                continue;
+            }
+            let top = f64::from(segs.last().unwrap()[1]);
+            if rho < r - 1e-9 {
+                inside += 1;
+                assert!((top - 6.0).abs() < 1e-5, "floor {top} at ({x},{y})");
+            } else if rho > r + 1e-9 {
+                assert!((top - 10.0).abs() < 1e-5, "top {top} at ({x},{y})");
+            }
+        }
+    }
+    assert!(inside > 600, "{inside} rays under the cutter");
+    // The plunge of a cylinder whose shank equals its radius does not collide.
+    assert!(out.collisions.is_empty(), "{:?}", out.collisions);
+}
+
+#[test]
+fn ball_end_groove_has_circular_profile() {
+    let h = 0.1;
+    let block = BoxStock::new([0.0, 0.0, 0.0], [20.0, 8.0, 5.0]).unwrap();
+    let mut stock = TriDexel::from_shape(&block, h).unwrap();
+    let r = 2.0;
+    let cutter = Cutter::new("b4", CutterShape::BallEnd { radius: r }, 10.0, r, 30.0).unwrap();
+    let depth = 1.2;
+    let zt = 5.0 - depth;
+    let p = path(vec![
+        (MoveKind::Rapid, vertical(-3.0, 4.0, zt)),
+        (MoveKind::Feed, vertical(23.0, 4.0, zt)),
+    ]);
+    let opts = SimOptions::default();
+    cut(&mut stock, None, &[(cutter, p)], &opts).unwrap();
+    let tol = h / 4.0;
+    let half_width = (r * r - (r - depth).powi(2)).sqrt();
+    // Z rays across the groove at x ≈ 10: floor follows the circle z = zt + r − sqrt(r² − dy²).
+    let g = stock.grid(2);
+    let (nu, nv) = g.size();
+    let mut checked = 0;
+    for j in 0..nv {
+        for i in 0..nu {
+            let (x, y) = g.ray_uv(i, j);
+            if (x - 10.0).abs() > 0.3 || !(0.0..=8.0).contains(&y) {
+                continue;
+            }
+            let dy = y - 4.0;
+            let want = if dy.abs() < half_width {
+                zt + r - (r * r - dy * dy).sqrt()
+            } else {
+                5.0
+            };
+            let top = f64::from(g.ray(i, j).as_slice().last().unwrap()[1]);
+            // Error measured along the groove normal (the sweep tolerance bounds it there).
+            let cos = if dy.abs() < half_width {
+                (1.0 - (dy / r).powi(2)).sqrt()
+            } else {
+                1.0
+            };
+            assert!(
+                (top - want).abs() * cos <= tol + 1e-4,
+                "y {y}: {top} vs {want}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 100);
+    // Y rays (along y) at x = 10, height z: the groove gap is 2·sqrt(r² − (zt + r − z)²).
+    let gy = stock.grid(1);
+    let (nu, nv) = gy.size(); // u = z, v = x
+    for j in 0..nv {
+        for i in 0..nu {
+            let (z, x) = gy.ray_uv(i, j);
+            if (x - 10.0).abs() > 0.15 || !(zt + 0.3..5.0).contains(&z) {
+                continue;
+            }
+            let segs = gy.ray(i, j).as_slice();
+            assert_eq!(segs.len(), 2, "z {z}: {segs:?}");
+            let gap = f64::from(segs[1][0] - segs[0][1]);
+            let half = (r * r - (zt + r - z).powi(2)).sqrt();
+            // Normal error ≤ tol on each wall; along y it grows by r / half (wall slope).
+            let bound = 2.0 * tol * r / half + 1e-4;
+            assert!(
+                (gap - 2.0 * half).abs() < bound,
+                "z {z}: gap {gap} vs {}",
+                2.0 * half
+            );
+        }
+    }
+}
+
+/// Plate x ∈ [−1, 1] (blade-like), stock on its +x side, flank pass with a flat end along y
+/// plus a deliberate dip of `gouge` mm into the plate at y = 2.
+fn plate_case(h: f64, gouge: f64) -> machining_sim::Report {
+    let design = BoxDesign {
+        min: [-1.0, -10.0, 0.0],
+        max: [1.0, 10.0, 15.0],
+        sample_spacing: 0.25,
+    };
+    let block = BoxStock::new([-1.0, -10.0, 0.0], [5.0, 10.0, 15.0]).unwrap();
+    let mut stock = TriDexel::from_shape(&block, h).unwrap();
+    let r = 2.0;
+    let cutter = Cutter::new("f4", CutterShape::FlatEnd { radius: r }, 20.0, r, 40.0).unwrap();
+    let x = 1.0 + r;
+    let z = -1.0;
+    let p = path(vec![
+        (MoveKind::Rapid, vertical(x, -13.0, 30.0)),
+        (MoveKind::Plunge, vertical(x, -13.0, z)),
+        (MoveKind::Feed, vertical(x, 1.0, z)),
+        (MoveKind::Feed, vertical(x - gouge, 2.0, z)),
+        (MoveKind::Feed, vertical(x, 3.0, z)),
+        (MoveKind::Feed, vertical(x, 13.0, z)),
+        (MoveKind::Retract, vertical(x, 13.0, 30.0)),
+    ]);
+    simulate(&mut stock, &design, &[(cutter, p)], &SimOptions::default()).unwrap()
+}
+
+#[test]
+fn deliberate_gouge_is_found_with_depth_and_location() {
+    let h = 0.2;
+    let rep = plate_case(h, 0.3);
+    let e = rep.max_overcut.clone().unwrap();
+    assert!((e.value_mm - 0.3).abs() < h, "{e:?}");
+    assert_eq!(e.surface, "x_max");
+    assert!((e.point[1] - 2.0).abs() < 0.3, "{e:?}");
+    assert_eq!(rep.metrics.max_overcut_mm, e.value_mm);
+    // Elsewhere on the machined face no overcut and residual below a cell.
+    let face = rep.maps.iter().find(|m| m.name == "x_max").unwrap();
+    for (k, p) in face.points.iter().enumerate() {
+        if (p[1] - 2.0).abs() > 2.5 {
+            assert!(
+                face.overcut_mm[k].unwrap() < h,
+                "{p:?} {:?}",
+                face.overcut_mm[k]
+            );
+            assert!(
+                face.residual_mm[k].unwrap() < h,
+                "{p:?} {:?}",
+                face.residual_mm[k]
+            );
+        }
+    }
+    assert_eq!(rep.metrics.collisions, 0, "{:?}", rep.collisions);
+}
+
+#[test]
+fn resolution_study_halving_the_cell_changes_overcut_less_than_a_cell() {
+    let coarse = plate_case(0.2, 0.45).metrics.max_overcut_mm;
+    let fine = plate_case(0.1, 0.45).metrics.max_overcut_mm;
+    assert!((coarse - fine).abs() < 0.1, "{coarse} vs {fine}");
+    assert!((fine - 0.45).abs() < 0.1, "{fine}");
+}
+
+#[test]
+fn residual_of_an_unmachined_strip_is_measured() {
+    // Same plate, the cutter stays 0.4 mm away from the face: residual 0.4 everywhere.
+    let design = BoxDesign {
+        min: [-1.0, -10.0, 0.0],
+        max: [1.0, 10.0, 15.0],
+        sample_spacing: 0.5,
+    };
+    let h = 0.1;
+    let block = BoxStock::new([-1.0, -10.0, 0.0], [5.0, 10.0, 15.0]).unwrap();
+    let mut stock = TriDexel::from_shape(&block, h).unwrap();
+    let cutter = Cutter::new("f4", CutterShape::FlatEnd { radius: 2.0 }, 20.0, 2.0, 40.0).unwrap();
+    let p = path(vec![
+        (MoveKind::Plunge, vertical(3.4, -13.0, -1.0)),
+        (MoveKind::Feed, vertical(3.4, 13.0, -1.0)),
+    ]);
+    let rep = simulate(&mut stock, &design, &[(cutter, p)], &SimOptions::default()).unwrap();
+    assert!(
+        (rep.metrics.max_residual_mm - 0.4).abs() < h,
+        "{:?}",
+        rep.max_residual
+    );
+    assert!(rep.metrics.max_overcut_mm < h);
+}
+
+#[test]
+fn shank_rub_and_rapid_through_material_are_collisions() {
+    let h = 0.25;
+    let block = BoxStock::new([0.0, 0.0, 0.0], [20.0, 20.0, 10.0]).unwrap();
+    let mut stock = TriDexel::from_shape(&block, h).unwrap();
+    // Flutes 5 mm long, shank radius 1.5 < cutter radius 2.
+    let mut cutter =
+        Cutter::new("f4", CutterShape::FlatEnd { radius: 2.0 }, 5.0, 1.5, 30.0).unwrap();
+    cutter.holder.push(HolderSegment {
+        bottom_radius: 10.0,
+        top_radius: 10.0,
+        length: 20.0,
+    });
+    let p = path(vec![
+        (MoveKind::Rapid, vertical(-5.0, 10.0, 2.0)),
+        // Side cut at depth 8: the flutes reach z = 7, the shank rubs z ∈ [7, 10].
+        (MoveKind::Feed, vertical(10.0, 10.0, 2.0)),
+        (MoveKind::Retract, vertical(10.0, 10.0, 40.0)),
+        // Rapid back down through uncut material.
+        (MoveKind::Rapid, vertical(15.0, 15.0, 5.0)),
+    ]);
+    let design = BoxDesign {
+        min: [0.0, 0.0, 0.0],
+        max: [20.0, 20.0, 1.0],
+        sample_spacing: 1.0,
+    };
+    let rep = simulate(&mut stock, &design, &[(cutter, p)], &SimOptions::default()).unwrap();
+    let shank = rep
+        .collisions
+        .iter()
+        .find(|c| {
+            c.move_index == 1 && c.part == PartKind::Shank && c.target == CollisionTarget::Stock
+        })
+        .unwrap_or_else(|| panic!("{:?}", rep.collisions));
+    assert!(shank.depth_mm > 1.0, "{shank:?}");
+    assert!(
+        shank.point[2] > 7.0 - h && shank.point[2] < 10.0 + h,
+        "{shank:?}"
+    );
+    assert!(rep.collisions.iter().any(|c| c.move_index == 3
+        && c.part == PartKind::RapidMove
+        && c.target == CollisionTarget::Stock));
+    // The shank stays buried in the uncut band while retracting: still a collision.
+    assert!(rep
+        .collisions
+        .iter()
+        .any(|c| c.move_index == 2 && c.part == PartKind::Shank));
+    assert_eq!(rep.metrics.collisions, 3);
+    // The approach rapid (move 0, outside the block) is clean.
+    assert!(!rep.collisions.iter().any(|c| c.move_index == 0));
+}
+
+#[test]
+fn holder_hitting_the_design_is_reported_through_the_mesh() {
+    let h = 0.5;
+    let block = BoxStock::new([0.0, 0.0, 0.0], [10.0, 10.0, 5.0]).unwrap();
+    let mut stock = TriDexel::from_shape(&block, h).unwrap();
+    let mut cutter =
+        Cutter::new("f2", CutterShape::FlatEnd { radius: 1.0 }, 5.0, 1.0, 10.0).unwrap();
+    cutter.holder.push(HolderSegment {
+        bottom_radius: 8.0,
+        top_radius: 8.0,
+        length: 20.0,
+    });
+    // A tall design wall next to the stock, 5 mm from the tool axis: the holder (radius 8)
+    // sweeps through it while the tool cuts air above the stock.
+    let design = BoxDesign {
+        min: [15.0, 0.0, 0.0],
+        max: [17.0, 10.0, 40.0],
+        sample_spacing: 2.0,
+    };
+    let p = path(vec![
+        (MoveKind::Feed, vertical(10.0, 5.0, 20.0)),
+        (MoveKind::Feed, vertical(10.0, 6.0, 20.0)),
+    ]);
+    let rep = simulate(&mut stock, &design, &[(cutter, p)], &SimOptions::default()).unwrap();
+    let hit = rep
+        .collisions
+        .iter()
+        .find(|c| c.target == CollisionTarget::Design && c.part == PartKind::Holder)
+        .unwrap_or_else(|| panic!("{:?}", rep.collisions));
+    // Holder face at x = 18 (circumscribed polygon: ≤ 18.14) against the wall [15, 17].
+    assert!(hit.depth_mm > 1.5 && hit.depth_mm < 3.5, "{hit:?}");
+}

@@ -1,0 +1,134 @@
+//! The impeller fixture as a design model: signs of the signed distance, samples on the
+//! surfaces, and a verification run of a gouging cut.
+
+use cam_core::{Cutter, CutterLocation, CutterShape, Move, MoveKind, Point3, ToolPath, Vector3};
+use impeller_model::fixtures::default_impeller;
+use impeller_model::Side;
+use machining_sim::{
+    simulate, CollisionTarget, DesignModel, ImpellerDesign, ImpellerSampling, PartKind, SimOptions,
+    TriDexel,
+};
+
+fn coarse() -> ImpellerSampling {
+    ImpellerSampling {
+        blade_u: 12,
+        blade_v: 6,
+        hub_t: 10,
+        hub_phi: 90,
+        tip_w: 2,
+        mesh_u: 32,
+        mesh_v: 8,
+    }
+}
+
+#[test]
+fn signed_distance_signs_and_samples_on_surfaces() {
+    let imp = default_impeller().unwrap();
+    let d = ImpellerDesign::new(&imp, coarse()).unwrap();
+    let blade = imp.main().instance(0);
+    let s = blade.side(Side::Pressure);
+    let ((u0, u1), (v0, v1)) = s.domain();
+    let (u, v) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
+    let p = s.point(u, v);
+    let n = blade.outward_normal(Side::Pressure, u, v).unwrap();
+    // Just outside the pressure side: +0.1; just inside (blade 0.8 mm thick): −0.1.
+    let out = d.signed_distance(&Point3::from(p + n * 0.1));
+    let inn = d.signed_distance(&Point3::from(p - n * 0.1));
+    assert!((out - 0.1).abs() < 1e-3, "{out}");
+    assert!((inn + 0.1).abs() < 1e-3, "{inn}");
+    // Deep below the hub surface near the axis: inside; far above the shroud: outside.
+    assert!(d.signed_distance(&Point3::new(0.0, 0.0, 1.0)) < -1.0);
+    assert!(d.signed_distance(&Point3::new(30.0, 0.0, 60.0)) > 1.0);
+    let grids = d.surface_grids();
+    let mut kept = 0;
+    for g in &grids {
+        for (p, n) in g.points.iter().zip(&g.normals) {
+            if n.norm() > 0.0 {
+                kept += 1;
+                let sd = d.signed_distance(p);
+                assert!(sd.abs() < 2e-3, "{} {p:?}: sd {sd}", g.name);
+                // The normal points out of the material (away from the blade roots, where
+                // the blade normal runs into the sloped hub).
+                if g.name == "hub" || imp.hub().signed_distance(&p.coords) > 0.1 {
+                    assert!(d.signed_distance(&(p + n * 0.05)) > 0.0, "{} {p:?}", g.name);
+                }
+            }
+        }
+    }
+    assert!(kept > 500, "{kept}");
+    assert!(grids.iter().any(|g| g.name == "splitter3_suction"));
+    assert!(grids.iter().any(|g| g.name == "main0_tip"));
+}
+
+#[test]
+fn gouge_into_a_blade_of_the_fixture_is_located() {
+    let imp = default_impeller().unwrap();
+    let sampling = ImpellerSampling {
+        blade_v: 24,
+        ..coarse()
+    };
+    let design = ImpellerDesign::new(&imp, sampling).unwrap();
+    let blade = imp.main().instance(0);
+    let s = blade.side(Side::Suction);
+    let ((u0, u1), (v0, v1)) = s.domain();
+    let v = v0 + 0.5 * (v1 - v0);
+    // A ball end following the suction side along u at mid-span, its sphere 0.3 mm into the
+    // blade (axis along the surface normal), for u from 0.45 to 0.75 of the domain.
+    let r = 1.5;
+    let gouge = 0.3;
+    // Short flutes: the channel is ~6 mm wide here, the shank (radius 1) reaches the
+    // neighbouring splitter and must be reported as a collision with the design.
+    let cutter = Cutter::new("b3", CutterShape::BallEnd { radius: r }, 3.0, 1.0, 30.0).unwrap();
+    let mut path = ToolPath::new("gouge", "b3");
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    let n_cl = 40;
+    for k in 0..=n_cl {
+        let u = u0 + (0.45 + 0.3 * k as f64 / n_cl as f64) * (u1 - u0);
+        let p = s.point(u, v);
+        let n = blade.outward_normal(Side::Suction, u, v).unwrap();
+        let tip = p - n * gouge;
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i] - 3.0);
+            hi[i] = hi[i].max(p[i] + 3.0);
+        }
+        path.moves.push(Move {
+            kind: MoveKind::Feed,
+            cl: CutterLocation::new(Point3::from(tip), n).unwrap(),
+            feed_mm_per_min: None,
+        });
+    }
+    let blank = machining_sim::BoxStock::new(lo, hi).unwrap();
+    let h = 0.1;
+    let mut stock = TriDexel::from_shape(&blank, h).unwrap();
+    let rep = simulate(
+        &mut stock,
+        &design,
+        &[(cutter, path)],
+        &SimOptions::default(),
+    )
+    .unwrap();
+    let e = rep.max_overcut.clone().unwrap();
+    assert!((e.value_mm - gouge).abs() < h, "{e:?}");
+    assert!(e.surface == "main0_suction", "{e:?}");
+    assert!(
+        rep.collisions
+            .iter()
+            .any(|c| c.target == CollisionTarget::Design && c.part == PartKind::Shank),
+        "{:?}",
+        rep.collisions
+    );
+    // The deepest sample lies on the gouged strip: its closest point on the side has v
+    // within the crater half width of the path's v-line.
+    let (sp, _) = impeller_model::query::blade_side_distance(
+        &blade,
+        Side::Suction,
+        &Vector3::new(e.point[0], e.point[1], e.point[2]),
+        None,
+    );
+    let crater = (r * r - (r - gouge).powi(2)).sqrt();
+    let on_line = s.point(sp.u, v);
+    assert!((sp.point - on_line).norm() < crater, "{e:?}");
+    let frac = (sp.u - u0) / (u1 - u0);
+    assert!((0.45..=0.75).contains(&frac), "{frac} {e:?}");
+}
