@@ -5,10 +5,10 @@
 
 mod cmd;
 mod error;
-#[allow(dead_code)] // wired into `run` as the pipeline stages land
 mod job;
-#[allow(dead_code)]
+mod pipeline;
 mod plot;
+mod report;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

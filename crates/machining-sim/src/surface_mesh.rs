@@ -299,7 +299,10 @@ mod tests {
                 })
                 .sum();
             let exact = std::f64::consts::PI * 9.0 * 4.0;
-            assert!((vol - exact).abs() < 0.1 * exact, "stride {stride}: {vol} vs {exact}");
+            assert!(
+                (vol - exact).abs() < 0.1 * exact,
+                "stride {stride}: {vol} vs {exact}"
+            );
         }
     }
 }

@@ -407,7 +407,11 @@ impl SurfaceProjector {
             let (l, r) = (node.left, node.right);
             let dl = self.nodes[l as usize].aabb.dist2(q);
             let dr = self.nodes[r as usize].aabb.dist2(q);
-            let ((near, dn), (far, df)) = if dl <= dr { ((l, dl), (r, dr)) } else { ((r, dr), (l, dl)) };
+            let ((near, dn), (far, df)) = if dl <= dr {
+                ((l, dl), (r, dr))
+            } else {
+                ((r, dr), (l, dl))
+            };
             if df < bound && sp < stack.len() {
                 stack[sp] = (far, df);
                 sp += 1;
@@ -483,7 +487,9 @@ impl SurfaceProjector {
             // next to the leaf's own minimum.
             let cu = b.u.clamp(leaf.u0, leaf.u1);
             let cv = b.v.clamp(leaf.v0, leaf.v1);
-            if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0) && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0) {
+            if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0)
+                && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0)
+            {
                 start = (cu, cv);
                 d_start = (patch.point(cu, cv) - q).norm_squared();
             }
