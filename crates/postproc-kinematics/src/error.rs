@@ -27,11 +27,12 @@ pub enum MachineError {
         message: String,
     },
     /// A field has a value that parses but is not acceptable.
-    #[error("{file}:{line}: field `{field}`: {message}")]
+    #[error("{file}{}: field `{field}`: {message}", line_suffix(*line))]
     Invalid {
         /// File name as given.
         file: String,
-        /// 1-based line of the field (0 when the field is absent from the file).
+        /// 1-based line of the field (0 when the field is absent from the file; the message
+        /// then shows no line).
         line: usize,
         /// Dotted field path, e.g. `axes.A.min`.
         field: String,
@@ -86,4 +87,12 @@ pub enum PostError {
     /// Reverse-motion smoothing failed (e.g. the B-spline least-squares system was singular).
     #[error("reverse-motion smoothing: {0}")]
     Smoothing(String),
+}
+
+fn line_suffix(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
 }

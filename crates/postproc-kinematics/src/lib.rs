@@ -24,7 +24,8 @@
 //!
 //! Dependencies: `cam-core` (cutter locations, moves), `nalgebra` (vectors; SVD least squares
 //! of the small B-spline systems), `serde` + `toml` (machine files with spans for line
-//! numbers), `thiserror` (errors) — the workspace's chosen crates.
+//! numbers), `thiserror` (errors), `rayon` (segment deviations evaluated in parallel) — the
+//! workspace's chosen crates.
 //!
 //! ```
 //! use postproc_kinematics::{Machine, post_locations, PostOptions};

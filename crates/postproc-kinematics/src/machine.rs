@@ -5,6 +5,9 @@
 //!
 //! ```toml
 //! name = "LinuxCNC xyzac-trt"
+//! description = "..."        # optional
+//! safe_z = 100.0              # optional: machine Z for retracts before reorientation
+//! singularity_tol_deg = 1e-5  # optional: tool axis this close to C counts as singular
 //! [kinematics]
 //! type = "table-table"        # "table-table" | "head-table" | "head-head"
 //! tilt_axis = "A"             # "A" (about X) or "B" (about Y); the other rotary axis is C (about Z)
@@ -22,10 +25,13 @@
 //! max = 200.0
 //! max_speed = 6000.0
 //! # ... Y, Z likewise; rotary axes: mode = "limited" (min/max) or "continuous"
-//! [home]
+//! [home]                      # optional per axis (default 0, which must lie in the travel)
 //! X = 0.0
 //! # ...
 //! ```
+//!
+//! Unknown keys are rejected. Errors carry the file name, the 1-based line and the dotted
+//! field path ([`MachineError`]).
 
 use crate::error::MachineError;
 use crate::joints::{AxisId, Joints};
@@ -335,9 +341,9 @@ struct RawMachine {
     kinematics: RawKinematics,
     #[serde(default)]
     workpiece: RawWorkpiece,
-    axes: BTreeMap<String, RawAxis>,
+    axes: BTreeMap<Spanned<String>, RawAxis>,
     #[serde(default)]
-    home: BTreeMap<String, Spanned<f64>>,
+    home: BTreeMap<Spanned<String>, Spanned<f64>>,
     safe_z: Option<Spanned<f64>>,
     singularity_tol_deg: Option<Spanned<f64>>,
 }
@@ -690,11 +696,12 @@ impl Validator<'_> {
         let tl = kinematics.tilt_axis().letter();
         let letters = ['X', 'Y', 'Z', tl, 'C'];
         for key in raw.axes.keys() {
-            let ok = key.chars().count() == 1 && key.chars().all(|c| letters.contains(&c));
+            let name = key.get_ref();
+            let ok = name.chars().count() == 1 && name.chars().all(|c| letters.contains(&c));
             if !ok {
                 return self.err(
-                    None,
-                    &format!("axes.{key}"),
+                    Some(key.span()),
+                    &format!("axes.{name}"),
                     format!("unknown axis for this machine (expected X, Y, Z, {tl}, C)"),
                 );
             }
@@ -705,7 +712,7 @@ impl Validator<'_> {
             max_speed: None,
         }; 5];
         for (i, l) in letters.iter().enumerate() {
-            axes[i] = self.axis(*l, raw.axes.get(&l.to_string()), i >= 3)?;
+            axes[i] = self.axis(*l, raw.axes.get(l.to_string().as_str()), i >= 3)?;
         }
         let workpiece_origin = match &raw.workpiece.origin {
             None => Vector3::zeros(),
@@ -719,6 +726,7 @@ impl Validator<'_> {
         };
         let mut home = Joints::default();
         for (key, v) in &raw.home {
+            let key = key.get_ref();
             let field = format!("home.{key}");
             let Some(i) = letters
                 .iter()
@@ -738,7 +746,9 @@ impl Validator<'_> {
             home.set(AxisId::ALL[i], val);
         }
         for i in 0..AxisId::ALL.len() {
-            if !raw.home.contains_key(&letters[i].to_string()) && !axes[i].contains(0.0, 0.0) {
+            if !raw.home.contains_key(letters[i].to_string().as_str())
+                && !axes[i].contains(0.0, 0.0)
+            {
                 return self.err(
                     None,
                     &format!("home.{}", letters[i]),

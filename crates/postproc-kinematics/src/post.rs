@@ -13,6 +13,7 @@ use crate::reverse_motion::{
     ReverseMotionReport,
 };
 use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// What to do when a block cannot be reached within the axis limits.
@@ -325,7 +326,33 @@ pub fn post_path_checked(
     };
     let mut scratch: Vec<(CutterLocation, Joints, f64)> = Vec::new();
     let initial = options.initial.unwrap_or(machine.home());
-    for b in blocks {
+    // The deviation of every source segment is independent of the others: evaluate them in
+    // parallel, then subdivide only the segments above tolerance.
+    let wants = |p: &PostedBlock, b: &PostedBlock| {
+        (b.kind != MoveKind::Rapid || options.linearise_rapids)
+            && !b.unwound
+            && b.limit_violation.is_none()
+            && p.limit_violation.is_none()
+    };
+    let first_dev: Vec<f64> = (0..blocks.len())
+        .into_par_iter()
+        .map(|i| {
+            if i == 0 || !wants(&blocks[i - 1], &blocks[i]) {
+                return 0.0;
+            }
+            let (p, b) = (&blocks[i - 1], &blocks[i]);
+            segment_deviation(
+                machine,
+                &p.joints,
+                &b.joints,
+                &p.cl.tip,
+                &b.cl.tip,
+                tl,
+                options.linearisation_samples,
+            )
+        })
+        .collect();
+    for (b, dev) in blocks.into_iter().zip(first_dev) {
         let Some(p) = out.last().cloned() else {
             // the first block starts from the initial posture
             let mut b = b;
@@ -337,12 +364,13 @@ pub fn post_path_checked(
             continue;
         };
         // Segments touching a block outside the limits (Report policy) are not subdivided.
-        let linearise = (b.kind != MoveKind::Rapid || options.linearise_rapids)
-            && !b.unwound
-            && b.limit_violation.is_none()
-            && p.limit_violation.is_none();
+        let linearise = wants(&p, &b);
         let mut b = b;
-        if linearise {
+        if linearise && dev <= settings.tol {
+            b.linearisation_error_mm = dev;
+            max_err = max_err.max(dev);
+            set_feed(machine, &p, &mut b);
+        } else if linearise {
             scratch.clear();
             let sub = subdivide(
                 machine,

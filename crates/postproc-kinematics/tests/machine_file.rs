@@ -196,3 +196,16 @@ mod fuzz {
         }
     }
 }
+
+#[test]
+fn unknown_axis_key_has_its_line() {
+    let text = fixture_text("xyzac-trt").replace("[axes.C]", "[axes.W]");
+    let err = Machine::from_toml_str(&text, "m.toml").unwrap_err();
+    match &err {
+        MachineError::Invalid { line, field, .. } => {
+            assert_eq!(field, "axes.W");
+            assert_eq!(*line, line_of(&text, "[axes.W]"));
+        }
+        other => panic!("{other:?}"),
+    }
+}

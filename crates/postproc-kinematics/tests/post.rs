@@ -2,7 +2,7 @@
 //! linearisation control checked by dense sampling, feeds, metrics.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use cam_core::{CutterLocation, Move, Point3, Vector3};
+use cam_core::{CutterLocation, Move, MoveKind, Point3, Vector3};
 use postproc_kinematics::linearise::point_segment_distance;
 use postproc_kinematics::plot::displacement_svg;
 use postproc_kinematics::{
@@ -370,5 +370,49 @@ fn look_ahead_avoids_forced_reconfiguration() {
             "{name}: {:?}",
             p.metrics
         );
+    }
+}
+
+mod fuzz {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Random short paths (any kinds, tips, axes, feeds) on every machine, with and
+        /// without reverse-motion removal: a posted path whose blocks reach their CLs, or a
+        /// typed error — never a panic.
+        #[test]
+        fn random_paths_post_or_error(
+            pts in prop::collection::vec((prop::array::uniform3(-150.0f64..150.0), prop::array::uniform3(-1.0f64..1.0), 0u8..4, 0.0f64..3000.0), 1..25),
+            smooth in any::<bool>(),
+        ) {
+            let moves: Vec<Move> = pts
+                .iter()
+                .filter_map(|(p, a, k, f)| {
+                    let cl = CutterLocation::new(Point3::new(p[0], p[1], p[2]), Vector3::new(a[0], a[1], a[2] + 1.2)).ok()?;
+                    let kind = [MoveKind::Rapid, MoveKind::Plunge, MoveKind::Feed, MoveKind::Retract][*k as usize];
+                    Some(Move { kind, cl, feed_mm_per_min: Some(*f) })
+                })
+                .collect();
+            for name in ["xyzac-trt", "xyzbc-trt", "turnmill-bc", "headhead-ac"] {
+                let m = fixture(name);
+                let opts = PostOptions {
+                    tool_length: 50.0,
+                    limit_policy: LimitPolicy::Report,
+                    reverse_motion: smooth.then(ReverseMotionOptions::default),
+                    ..Default::default()
+                };
+                match post_path(&m, &moves, &opts) {
+                    Ok(p) => {
+                        for b in &p.blocks {
+                            let f = m.forward(&b.joints, 50.0);
+                            prop_assert!((f.tip - b.cl.tip).norm() < 1e-6);
+                        }
+                        prop_assert!(p.metrics.max_linearisation_error_mm.is_finite());
+                    }
+                    Err(e) => prop_assert!(!e.to_string().is_empty()),
+                }
+            }
+        }
     }
 }
