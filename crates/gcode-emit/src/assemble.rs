@@ -6,7 +6,8 @@
 //!    after the last (`d` = [`AssembleOptions::retract_mm`]); the dialect then retracts the
 //!    spindle to the machine's safe Z before any tool change or reorientation;
 //! 2. an operation whose tool axis is constant (within [`AssembleOptions::fixed_axis_tol_rad`])
-//!    becomes a 3+2 tilted-plane operation when the dialect has one;
+//!    becomes a 3+2 tilted-plane operation when the dialect has one (its blocks are still
+//!    posted, so the axis limits are checked and the plane's machine angles are known);
 //! 3. otherwise the moves go through `postproc-kinematics`' [`post_path`] (inverse kinematics
 //!    with continuity from the previous operation's last posture, limits, unwinding;
 //!    linearisation control only for joint output, where the controller interpolates joints;
@@ -129,10 +130,20 @@ pub fn assemble_program(
         let mut post = options.post.clone();
         post.initial = posture;
         if fixed && indexed_ok {
-            let j = machine
-                .inverse(&first.cl, post.tool_length, posture.as_ref())
-                .map_err(|e| kin_err(1, e.to_string()))?;
-            posture = Some(j);
+            // Post the moves anyway: checks every block against the axis limits and gives
+            // the machine angles of the plane.
+            let mut check = post.clone();
+            check.linearisation_tol = None;
+            let posted = post_path(machine, &moves, &check).map_err(|e| match e {
+                postproc_kinematics::PostError::Block { index, source } => {
+                    kin_err(index, source.to_string())
+                }
+                other => kin_err(0, other.to_string()),
+            })?;
+            let Some(j) = posted.blocks.first().map(|b| b.joints) else {
+                return Err(kin_err(0, "no blocks posted".into()));
+            };
+            posture = posted.blocks.last().map(|b| b.joints).or(posture);
             let mut feed = options.post.default_feed_mm_per_min;
             let tips = moves
                 .iter()

@@ -179,13 +179,27 @@ pub struct MotionStyle {
 
 /// Modal motion writer: emits the motion code and the axis words that changed; inverse-time
 /// `F` on every `G93` block (as LinuxCNC and Fanuc require), mm/min `F` when it changes.
+/// Reuses its buffers: no allocation per block once warmed up, except the block text.
 #[derive(Debug)]
 pub struct MotionWriter {
     style: MotionStyle,
     motion: Option<bool>,
-    words: Vec<(String, String)>,
+    /// Last written value of X Y Z A B C and the three vector words.
+    last: [Option<String>; 9],
     feed: Option<String>,
     inverse: bool,
+    value: String,
+    axes: String,
+}
+
+/// Slot of a rotary letter in [`MotionWriter::last`]; other letters are always written.
+fn rotary_slot(letter: char) -> Option<usize> {
+    match letter.to_ascii_uppercase() {
+        'A' => Some(3),
+        'B' => Some(4),
+        'C' => Some(5),
+        _ => None,
+    }
 }
 
 impl MotionWriter {
@@ -194,9 +208,11 @@ impl MotionWriter {
         Self {
             style,
             motion: None,
-            words: Vec::new(),
+            last: Default::default(),
             feed: None,
             inverse: false,
+            value: String::new(),
+            axes: String::new(),
         }
     }
 
@@ -204,7 +220,9 @@ impl MotionWriter {
     /// or a move written by other means), so the next block states every word.
     pub fn forget_positions(&mut self) {
         self.motion = None;
-        self.words.clear();
+        for l in &mut self.last {
+            *l = None;
+        }
     }
 
     /// `true` while inverse-time mode is active.
@@ -223,18 +241,38 @@ impl MotionWriter {
         }
     }
 
-    fn changed(&mut self, addr: &str, value: String) -> Option<String> {
-        match self.words.iter_mut().find(|(a, _)| a == addr) {
-            Some((_, v)) if *v == value => None,
-            Some((_, v)) => {
-                v.clone_from(&value);
-                Some(value)
-            }
-            None => {
-                self.words.push((addr.to_string(), value.clone()));
-                Some(value)
+    /// Formats `v` into the scratch value and appends `addr value` to the axis words if it
+    /// differs from the last value written in `slot`.
+    fn axis_word(
+        &mut self,
+        slot: Option<usize>,
+        addr: &str,
+        v: f64,
+        fmt: NumberFormat,
+        at: At<'_>,
+    ) -> Result<(), GcodeError> {
+        self.value.clear();
+        if !fmt.write_to(v, &mut self.value) {
+            return Err(GcodeError::NonFinite {
+                operation: at.op.to_string(),
+                block: at.block,
+                word: addr.to_string(),
+                value: v,
+            });
+        }
+        if let Some(k) = slot {
+            match &mut self.last[k] {
+                Some(prev) if *prev == self.value => return Ok(()),
+                Some(prev) => prev.clone_from(&self.value),
+                none => *none = Some(self.value.clone()),
             }
         }
+        if !self.axes.is_empty() {
+            self.axes.push(' ');
+        }
+        self.axes.push_str(addr);
+        self.axes.push_str(&self.value);
+        Ok(())
     }
 
     /// Writes one move; `prefix` words (e.g. `G43.4 H3`) go right after the motion code.
@@ -248,12 +286,9 @@ impl MotionWriter {
         at: At<'_>,
     ) -> Result<bool, GcodeError> {
         let st = self.style;
-        let mut axes = Vec::with_capacity(9);
-        for (addr, v) in ["X", "Y", "Z"].iter().zip(mv.xyz) {
-            let s = num(st.linear_fmt, v, addr, at)?;
-            if let Some(s) = self.changed(addr, s) {
-                axes.push(format!("{addr}{s}"));
-            }
+        self.axes.clear();
+        for (k, (addr, v)) in ["X", "Y", "Z"].iter().zip(mv.xyz).enumerate() {
+            self.axis_word(Some(k), addr, v, st.linear_fmt, at)?;
         }
         if mode == OutputMode::TcpVector {
             let Some(t) = mv.tool_vector else {
@@ -262,61 +297,71 @@ impl MotionWriter {
                     block: at.block,
                 });
             };
-            for (addr, v) in st.vector_words.iter().zip(t) {
-                let s = num(st.angular_fmt, v, addr, at)?;
-                if let Some(s) = self.changed(addr, s) {
-                    axes.push(format!("{addr}{s}"));
-                }
+            for (k, (addr, v)) in st.vector_words.iter().zip(t).enumerate() {
+                self.axis_word(Some(6 + k), addr, v, st.angular_fmt, at)?;
             }
         } else {
+            let mut letter = [0u8; 4];
             for r in &mv.rotary {
-                let addr = r.letter.to_string();
-                let s = num(st.angular_fmt, r.deg, &addr, at)?;
-                if let Some(s) = self.changed(&addr, s) {
-                    axes.push(format!("{addr}{s}"));
-                }
+                let addr: &str = r.letter.encode_utf8(&mut letter);
+                self.axis_word(rotary_slot(r.letter), addr, r.deg, st.angular_fmt, at)?;
             }
         }
-        if axes.is_empty() && prefix.is_empty() {
+        if self.axes.is_empty() && prefix.is_empty() {
             return Ok(false);
         }
-        let mut words: Vec<String> = Vec::with_capacity(axes.len() + 4);
+        let mut block = String::with_capacity(self.axes.len() + 32);
+        let word = |block: &mut String, w: &str| {
+            if !block.is_empty() {
+                block.push(' ');
+            }
+            block.push_str(w);
+        };
         let rapid = matches!(mv.feed, Feed::Rapid);
         match mv.feed {
             Feed::InverseTime(_) if !self.inverse => {
-                words.push(st.feed_modes.0.to_string());
+                word(&mut block, st.feed_modes.0);
                 self.inverse = true;
                 self.feed = None;
             }
             Feed::PerMinute(_) if self.inverse => {
-                words.push(st.feed_modes.1.to_string());
+                word(&mut block, st.feed_modes.1);
                 self.inverse = false;
                 self.feed = None;
             }
             _ => {}
         }
         if self.motion != Some(rapid) {
-            words.push(if rapid { st.rapid } else { st.linear }.to_string());
+            word(&mut block, if rapid { st.rapid } else { st.linear });
             self.motion = Some(rapid);
         }
         if !prefix.is_empty() {
-            words.push(prefix.to_string());
+            word(&mut block, prefix);
         }
-        words.extend(axes);
+        if !self.axes.is_empty() {
+            word(&mut block, &self.axes);
+        }
         match mv.feed {
             Feed::Rapid => {}
             Feed::PerMinute(f) => {
                 let s = num(st.feed_fmt, f, "F", at)?;
                 if self.feed.as_deref() != Some(s.as_str()) {
-                    words.push(format!("F{s}"));
+                    word(&mut block, &format!("F{s}"));
                     self.feed = Some(s);
                 }
             }
             Feed::InverseTime(f) => {
-                words.push(format!("F{}", num(st.inverse_fmt, f, "F", at)?));
+                // A slow block has a small 1/min value: keep at least four significant
+                // digits (up to 9 decimals) so it never prints as F0.
+                let mut fmt = st.inverse_fmt;
+                if f > 0.0 && f.is_finite() {
+                    let need = (4.0 - f.log10().floor() - 1.0).clamp(0.0, 9.0) as usize;
+                    fmt.decimals = fmt.decimals.max(need);
+                }
+                word(&mut block, &format!("F{}", num(fmt, f, "F", at)?));
             }
         }
-        w.block(&words.join(" "));
+        w.block(&block);
         Ok(true)
     }
 }

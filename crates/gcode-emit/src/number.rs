@@ -46,29 +46,40 @@ impl NumberFormat {
     /// Formats `value`; `None` if it is NaN or infinite (callers turn that into a typed
     /// error naming the word and block). O(digits).
     pub fn format(&self, value: f64) -> Option<String> {
+        let mut s = String::new();
+        self.write_to(value, &mut s).then_some(s)
+    }
+
+    /// Appends the formatted `value` to `out` (no allocation once `out` has capacity);
+    /// returns `false` and appends nothing if the value is NaN or infinite.
+    pub fn write_to(&self, value: f64, out: &mut String) -> bool {
+        use std::fmt::Write;
         if !value.is_finite() {
-            return None;
+            return false;
         }
+        let start = out.len();
         // `{:.N}` never uses exponent notation for f64; it rounds the exact binary value.
-        let mut s = format!("{:.*}", self.decimals, value);
+        // Writing into a String cannot fail.
+        let _ = write!(out, "{:.*}", self.decimals, value);
         // A value that rounds to zero prints as "-0.000"; drop the sign.
-        if s.starts_with('-') && s[1..].bytes().all(|b| b == b'0' || b == b'.') {
-            s.remove(0);
+        if out[start..].starts_with('-') && out[start + 1..].bytes().all(|b| b == b'0' || b == b'.')
+        {
+            out.remove(start);
         }
-        if self.trim_zeros && s.contains('.') {
-            while s.ends_with('0') {
-                s.pop();
+        if self.trim_zeros && out[start..].contains('.') {
+            while out.ends_with('0') {
+                out.pop();
             }
-            if s.ends_with('.') && !self.force_point {
-                s.pop();
+            if out.ends_with('.') && !self.force_point {
+                out.pop();
             }
-        } else if self.force_point && !s.contains('.') {
-            s.push('.');
+        } else if self.force_point && !out[start..].contains('.') {
+            out.push('.');
         }
-        if self.plus_sign && !s.starts_with('-') {
-            s.insert(0, '+');
+        if self.plus_sign && !out[start..].starts_with('-') {
+            out.insert(start, '+');
         }
-        Some(s)
+        true
     }
 }
 

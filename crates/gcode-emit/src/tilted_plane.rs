@@ -10,7 +10,11 @@
 //!   `R = Rz(c)·Ry(b)·Rx(a)` with `c = 0`, tilted Z axis
 //!   `(sin b cos a, −sin a, cos b cos a)`; hence `a = −asin(u_y)`, `b = atan2(u_x, u_z)`.
 //!
-//! In both cases the third angle is 0 and the plane rotates about the active datum, so a
+//! - Euler angles Z, X', Z'' (Fanuc `G68.2 I J K`): `R = Rz(a)·Rx(b)` with the third angle 0,
+//!   tilted Z axis `(sin a sin b, −cos a sin b, cos b)`; hence `b = acos(u_z)`,
+//!   `a = atan2(u_x, −u_y)` (`a = 0` when `u = +Z`).
+//!
+//! In every case the third angle is 0 and the plane rotates about the active datum, so a
 //! point `p` of the workpiece frame has tilted-frame coordinates `Rᵀ·p`. O(1).
 
 use cam_core::{Point3, UnitVector3};
@@ -54,6 +58,23 @@ impl TiltedPlane {
         }
     }
 
+    /// Euler Z-X'-Z'' plane (Fanuc `G68.2`) whose Z axis is `u`.
+    pub fn euler_zxz(u: &UnitVector3) -> Self {
+        let b = u.z.clamp(-1.0, 1.0).acos();
+        let a = if u.x.hypot(u.y) > 0.0 {
+            u.x.atan2(-u.y)
+        } else {
+            0.0
+        };
+        let r = Rotation3::from_axis_angle(&Vector3::z_axis(), a)
+            * Rotation3::from_axis_angle(&Vector3::x_axis(), b);
+        Self {
+            a,
+            b,
+            rotation: *r.matrix(),
+        }
+    }
+
     /// Coordinates of workpiece point `p` in the tilted frame.
     pub fn to_plane(&self, p: &Point3) -> Point3 {
         Point3::from(self.rotation.transpose() * p.coords)
@@ -72,7 +93,7 @@ mod tests {
             px in -100.0f64..100.0, py in -100.0f64..100.0, pz in -100.0f64..100.0)
         {
             let u = UnitVector3::new_normalize(Vector3::new(x, y, z));
-            for plane in [TiltedPlane::axis_by_axis_xy(&u), TiltedPlane::spatial_ab(&u)] {
+            for plane in [TiltedPlane::axis_by_axis_xy(&u), TiltedPlane::spatial_ab(&u), TiltedPlane::euler_zxz(&u)] {
                 let zt = plane.rotation * Vector3::z();
                 prop_assert!((zt - u.into_inner()).norm() < 1e-12);
                 let p = Point3::new(px, py, pz);
@@ -101,6 +122,14 @@ mod tests {
             b.cos() * a.cos(),
         ));
         let p = TiltedPlane::spatial_ab(&u);
+        assert!((p.a - a).abs() < 1e-12 && (p.b - b).abs() < 1e-12);
+        let (a, b) = (0.3f64, 0.7f64);
+        let u = UnitVector3::new_normalize(Vector3::new(
+            a.sin() * b.sin(),
+            -a.cos() * b.sin(),
+            b.cos(),
+        ));
+        let p = TiltedPlane::euler_zxz(&u);
         assert!((p.a - a).abs() < 1e-12 && (p.b - b).abs() < 1e-12);
     }
 }

@@ -215,3 +215,31 @@ proptest! {
         let _ = read_gcode(&s, "fuzz.ngc");
     }
 }
+
+#[test]
+fn tilted_plane_operations_are_checked_against_the_axis_limits() {
+    let machine = support::xyzac();
+    let mut op = support::indexed_op("pocket", 4);
+    for m in &mut op.path.moves {
+        m.cl.tip.x += 1000.0; // X travel is ±200 mm
+    }
+    let r = assemble_program(
+        "p",
+        &[op],
+        &machine,
+        &Sinumerik::default(),
+        &AssembleOptions {
+            mode: OutputMode::TcpAngles,
+            ..Default::default()
+        },
+    );
+    match r {
+        Err(GcodeError::Kinematics {
+            operation, reason, ..
+        }) => {
+            assert_eq!(operation, "pocket");
+            assert!(reason.contains("axis X"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+}

@@ -371,3 +371,50 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn tool_paths_with_cutters_write_and_read_back() {
+    let p = demo_program();
+    let op = &p.operations[0];
+    let q = ClProgram::from_tool_paths(
+        Some("JOB".into()),
+        [(op.path.clone(), op.cutter.clone(), Some(7))],
+    );
+    let r = read(&write_cl(&q, &ClWriteOptions::default()).unwrap()).unwrap();
+    assert_eq!(r.part_name.as_deref(), Some("JOB"));
+    let c = r.operations[0].cutter.as_ref().unwrap();
+    assert_eq!(c.flute_length, 35.0);
+    assert!(
+        (c.shape.radius_at(3.0) - op.cutter.as_ref().unwrap().shape.radius_at(3.0)).abs() < 1e-12
+    );
+    assert_eq!(r.operations[0].path.moves.len(), op.path.moves.len());
+}
+
+#[test]
+fn nx_tldata_mill_defines_the_cutter() {
+    let p =
+        read("TLDATA/MILL,10.0000,2.0000,50.0000,0.0000,0.0000\nGOTO/0,0,0\nTLDATA/DRILL,5,118\n")
+            .unwrap();
+    let c = p.operations[0].cutter.as_ref().unwrap();
+    assert_eq!(
+        c.shape,
+        CutterShape::BullNose {
+            radius: 5.0,
+            corner_radius: 2.0
+        }
+    );
+    assert_eq!(c.flute_length, 50.0);
+    assert!(p
+        .warnings
+        .iter()
+        .any(|w| w.line == 3 && w.message.contains("DRILL")));
+    assert_eq!(parse_err("TLDATA/MILL,x\n"), (1, "TLDATA".into(), 2));
+    assert_eq!(parse_err("TLDATA/MILL\n"), (1, "TLDATA".into(), 2));
+}
+
+#[test]
+fn windows_files_with_bom_and_crlf_read_like_unix_ones() {
+    let unix = read(SAMPLE).unwrap();
+    let win = format!("\u{feff}{}", SAMPLE.replace('\n', "\r\n"));
+    assert_eq!(read(&win).unwrap(), unix);
+}

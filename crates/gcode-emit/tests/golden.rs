@@ -189,6 +189,15 @@ fn fanuc_tcp_angles_and_vectors_match_golden() {
 }
 
 #[test]
+fn fanuc_joint_inverse_time_and_g68_2_match_golden() {
+    let p = program(vec![rough(OutputMode::Joint), finish_indexed()]);
+    assert_same(
+        &Fanuc.write(&p, &options()).unwrap(),
+        "fanuc_joint_g68_2.nc",
+    );
+}
+
+#[test]
 fn sinumerik_traori_and_cycle800_match_golden() {
     let p = program(vec![rough(OutputMode::TcpAngles), finish_indexed()]);
     assert_same(
@@ -224,16 +233,11 @@ fn line_numbers_are_optional_except_on_heidenhain() {
 #[test]
 fn dialect_limits_are_typed_errors() {
     let indexed = program(vec![finish_indexed()]);
-    for d in [&LinuxCnc::default() as &dyn Dialect, &Fanuc] {
-        assert!(
-            matches!(
-                d.write(&indexed, &options()),
-                Err(GcodeError::Unsupported { .. })
-            ),
-            "{}",
-            d.name()
-        );
-    }
+    // LinuxCNC has no tilted-plane function.
+    assert!(matches!(
+        LinuxCnc::default().write(&indexed, &options()),
+        Err(GcodeError::Unsupported { .. })
+    ));
     let joint = program(vec![rough(OutputMode::Joint)]);
     assert!(matches!(
         HeidenhainIso.write(&joint, &options()),
@@ -398,4 +402,16 @@ fn users_can_add_their_own_dialect() {
             "X12.500 Z1.250 A-15.000 C30.500 F800;"
         ]
     );
+}
+
+#[test]
+fn slow_inverse_time_blocks_keep_significant_digits() {
+    let mut op = rough(OutputMode::Joint);
+    if let Motion::Simultaneous { moves, .. } = &mut op.motion {
+        moves[1].feed = Feed::InverseTime(0.000_123_456);
+    }
+    let text = LinuxCnc::default()
+        .write(&program(vec![op]), &options())
+        .unwrap();
+    assert!(text.contains("G93 G1 Z2 F0.0001235\n"), "{text}");
 }

@@ -3,7 +3,7 @@
 //!
 //! A CL file is a sequence of records `WORD/param,param,...`. A trailing `$` continues a
 //! record on the next line; `$$` starts a comment. The reader understands `PARTNO`, `UNITS`,
-//! `MULTAX`, `LOADTL`, `CUTTER`, `TLAXIS`, `FEDRAT`, `RAPID`, `GOTO` (3 or 6 values), `FROM`,
+//! `MULTAX`, `LOADTL`, `CUTTER` (1–7 parameters), `TLDATA/MILL` (NX), `TLAXIS`, `FEDRAT`, `RAPID`, `GOTO` (3 or 6 values), `FROM`,
 //! `SPINDL`, `COOLNT`, `PPRINT`, `TOOL PATH` / `END-OF-PATH` (operation brackets written by
 //! many CAM systems) and `FINI`; every other record is kept as a [`ClWarning`] with its line.
 
@@ -73,6 +73,30 @@ impl ClOperation {
             coolant: Coolant::Off,
             multax: true,
             comments: Vec::new(),
+        }
+    }
+}
+
+impl ClProgram {
+    /// A program from tool paths with their cutters and tool numbers (spindle and coolant
+    /// unset), e.g. to write the CL file of a job's operations.
+    pub fn from_tool_paths(
+        part_name: Option<String>,
+        paths: impl IntoIterator<Item = (ToolPath, Option<Cutter>, Option<u32>)>,
+    ) -> Self {
+        Self {
+            part_name,
+            operations: paths
+                .into_iter()
+                .map(|(path, cutter, tool_number)| {
+                    let mut op = ClOperation::new(path);
+                    op.apt_cutter = cutter.as_ref().map(AptCutter::from_cutter);
+                    op.cutter = cutter;
+                    op.tool_number = tool_number;
+                    op
+                })
+                .collect(),
+            warnings: Vec::new(),
         }
     }
 }

@@ -63,6 +63,8 @@ pub fn read_cl_file(path: &Path, options: &ClReadOptions) -> Result<ClProgram, G
 /// [`GcodeError::ClParse`].
 pub fn read_cl(text: &str, file: &str, options: &ClReadOptions) -> Result<ClProgram, GcodeError> {
     let mut reader = Reader::new(file, *options);
+    // Editors on Windows may start the file with a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut pending: Option<(usize, String)> = None;
     let mut last_line = 0;
     for (i, raw) in text.lines().enumerate() {
@@ -344,7 +346,7 @@ impl<'a> Reader<'a> {
                 for i in 0..params.len() {
                     vals.push(self.num(line, w, &params, i)?);
                 }
-                let mut apt = apt_from_cl_params(&vals, self.scale).ok_or_else(|| {
+                let apt = apt_from_cl_params(&vals, self.scale).ok_or_else(|| {
                     self.err(
                         line,
                         w,
@@ -352,36 +354,43 @@ impl<'a> Reader<'a> {
                         format!("expected 1 to 7 numbers, found {}", vals.len()),
                     )
                 })?;
-                if apt.d <= 0.0 {
-                    return Err(self.err(line, w, 1, "diameter must be > 0"));
-                }
-                if apt.h <= 0.0 {
-                    apt.h = self.options.default_flute_length_per_diameter * apt.d;
+                self.set_cutter(line, w, apt)?;
+            }
+            "TLDATA" => {
+                // NX: TLDATA/MILL,d,r,length,taper,tip_angle (angles in degrees).
+                if !params
+                    .first()
+                    .is_some_and(|p| p.eq_ignore_ascii_case("MILL"))
+                {
                     self.warn(
                         line,
                         format!(
-                            "CUTTER has no height; flute length set to {} × diameter",
-                            self.options.default_flute_length_per_diameter
+                            "TLDATA/{} ignored: only MILL tools are read",
+                            params.join(",")
                         ),
                     );
+                    return Ok(());
                 }
-                let name = self.tool_name();
-                let cutter = apt.to_shape().and_then(|(shape, h)| {
-                    // Shank continues the flute profile; stick-out = flute length (the CL
-                    // file carries no holder data).
-                    Cutter::new(name, shape, h, shape.radius_at(h), h)
-                });
-                match cutter {
-                    Ok(c) => self.cutter = Some(c),
-                    Err(reason) => {
-                        self.warn(
-                            line,
-                            format!("CUTTER kept as APT parameters only: {reason}"),
-                        );
-                        self.cutter = None;
+                let mut v = [0.0; 5];
+                for (k, slot) in v.iter_mut().enumerate() {
+                    if k + 1 < params.len() {
+                        *slot = self.num(line, w, &params, k + 1)?;
+                    } else if k == 0 {
+                        return Err(self.err(line, w, 2, "missing diameter"));
                     }
                 }
-                self.apt_cutter = Some(apt);
+                let (d, r) = (v[0], v[1]);
+                let e = if r > 0.0 { d / 2.0 - r } else { d / 2.0 };
+                let apt = AptCutter {
+                    d: d * self.scale,
+                    r: r * self.scale,
+                    e: e * self.scale,
+                    f: r * self.scale,
+                    alpha: v[4].to_radians(),
+                    beta: v[3].to_radians(),
+                    h: v[2] * self.scale,
+                };
+                self.set_cutter(line, w, apt)?;
             }
             "FEDRAT" => {
                 let mut value = None;
@@ -535,6 +544,39 @@ impl<'a> Reader<'a> {
                 ),
             ),
         }
+        Ok(())
+    }
+
+    /// Validates an APT cutter from `CUTTER` or `TLDATA`, completes a missing height and sets
+    /// the modal cutter (a warning keeps unsupported shapes as APT numbers only).
+    fn set_cutter(&mut self, line: usize, w: &str, mut apt: AptCutter) -> Result<(), GcodeError> {
+        if apt.d <= 0.0 {
+            return Err(self.err(line, w, 1, "diameter must be > 0"));
+        }
+        if apt.h <= 0.0 {
+            apt.h = self.options.default_flute_length_per_diameter * apt.d;
+            self.warn(
+                line,
+                format!(
+                    "{w} has no height; flute length set to {} × diameter",
+                    self.options.default_flute_length_per_diameter
+                ),
+            );
+        }
+        let name = self.tool_name();
+        let cutter = apt.to_shape().and_then(|(shape, h)| {
+            // Shank continues the flute profile; stick-out = flute length (the CL file
+            // carries no holder data).
+            Cutter::new(name, shape, h, shape.radius_at(h), h)
+        });
+        match cutter {
+            Ok(c) => self.cutter = Some(c),
+            Err(reason) => {
+                self.warn(line, format!("{w} kept as APT parameters only: {reason}"));
+                self.cutter = None;
+            }
+        }
+        self.apt_cutter = Some(apt);
         Ok(())
     }
 

@@ -11,16 +11,19 @@
 //!   F in mm/min.
 //! - TCP with tool vectors ([`OutputMode::TcpVector`]): type 2, `G43.5 H<n>`, tool direction
 //!   as `I J K`.
+//! - 3+2 ([`crate::Motion::Indexed`]): tilted working plane `G68.2 X0 Y0 Z0 I J K` (Euler
+//!   angles Z-X'-Z'' about the workpiece origin, K = 0), `G53.1` turns the rotary axes to
+//!   the plane, tips in the tilted frame with `G43 H<n>` on the first approach block,
+//!   `G49` and `G69` at the end.
 //! - `G49` cancels compensation / TCP at the end of each operation, then `G53 G0 Z<safe>`
 //!   retracts in machine coordinates before any tool change or reorientation.
 
-use super::common::{
-    coolant_word, op_comment, rotary_words, simultaneous, spindle_words, write_moves,
-};
+use super::common::{coolant_word, op_comment, rotary_words, spindle_words, tip_move, write_moves};
 use crate::dialect::{
     num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
 };
-use crate::program::{NcProgram, OutputMode, ProgramOptions};
+use crate::program::{Motion, NcProgram, OutputMode, ProgramOptions};
+use crate::tilted_plane::TiltedPlane;
 use crate::{GcodeError, NumberFormat};
 
 /// Fanuc dialect.
@@ -45,7 +48,7 @@ impl Dialect for Fanuc {
         true
     }
     fn supports_indexed(&self) -> bool {
-        false
+        true
     }
 
     fn write(&self, program: &NcProgram, o: &ProgramOptions) -> Result<String, GcodeError> {
@@ -86,16 +89,6 @@ impl Dialect for Fanuc {
         let safe = format!("G53 G0 Z{}", num(lin, o.safe_z_machine, "Z", at0)?);
         let mut tool: Option<u32> = None;
         for op in &program.operations {
-            let (mode, moves) = simultaneous(
-                op,
-                self.name(),
-                &[
-                    OutputMode::Joint,
-                    OutputMode::TcpAngles,
-                    OutputMode::TcpVector,
-                ],
-            )?;
-            let Some(first) = moves.first() else { continue };
             let at = At {
                 op: &op.name,
                 block: 0,
@@ -115,28 +108,72 @@ impl Dialect for Fanuc {
             )?);
             w.block(coolant_word(op.tool.coolant));
             mw.forget_positions();
-            if mode != OutputMode::TcpVector && !first.rotary.is_empty() {
-                w.block(&format!(
-                    "G0 {}",
-                    rotary_words(first, style.angular_fmt, at)?
-                ));
-            }
-            let h = op.tool.number;
-            let prefix = match mode {
-                OutputMode::Joint => {
-                    w.block(&format!(
-                        "G0 X{} Y{}",
-                        num(lin, first.xyz[0], "X", at)?,
-                        num(lin, first.xyz[1], "Y", at)?
-                    ));
-                    format!("G43 H{h}")
+            match &op.motion {
+                Motion::Simultaneous { mode, moves } => {
+                    let mode = *mode;
+                    let Some(first) = moves.first() else { continue };
+                    if mode != OutputMode::TcpVector && !first.rotary.is_empty() {
+                        w.block(&format!(
+                            "G0 {}",
+                            rotary_words(first, style.angular_fmt, at)?
+                        ));
+                    }
+                    let h = op.tool.number;
+                    let prefix = match mode {
+                        OutputMode::Joint => {
+                            w.block(&format!(
+                                "G0 X{} Y{}",
+                                num(lin, first.xyz[0], "X", at)?,
+                                num(lin, first.xyz[1], "Y", at)?
+                            ));
+                            format!("G43 H{h}")
+                        }
+                        OutputMode::TcpAngles => format!("G43.4 H{h}"),
+                        OutputMode::TcpVector => format!("G43.5 H{h}"),
+                    };
+                    write_moves(&mut w, &mut mw, &op.name, mode, moves, &prefix)?;
+                    if let Some(g94) = mw.leave_inverse_time() {
+                        w.block(g94);
+                    }
                 }
-                OutputMode::TcpAngles => format!("G43.4 H{h}"),
-                OutputMode::TcpVector => format!("G43.5 H{h}"),
-            };
-            write_moves(&mut w, &mut mw, &op.name, mode, moves, &prefix)?;
-            if let Some(g94) = mw.leave_inverse_time() {
-                w.block(g94);
+                Motion::Indexed {
+                    tool_axis, tips, ..
+                } => {
+                    let plane = TiltedPlane::euler_zxz(tool_axis);
+                    w.block(&format!(
+                        "G68.2 X0. Y0. Z0. I{} J{} K0.",
+                        num(style.angular_fmt, plane.a.to_degrees(), "I", at)?,
+                        num(style.angular_fmt, plane.b.to_degrees(), "J", at)?
+                    ));
+                    w.block("G53.1");
+                    let moves: Vec<_> = tips
+                        .iter()
+                        .map(|(p, f)| {
+                            let q = plane.to_plane(p);
+                            tip_move([q.x, q.y, q.z], *f)
+                        })
+                        .collect();
+                    if let Some(first) = moves.first() {
+                        w.block(&format!(
+                            "G0 X{} Y{}",
+                            num(lin, first.xyz[0], "X", at)?,
+                            num(lin, first.xyz[1], "Y", at)?
+                        ));
+                    }
+                    let prefix = format!("G43 H{}", op.tool.number);
+                    write_moves(
+                        &mut w,
+                        &mut mw,
+                        &op.name,
+                        OutputMode::TcpAngles,
+                        &moves,
+                        &prefix,
+                    )?;
+                    w.block("G49");
+                    w.block("G69");
+                    mw.forget_positions();
+                    continue;
+                }
             }
             w.block("G49");
             mw.forget_positions();

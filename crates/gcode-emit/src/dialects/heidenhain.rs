@@ -2,8 +2,9 @@
 //!
 //! Chosen over conversational (Klartext) because the rest of the toolkit writes G-code and
 //! the ISO form keeps one motion model; the TNC's five-axis functions are available in both.
-//! - Program: `%NAME G71 *` (G71 = mm), every block numbered and ended with ` *`, last block
-//!   `N99999999 %NAME G71 *`. Numbers carry an explicit sign (`X+10.5`).
+//! - Program: `%NAME G71 *` (G71 = mm), every block numbered and ended with ` *` — comment
+//!   blocks too (`N20 ;TEXT *`) — last block `N99999999 %NAME G71 *`. Numbers carry an
+//!   explicit sign (`X+10.5`).
 //! - Tool call `T<n> G17 S<rpm>` (tool axis Z; the TNC applies the tool length itself, there
 //!   is no `G43`), `M3`/`M4`, coolant `M8`/`M7`, `M9`, `M5`, end `M30`.
 //! - Retract between operations `G00 Z+<safe> M91` (`M91`: machine-based coordinates).
@@ -84,7 +85,7 @@ impl Dialect for HeidenhainIso {
                 block: 0,
             };
             if o.comments {
-                w.raw(&format!(";{}", sanitize(&op_comment(op), true)));
+                w.block(&format!(";{}", sanitize(&op_comment(op), true)));
             }
             w.block(&safe);
             if tool != Some(op.tool.number) {

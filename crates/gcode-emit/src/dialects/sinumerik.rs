@@ -11,7 +11,7 @@
 //! - TCP with vectors ([`OutputMode::TcpVector`]): `TRAORI` + `ORIWKS`, orientation as the
 //!   unit tool vector `A3= B3= C3=` in the workpiece frame.
 //! - 3+2 ([`crate::Motion::Indexed`]): `CYCLE800(_FR, _TC, _ST, _MODE, _X0, _Y0, _Z0, _A, _B,
-//!   _C, _X1, _Y1, _Z1, _DIR, _FR_I)` with mode 57 (axis by axis, rotations X then Y then Z
+//!   _C, _X1, _Y1, _Z1, _DIR, _FR_I, _DMODE)` with mode 57 (axis by axis, rotations X then Y then Z
 //!   about the rotated axes), `_FR = 0` (we retract before), `_ST = 0` (new plane), the
 //!   swivel data record named in [`Sinumerik::swivel_record`], `_DIR` from the sign of the
 //!   first rotary angle; tips are written in the tilted frame; `CYCLE800()` resets the
@@ -137,7 +137,7 @@ impl Dialect for Sinumerik {
                         1
                     };
                     w.block(&format!(
-                        "CYCLE800(0,\"{}\",0,57,0,0,0,{},{},0,0,0,0,{},0)",
+                        "CYCLE800(0,\"{}\",0,57,0,0,0,{},{},0,0,0,0,{},0,0)",
                         sanitize(&self.swivel_record, false).replace('"', ""),
                         num(ang, plane.a.to_degrees(), "_A", at)?,
                         num(ang, plane.b.to_degrees(), "_B", at)?,

@@ -146,3 +146,85 @@ pub fn run(args: Args) -> Result<(), CliError> {
     );
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(dir: &std::path::Path, dialect: &str, mode: Option<Mode>) -> Args {
+        let cl = dir.join("in.cls");
+        std::fs::write(
+            &cl,
+            "PARTNO IMP\nMULTAX/ON\nLOADTL/2\nCUTTER/6,3,0,3,0,0,30\nSPINDL/RPM,9000,CLW\n\
+             COOLNT/FLOOD\nFEDRAT/MMPM,600\nGOTO/25,10,5,0.1,0.05,0.99373\n\
+             GOTO/20,15,4,0.2,0.1,0.97468\nGOTO/15,20,3,0.3,0.15,0.94207\nFINI\n",
+        )
+        .unwrap();
+        Args {
+            cl_file: cl,
+            machine: PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../fixtures/machines/xyzac-trt.toml"),
+            dialect: dialect.into(),
+            out: dir.join(format!("out.{dialect}")),
+            mode,
+            tool_length: 0.0,
+            retract: 10.0,
+            safe_z: None,
+            decimals: 4,
+            no_line_numbers: false,
+            program_number: 1000,
+        }
+    }
+
+    fn scratch(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("impeller-post-{}-{tag}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn posts_a_cl_file_for_every_dialect() {
+        let dir = scratch("ok");
+        for (d, needle) in [
+            ("linuxcnc", "G93 G1"),
+            ("fanuc", "G43 H2"),
+            ("sinumerik", "TRAORI"),
+            ("heidenhain", "M128"),
+        ] {
+            let a = args(&dir, d, None);
+            let out = a.out.clone();
+            run(a).unwrap();
+            let text = std::fs::read_to_string(&out).unwrap();
+            assert!(text.contains(needle), "{d}:\n{text}");
+            // The machine file's safe_z (100 mm) is the retract height.
+            assert!(
+                text.contains("Z100") || text.contains("Z+100"),
+                "{d}:\n{text}"
+            );
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn user_errors_are_one_line_messages() {
+        let dir = scratch("err");
+        let e = run(args(&dir, "haas", None)).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "unknown dialect `haas`; valid dialects: linuxcnc, fanuc, sinumerik, heidenhain"
+        );
+        let e = run(args(&dir, "heidenhain", Some(Mode::Joint)))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("cannot write Joint"), "{e}");
+        let mut a = args(&dir, "fanuc", None);
+        std::fs::write(&a.cl_file, "GOTO/1,2\n").unwrap();
+        let e = run(a).unwrap_err().to_string();
+        assert!(e.contains("in.cls:1: GOTO field 0"), "{e}");
+        a = args(&dir, "fanuc", None);
+        a.out = dir.join("missing-dir/out.nc");
+        assert!(run(a).is_err());
+        assert!(!e.contains('\n'));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
