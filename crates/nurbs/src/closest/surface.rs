@@ -447,6 +447,65 @@ pub(crate) struct Node {
     pub right: u32,
 }
 
+/// Marks a leaf index in [`Node4::child`] and on the walk's stack.
+const LEAF_BIT: u32 = 1 << 31;
+
+/// Node of the 4-wide hierarchy: boxes of up to four children stored together.
+#[derive(Debug, Clone)]
+struct Node4 {
+    aabb: [Aabb; 4],
+    obb: [Obb; 4],
+    /// Child node index, or leaf index with [`LEAF_BIT`] set.
+    child: [u32; 4],
+    n: u8,
+}
+
+/// Collapses binary node `at` (and its subtree) into 4-wide nodes; returns the index of the
+/// new node.
+fn collapse(nodes: &[Node], at: usize, wide: &mut Vec<Node4>) -> u32 {
+    let mut frontier: Vec<usize> = if nodes[at].right == u32::MAX {
+        vec![at]
+    } else {
+        vec![nodes[at].left as usize, nodes[at].right as usize]
+    };
+    // Replace inner nodes by their two children while there is room.
+    let mut k = 0;
+    while k < frontier.len() && frontier.len() < 4 {
+        let n = &nodes[frontier[k]];
+        if n.right != u32::MAX {
+            frontier[k] = n.left as usize;
+            frontier.insert(k + 1, n.right as usize);
+        } else {
+            k += 1;
+        }
+    }
+    let me = wide.len();
+    let empty_obb = Obb {
+        c: Vector3::zeros(),
+        axes: [Vector3::x(), Vector3::y(), Vector3::z()],
+        h: [0.0; 3],
+    };
+    wide.push(Node4 {
+        aabb: [Aabb::empty(); 4],
+        obb: [empty_obb; 4],
+        child: [0; 4],
+        n: frontier.len() as u8,
+    });
+    for (c, &f) in frontier.iter().enumerate() {
+        let n = &nodes[f];
+        let child = if n.right == u32::MAX {
+            n.left | LEAF_BIT
+        } else {
+            collapse(nodes, f, wide)
+        };
+        let w = &mut wide[me];
+        w.aabb[c] = n.aabb;
+        w.obb[c] = n.obb;
+        w.child[c] = child;
+    }
+    me as u32
+}
+
 /// Precomputed closest-point query structure for one surface. See the module docs.
 #[derive(Debug, Clone)]
 pub struct SurfaceProjector {
@@ -456,6 +515,8 @@ pub struct SurfaceProjector {
     pub(crate) v_breaks: Vec<f64>,
     pub(crate) leaves: Vec<Leaf>,
     pub(crate) nodes: Vec<Node>,
+    /// The same hierarchy collapsed to (up to) four children per node for the query walk.
+    wide: Vec<Node4>,
     pub(crate) domain: ((f64, f64), (f64, f64)),
     step_tol: f64,
 }
@@ -518,12 +579,15 @@ impl SurfaceProjector {
         let diag = (size.max - size.min).norm();
         let step_tol = 1e-13 * (1.0 + if diag.is_finite() { diag } else { 0.0 });
         let nodes = build_bvh(&leaves);
+        let mut wide = Vec::with_capacity(nodes.len() / 2 + 1);
+        collapse(&nodes, 0, &mut wide);
         SurfaceProjector {
             patches,
             u_breaks,
             v_breaks,
             leaves,
             nodes,
+            wide,
             domain,
             step_tol,
         }
@@ -606,9 +670,10 @@ impl SurfaceProjector {
                 best = Some((l, l.converged));
             }
         }
-        // Depth-first walk, nearer child first; each stack entry keeps its box distance so
-        // it is re-tested against the (possibly improved) bound when popped.
-        let mut stack = [(0u32, 0.0f64); 64];
+        // Depth-first walk over the 4-wide hierarchy, nearer children first; each stack entry
+        // keeps its box distance so it is re-tested against the (possibly improved) bound
+        // when popped. Entries with `LEAF_BIT` set are leaves.
+        let mut stack = [(0u32, 0.0f64); 128];
         let mut sp = 1usize;
         let mut solves = 0usize;
         while sp > 0 {
@@ -618,12 +683,11 @@ impl SurfaceProjector {
             if d2 >= bound {
                 continue;
             }
-            let node = &self.nodes[index as usize];
-            if node.right == u32::MAX {
+            if index & LEAF_BIT != 0 {
                 if solves >= MAX_LEAF_SOLVES {
                     continue;
                 }
-                if let Some(l) = self.solve_leaf(node.left as usize, q, best, bound) {
+                if let Some(l) = self.solve_leaf((index & !LEAF_BIT) as usize, q, best, bound) {
                     solves += 1;
                     if l.0.d2 < bound {
                         best = Some(l);
@@ -631,37 +695,34 @@ impl SurfaceProjector {
                 }
                 continue;
             }
-            let (l, r) = (node.left, node.right);
-            let lb = |n: &Node| {
-                let a = n.aabb.dist2(q);
+            let node = &self.wide[index as usize];
+            // (lower bound, centre distance, child) of the children closer than the bound.
+            let mut kids = [(0.0f64, 0.0f64, 0u32); 4];
+            let mut nk = 0;
+            for c in 0..node.n as usize {
+                let a = node.aabb[c].dist2(q);
                 if a >= bound {
-                    a
-                } else {
-                    a.max(n.obb.dist2(q))
+                    continue;
                 }
-            };
-            let dl = lb(&self.nodes[l as usize]);
-            let dr = lb(&self.nodes[r as usize]);
-            // Nearer box first; when `q` is inside both (common near the root), the nearer
-            // box centre is the better guess.
-            let left_first = if dl == dr {
-                (self.nodes[l as usize].obb.c - q).norm_squared()
-                    <= (self.nodes[r as usize].obb.c - q).norm_squared()
-            } else {
-                dl < dr
-            };
-            let ((near, dn), (far, df)) = if left_first {
-                ((l, dl), (r, dr))
-            } else {
-                ((r, dr), (l, dl))
-            };
-            if df < bound && sp < stack.len() {
-                stack[sp] = (far, df);
-                sp += 1;
+                let lb = a.max(node.obb[c].dist2(q));
+                if lb >= bound {
+                    continue;
+                }
+                let key2 = (node.obb[c].c - q).norm_squared();
+                // Insertion sort, nearest first (ties: nearer box centre).
+                let mut at = nk;
+                while at > 0 && (kids[at - 1].0, kids[at - 1].1) > (lb, key2) {
+                    kids[at] = kids[at - 1];
+                    at -= 1;
+                }
+                kids[at] = (lb, key2, node.child[c]);
+                nk += 1;
             }
-            if dn < bound && sp < stack.len() {
-                stack[sp] = (near, dn);
-                sp += 1;
+            for k in (0..nk).rev() {
+                if sp < stack.len() {
+                    stack[sp] = (kids[k].2, kids[k].0);
+                    sp += 1;
+                }
             }
         }
         // A best point held on an interior leaf edge is not yet stationary for the whole
