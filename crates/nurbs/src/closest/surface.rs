@@ -809,27 +809,30 @@ impl SurfaceProjector {
             }
         }
         let patch = &self.patches[leaf.patch];
-        let mut start = (leaf.samples[0].0, leaf.samples[0].1);
-        let mut d_start = f64::INFINITY;
+        // Start from the current best clamped into the leaf when it lies just across an
+        // edge (it is then next to the leaf's own minimum), else from the nearest sample.
+        let mut clamped = None;
         if let Some((b, _)) = best {
-            // The current best clamped into the leaf: near a shared edge this starts Newton
-            // next to the leaf's own minimum.
             let cu = b.u.clamp(leaf.u0, leaf.u1);
             let cv = b.v.clamp(leaf.v0, leaf.v1);
             if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0)
                 && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0)
             {
-                start = (cu, cv);
-                d_start = (patch.point(cu, cv) - q).norm_squared();
+                clamped = Some((cu, cv));
             }
         }
-        for (u, v, p) in &leaf.samples {
-            let d = (p - q).norm_squared();
-            if d < d_start {
-                d_start = d;
-                start = (*u, *v);
+        let start = clamped.unwrap_or_else(|| {
+            let mut start = (leaf.samples[0].0, leaf.samples[0].1);
+            let mut d_start = f64::INFINITY;
+            for (u, v, p) in &leaf.samples {
+                let d = (p - q).norm_squared();
+                if d < d_start {
+                    d_start = d;
+                    start = (*u, *v);
+                }
             }
-        }
+            start
+        });
         let mut l = minimise(
             |u, v| patch.derivs2(u, v),
             q,
