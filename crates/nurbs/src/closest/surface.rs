@@ -649,13 +649,24 @@ impl SurfaceProjector {
 
     /// The global closest point of the surface to `q`, starting from `hint = (u, v)` when
     /// given (typically the previous answer of a path of queries). The hint only speeds the
-    /// search up; the answer is the same global minimum as without it.
+    /// search up; the answer is the same global minimum as without it. A non-finite `q`
+    /// gives a NaN distance (and a non-finite hint is ignored).
     pub fn closest_point_with_hint(
         &self,
         q: &Vector3<f64>,
         hint: Option<(f64, f64)>,
     ) -> SurfacePoint {
         let ((ua, ub), (va, vb)) = self.domain;
+        if !q.iter().all(|c| c.is_finite()) {
+            // No point is closest to a non-finite query.
+            return SurfacePoint {
+                u: ua,
+                v: va,
+                point: self.point(ua, va),
+                distance: f64::NAN,
+                on_boundary: false,
+            };
+        }
         let mut best: Option<(Local, bool)> = None;
         // Patch of the previous evaluation: consecutive Newton iterates usually stay in it.
         let last = std::cell::Cell::new(0usize);
