@@ -238,6 +238,8 @@ pub(crate) struct Leaf {
     /// May the leaf be dropped because the distance decreases towards edge
     /// `[u0, u1, v0, v1]` (edge interior to the surface and C¹ across it)?
     exclude_towards: [bool; 4],
+    /// Leaves sharing the whole edge `[u0, u1, v0, v1]` (`u32::MAX` if none).
+    edge_neighbours: [u32; 4],
     samples: [(f64, f64, Vector3<f64>); 9],
     /// Interval data of the Hessian certificate.
     hess: HessianBounds,
@@ -580,6 +582,7 @@ impl SurfaceProjector {
         }
         let diag = (size.max - size.min).norm();
         let step_tol = 1e-13 * (1.0 + if diag.is_finite() { diag } else { 0.0 });
+        link_edge_neighbours(&mut leaves);
         let nodes = build_bvh(&leaves);
         let mut wide = Vec::with_capacity(nodes.len() / 2 + 1);
         collapse(&nodes, 0, &mut wide);
@@ -819,6 +822,27 @@ impl SurfaceProjector {
                 1 if leaf.exclude_towards[2] => return None,
                 -1 if leaf.exclude_towards[3] => return None,
                 _ => {}
+            }
+        }
+        if let Some((b, true)) = best {
+            // The best is a stationary (KKT) point inside a neighbour sharing a whole edge
+            // across which the surface is C¹: if both leaves are certified convex, the
+            // distance is convex on their union (a rectangle; piecewise convex and C¹), whose
+            // unique minimum is then the best — nothing closer here.
+            for (k, &nb) in leaf.edge_neighbours.iter().enumerate() {
+                let Some(n) = self.leaves.get(nb as usize) else {
+                    continue;
+                };
+                if !leaf.exclude_towards[k] {
+                    continue;
+                }
+                if b.u >= n.u0 && b.u <= n.u1 && b.v >= n.v0 && b.v <= n.v1 {
+                    let c = *certified.get_or_insert_with(|| leaf.hess.certifies(&leaf.obb, q));
+                    if c && n.hess.certifies(&n.obb, q) {
+                        return None;
+                    }
+                    break;
+                }
             }
         }
         let patch = &self.patches[leaf.patch];
@@ -1121,8 +1145,39 @@ fn make_leaf(
         cone_v,
         obb_half_diag,
         exclude_towards,
+        edge_neighbours: [u32::MAX; 4],
         samples,
         hess,
+    }
+}
+
+/// Records, for every leaf, the leaves that share one of its edges entirely (same edge
+/// parameter and the same extent in the other direction).
+fn link_edge_neighbours(leaves: &mut [Leaf]) {
+    use std::collections::HashMap;
+    // Key: (direction, edge parameter, extent start, extent end) as bit patterns.
+    let mut edges: HashMap<(u8, u64, u64, u64), Vec<(usize, usize)>> = HashMap::new();
+    for (i, l) in leaves.iter().enumerate() {
+        let keys = [
+            (
+                (0u8, l.u0.to_bits(), l.v0.to_bits(), l.v1.to_bits()),
+                0usize,
+            ),
+            ((0u8, l.u1.to_bits(), l.v0.to_bits(), l.v1.to_bits()), 1),
+            ((1u8, l.v0.to_bits(), l.u0.to_bits(), l.u1.to_bits()), 2),
+            ((1u8, l.v1.to_bits(), l.u0.to_bits(), l.u1.to_bits()), 3),
+        ];
+        for (key, side) in keys {
+            edges.entry(key).or_default().push((i, side));
+        }
+    }
+    for sharing in edges.values() {
+        if let [(a, sa), (b, sb)] = sharing[..] {
+            if sa != sb {
+                leaves[a].edge_neighbours[sa] = b as u32;
+                leaves[b].edge_neighbours[sb] = a as u32;
+            }
+        }
     }
 }
 
