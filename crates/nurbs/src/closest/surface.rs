@@ -1155,8 +1155,10 @@ fn make_leaf(
 /// parameter and the same extent in the other direction).
 fn link_edge_neighbours(leaves: &mut [Leaf]) {
     use std::collections::HashMap;
-    // Key: (direction, edge parameter, extent start, extent end) as bit patterns.
-    let mut edges: HashMap<(u8, u64, u64, u64), Vec<(usize, usize)>> = HashMap::new();
+    // Key: (direction, edge parameter, extent start, extent end) as bit patterns; value:
+    // (leaf, side) pairs on that edge.
+    type EdgeKey = (u8, u64, u64, u64);
+    let mut edges: HashMap<EdgeKey, Vec<(usize, usize)>> = HashMap::new();
     for (i, l) in leaves.iter().enumerate() {
         let keys = [
             (
