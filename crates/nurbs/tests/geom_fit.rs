@@ -1,4 +1,5 @@
 //! Fitting: interpolation, least squares, smoothing, surface interpolation, skinning.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{Vector2, Vector3};
 use nurbs::fit::{
