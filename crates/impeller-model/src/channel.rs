@@ -218,6 +218,22 @@ impl Impeller {
         }
     }
 
+    /// Side parameters (v_hub, v_shroud) of the isocurves that enclose the part of `side`
+    /// between hub and shroud: the smallest v of its hub edge and the largest v of its shroud
+    /// edge over 41 values of u. For imported blades (no design data) this is the v range a
+    /// ruled approximation ([`crate::ruled`]) should span. `None` if an edge misses its wall.
+    pub fn span_v_range(&self, blade: &Blade, side: Side) -> Option<(f64, f64)> {
+        let ((u0, u1), _) = blade.side(side).domain();
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for i in 0..=40 {
+            let u = u0 + (u1 - u0) * i as f64 / 40.0;
+            lo = lo.min(edge_v(blade, side, self.hub(), u)?);
+            hi = hi.max(edge_v(blade, side, self.shroud(), u)?);
+        }
+        (lo < hi).then_some((lo, hi))
+    }
+
     /// Smallest distance between facing blade sides along `wall` (mm); every channel is the
     /// same by N-fold symmetry, so channel 0 is measured. `None` if an edge misses the wall.
     pub fn min_channel_width(&self, wall: Wall) -> Option<f64> {
