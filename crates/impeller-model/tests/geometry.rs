@@ -180,6 +180,38 @@ fn min_angular_gap(a: &Blade, b: &Blade, rot_b: f64) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Free-form sides interpolate the offset grid: the thickness is exact at the grid and within
+/// the fit tolerance between (moderate twist 1e-6 mm, strong twist 5e-4 mm), noses left out.
+#[test]
+fn free_form_blade_thickness_matches_distribution_within_fit_tolerance() {
+    for (name, tol) in [
+        ("impeller-5-freeform", 1e-6),
+        ("impeller-11+11-freeform", 5e-4),
+    ] {
+        let imp = fixture(name);
+        let b = imp.main().blade();
+        let d = b.design().unwrap();
+        let (le, te) = d.thickness.nose_lengths();
+        let mut worst = 0.0f64;
+        for j in 0..=16 {
+            for i in 0..=160 {
+                let u = i as f64 / 160.0;
+                let m = d.m_local(u);
+                if m < 2.0 * le || m > 1.0 - 2.0 * te {
+                    continue;
+                }
+                // At a blunt edge the camber normal may leave a side's domain.
+                let Some(t) = b.normal_thickness(u, d.v_of_span(j as f64 / 16.0)) else {
+                    assert!(u > 0.98, "{name}: no thickness at u = {u}");
+                    continue;
+                };
+                worst = worst.max((t - d.thickness.thickness(m)).abs());
+            }
+        }
+        assert!(worst < tol, "{name}: thickness error {worst} mm");
+    }
+}
+
 #[test]
 fn blades_do_not_intersect_and_channels_are_positive() {
     for name in [
