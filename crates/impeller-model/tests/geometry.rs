@@ -267,6 +267,32 @@ fn the_overlap_measure_detects_blades_that_touch() {
 }
 
 #[test]
+fn channel_sections_span_less_than_a_pitch_with_the_splitter_inside() {
+    let imp = fixtures::default_impeller().unwrap();
+    let pitch = imp.main().pitch_rad();
+    let c = imp.channel(2);
+    let (a, b) = imp.hub().meridional().domain();
+    let mut with_splitter = 0;
+    for k in 1..20 {
+        let t = a + (b - a) * k as f64 / 20.0;
+        for wall in [imp.hub(), imp.shroud()] {
+            let s = c.section(wall, t).unwrap();
+            assert!(s.right > s.left && s.right - s.left < pitch, "{s:?}");
+            if let Some((p, q)) = s.splitter {
+                with_splitter += 1;
+                assert!(s.left < p && p < q && q < s.right, "{s:?}");
+            }
+        }
+    }
+    assert!(with_splitter > 10);
+    // The left side sits where the blade's own edge is: rotating channel 0 by two pitches.
+    let s0 = imp.channel(0).section(imp.hub(), 0.5 * (a + b)).unwrap();
+    let s2 = c.section(imp.hub(), 0.5 * (a + b)).unwrap();
+    let d = (s2.left - s0.left - 2.0 * pitch).rem_euclid(std::f64::consts::TAU);
+    assert!(d < 1e-9 || d > std::f64::consts::TAU - 1e-9);
+}
+
+#[test]
 fn n_fold_symmetry_holds() {
     let imp = fixtures::default_impeller().unwrap();
     let n = imp.main().count();
