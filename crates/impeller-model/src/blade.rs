@@ -10,8 +10,10 @@
 use crate::error::ModelError;
 use crate::thickness::ThicknessLaw;
 use nalgebra::{Rotation3, Vector3};
+use nurbs::closest::SurfaceProjector;
 use nurbs::NurbsSurface;
 use std::f64::consts::TAU;
+use std::sync::{Arc, OnceLock};
 
 /// How a blade was designed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -41,6 +43,16 @@ impl Side {
             Side::Suction => Side::Pressure,
         }
     }
+}
+
+/// The leading or the trailing edge of a blade.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BladeEdge {
+    /// u = start of the side domains.
+    Leading,
+    /// u = end of the side domains.
+    Trailing,
 }
 
 /// Design data kept by the parametric builder (absent for imported blades).
@@ -89,6 +101,9 @@ pub struct Blade {
     /// The side facing +θ (toward blade k+1 of the row).
     plus_theta: Side,
     design: Option<BladeDesign>,
+    /// Global closest-point structures of [pressure, suction], built on first use and shared
+    /// by clones (not by rotated copies).
+    projectors: Arc<OnceLock<[SurfaceProjector; 2]>>,
 }
 
 fn mid(s: &NurbsSurface) -> (f64, f64) {
@@ -147,6 +162,7 @@ impl Blade {
             suction_sign,
             plus_theta,
             design: None,
+            projectors: Arc::new(OnceLock::new()),
         })
     }
 
@@ -209,6 +225,73 @@ impl Blade {
             .map(|n| n * self.outward_sign(side))
     }
 
+    /// The flat face closing a blunt edge: the ruled surface between the pressure and suction
+    /// isocurves at that edge, exact via `NurbsSurface::ruled`: its u runs along the edge (the
+    /// sides' v mapped to [0, 1], hub to shroud), its v from the pressure (0) to the suction
+    /// side (1).
+    /// `None` for a rounded (closed) edge, where both isocurves coincide within 1e-9 mm.
+    pub fn edge_face(&self, edge: BladeEdge) -> Result<Option<NurbsSurface>, ModelError> {
+        let at = |s: &NurbsSurface| {
+            let ((u0, u1), _) = s.domain();
+            match edge {
+                BladeEdge::Leading => u0,
+                BladeEdge::Trailing => u1,
+            }
+        };
+        let cp = self.pressure.iso_curve_at_u(at(&self.pressure))?;
+        let cs = self.suction.iso_curve_at_u(at(&self.suction))?;
+        let (a, b) = cp.domain();
+        let (c, d) = cs.domain();
+        let gap = (0..=16)
+            .map(|k| {
+                let t = k as f64 / 16.0;
+                (cp.point(a + (b - a) * t) - cs.point(c + (d - c) * t)).norm()
+            })
+            .fold(0.0, f64::max);
+        if gap < 1e-9 {
+            return Ok(None);
+        }
+        Ok(Some(NurbsSurface::ruled(&cp, &cs)?))
+    }
+
+    /// A point inside the blade near its middle: the camber point at mid-parameters, or the
+    /// midpoint of the two sides there.
+    pub fn mid_point(&self) -> Vector3<f64> {
+        if let Some(c) = &self.camber {
+            let (u, v) = mid(c);
+            return c.point(u, v);
+        }
+        let (up, vp) = mid(&self.pressure);
+        let (us, vs) = mid(&self.suction);
+        0.5 * (self.pressure.point(up, vp) + self.suction.point(us, vs))
+    }
+
+    /// The isoparametric curve u = const of `side` (a blade section line from hub to shroud;
+    /// a straight ruling on ruled blades).
+    pub fn iso_u(&self, side: Side, u: f64) -> Result<nurbs::NurbsCurve<3>, ModelError> {
+        Ok(self.side(side).iso_curve_at_u(u)?)
+    }
+
+    /// The isoparametric curve v = const of `side` (a flow line from leading to trailing edge).
+    pub fn iso_v(&self, side: Side, v: f64) -> Result<nurbs::NurbsCurve<3>, ModelError> {
+        Ok(self.side(side).iso_curve_at_v(v)?)
+    }
+
+    /// The global closest-point structure of `side` (nurbs' `SurfaceProjector`: Bézier
+    /// patches in a bounding-volume tree, Newton per candidate leaf), built on first use.
+    pub fn projector(&self, side: Side) -> &SurfaceProjector {
+        let p = self.projectors.get_or_init(|| {
+            [
+                SurfaceProjector::new(&self.pressure),
+                SurfaceProjector::new(&self.suction),
+            ]
+        });
+        match side {
+            Side::Pressure => &p[0],
+            Side::Suction => &p[1],
+        }
+    }
+
     /// This blade turned by `angle` (radians) about +Z (exact: control points rotate).
     pub fn rotated(&self, angle: f64) -> Blade {
         let rot = Rotation3::from_axis_angle(&Vector3::z_axis(), angle);
@@ -221,6 +304,7 @@ impl Blade {
             suction_sign: self.suction_sign,
             plus_theta: self.plus_theta,
             design: self.design.clone(),
+            projectors: Arc::new(OnceLock::new()),
         }
     }
 }
