@@ -81,8 +81,8 @@ fn centrifugal_round_trip() {
     let (a, b, dev) = round_trip(&import_common::centrifugal_geomturbo(), "cc", &opts);
     let (sa, sb) = (a.impeller.summary(), b.impeller.summary());
     assert_eq!(
-        (sa.main_blade_count, sa.splitter_blade_count),
-        (sb.main_blade_count, sb.splitter_blade_count)
+        (sa.main_blade_count, sa.splitter_blade_count, sa.blade_kind),
+        (sb.main_blade_count, sb.splitter_blade_count, sb.blade_kind)
     );
     assert!(dev <= opts.fit_tol_mm, "{dev}");
 }

@@ -11,7 +11,9 @@
 //!   (v_h(u), v_s(u), found as in [`crate::channel::edge_v`]; the side's own v limits when it
 //!   does not reach a wall) and the point at v_h + s·(v_s − v_h) is taken. Each profile is a
 //!   closed loop: pressure side LE → TE, then suction side TE → LE, ending on its first point.
-//!   A ruled blade's sections are exact; a free-form blade is resampled, so the re-imported
+//!   Blades whose sides are of degree 1 across the span (ruled) get exactly two sections, hub
+//!   and shroud, so they are re-imported as ruled blades; a free-form blade is resampled, so
+//!   the re-imported
 //!   surface differs from it by the interpolation error between sections (measured in the
 //!   round-trip test).
 //!
@@ -89,8 +91,11 @@ fn side_section(
 
 fn profile_text(imp: &Impeller, blade: &Blade, sampling: &CurveSampling) -> String {
     let mut out = String::new();
-    for k in 0..sampling.n_spans {
-        let span = k as f64 / (sampling.n_spans - 1) as f64;
+    // Sides of degree 1 across the span are ruled: hub and shroud sections are exact.
+    let ruled = blade.pressure().degree_v() == 1 && blade.suction().degree_v() == 1;
+    let n_spans = if ruled { 2 } else { sampling.n_spans };
+    for k in 0..n_spans {
+        let span = k as f64 / (n_spans - 1) as f64;
         let _ = writeln!(out, "# Profile {} at {:.4}%", k + 1, 100.0 * span);
         let p = side_section(imp, blade, Side::Pressure, span, sampling.n_chord);
         let s = side_section(imp, blade, Side::Suction, span, sampling.n_chord);

@@ -186,7 +186,10 @@ pub fn check_tolerance(fitted: &FittedImpeller) -> Result<(), ImportError> {
         ));
         entities.push((format!("blade {:?} suction side", b.name), b.suction_fit_mm));
     }
-    match entities.into_iter().find(|(_, e)| e.is_nan() || *e > fitted.tol_mm) {
+    match entities
+        .into_iter()
+        .find(|(_, e)| e.is_nan() || *e > fitted.tol_mm)
+    {
         Some((entity, e)) => Err(ImportError::Geometry {
             file: fitted.source.clone(),
             entity,

@@ -323,7 +323,7 @@ pub fn prepare(
             let entity = || format!("blade {:?} section {} (line {})", b.name, k + 1, s.line);
             let pair: Pair = match &s.shape {
                 SectionShape::Loop(pts) => {
-                    let (a, c) = split_loop(&dedup(pts.clone(), eps)).ok_or_else(|| {
+                    let (a, c) = split_loop(pts, eps).ok_or_else(|| {
                         geom_err(
                             entity(),
                             "the loop has fewer than 4 distinct points or no meridional extent",
