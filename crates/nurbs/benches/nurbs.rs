@@ -36,12 +36,19 @@ fn reference_surface() -> NurbsSurface {
                 .map(|j| {
                     let x = 100.0 * i as f64 / 11.0;
                     let y = 100.0 * j as f64 / 11.0;
-                    Vector3::new(x, y, 8.0 * (x / 17.0).sin() * (y / 23.0).cos() + 0.002 * x * y)
+                    Vector3::new(
+                        x,
+                        y,
+                        8.0 * (x / 17.0).sin() * (y / 23.0).cos() + 0.002 * x * y,
+                    )
                 })
                 .collect()
         })
         .collect();
-    let knots = nurbs::KnotVector::clamped_uniform(3, 12).unwrap().knots().to_vec();
+    let knots = nurbs::KnotVector::clamped_uniform(3, 12)
+        .unwrap()
+        .knots()
+        .to_vec();
     NurbsSurface::new(3, 3, knots.clone(), knots, ctrl, None).unwrap()
 }
 

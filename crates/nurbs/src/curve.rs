@@ -237,7 +237,7 @@ impl<const D: usize> NurbsCurve<D> {
     }
 
     /// Point, first and second derivative `[C, C', C'']` without allocation (A3.2/A4.2
-    /// specialised to order 2). Parameters outside the domain are clamped.
+    /// specialised to order 2; O(p² + p D)). Parameters outside the domain are clamped.
     pub fn derivs2(&self, u: f64) -> [SVector<f64, D>; 3] {
         let p = self.knots.degree();
         let u = clamp_param(self.knots.knots(), p, u);

@@ -16,7 +16,7 @@ use crate::{MAX_DEGREE, MAX_ORDER};
 ///
 /// Knot vectors need not be clamped (end multiplicity `p + 1`) for evaluation; operations
 /// that need a clamped vector clamp internally.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(try_from = "KnotVectorData", into = "KnotVectorData")]
 pub struct KnotVector {
     degree: usize,
@@ -25,6 +25,15 @@ pub struct KnotVector {
     /// the difference vanishes or `k + g` is past the end): the denominators of A2.2/A2.3,
     /// precomputed so evaluation multiplies instead of dividing.
     inv_diff: Vec<f64>,
+}
+
+impl std::fmt::Debug for KnotVector {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("KnotVector")
+            .field("degree", &self.degree)
+            .field("knots", &self.knots)
+            .finish()
+    }
 }
 
 /// Serialised form of a [`KnotVector`] (validated when converted back).

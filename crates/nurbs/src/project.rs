@@ -67,14 +67,25 @@ impl SurfaceProjector {
         }
         let d = match dir.try_normalize(0.0) {
             Some(d) if d.iter().all(|c| c.is_finite()) => d,
-            _ => return Err(ProjectError::InvalidInput("direction is zero or not finite")),
+            _ => {
+                return Err(ProjectError::InvalidInput(
+                    "direction is zero or not finite",
+                ))
+            }
         };
         let e1 = d
-            .cross(&if d.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() })
+            .cross(&if d.x.abs() < 0.9 {
+                Vector3::x()
+            } else {
+                Vector3::y()
+            })
             .normalize();
         let e2 = d.cross(&e1);
         let frame = Frame { q: *q, d, e1, e2 };
-        let size = self.nodes.first().map_or(0.0, |n| (n.aabb.max - n.aabb.min).norm());
+        let size = self
+            .nodes
+            .first()
+            .map_or(0.0, |n| (n.aabb.max - n.aabb.min).norm());
         let tol = 1e-12 * (1.0 + size.min(1e6));
         let mut hits: Vec<RayHit> = Vec::new();
         for leaf in &self.leaves {
@@ -99,7 +110,9 @@ impl SurfaceProjector {
         mode: RayMode,
     ) -> Result<Option<RayHit>, ProjectError> {
         let hits = self.intersect_line(q, dir, mode)?;
-        Ok(hits.into_iter().min_by(|a, b| a.t.abs().total_cmp(&b.t.abs())))
+        Ok(hits
+            .into_iter()
+            .min_by(|a, b| a.t.abs().total_cmp(&b.t.abs())))
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -17,7 +17,7 @@ impl NurbsSurface {
     /// parameter, so `S(0, v) = profile(v)`. Control net `(2 k + 1) × n_profile`, `k`
     /// segments. Exact: the distance of `S(u, v)` from the axis equals that of
     /// `profile(v)` to rounding (tested to 1e-12 relative). Profile points on the axis
-    /// give a pole (the normal is undefined there).
+    /// give a pole (the normal is undefined there). O(n_profile) control points × ≤ 9.
     pub fn revolution(
         profile: &NurbsCurve<3>,
         axis_point: Vector3<f64>,

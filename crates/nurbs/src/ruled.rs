@@ -55,7 +55,8 @@ impl NurbsSurface {
     /// larger multiplicity of each value (A5.4; knots are merged by exact equality). Degree
     /// in `v` is 1 with knots `{0, 0, 1, 1}`. Exact: `S(u, 0) = c1(u')`, `S(u, 1) = c2(u'')`
     /// to rounding. For rational curves the rulings are straight but the `v` speed along
-    /// them is not uniform (weights blend linearly).
+    /// them is not uniform (weights blend linearly). Cost O((n1 + n2) p t) for the
+    /// elevation and refinement.
     pub fn ruled(c1: &NurbsCurve<3>, c2: &NurbsCurve<3>) -> Result<Self, NurbsError> {
         let p = c1.degree().max(c2.degree());
         let h1 = prepared(c1, p)?;

@@ -393,7 +393,8 @@ impl NurbsSurface {
     }
 
     /// Point and all partial derivatives up to second order (A3.6 restricted to
-    /// `k + l <= 2`, then the A4.4 quotient rule for rational surfaces). No heap allocation.
+    /// `k + l <= 2`, then the A4.4 quotient rule for rational surfaces; O(p² + q² + p q)).
+    /// No heap allocation.
     /// Parameters outside the domain are clamped; at knots the right-sided span is used.
     pub fn derivs2(&self, u: f64, v: f64) -> SurfaceDerivs2 {
         let (pu, pv) = (self.degree_u(), self.degree_v());

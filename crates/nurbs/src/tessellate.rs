@@ -68,10 +68,7 @@ fn second_bounds(b: &BezierPatch) -> (f64, f64, f64) {
         let mut m = (0.0f64, 0.0f64, 0.0f64);
         for i in 0..=4 {
             for j in 0..=4 {
-                let d = b.derivs2(
-                    b.u0 + du * i as f64 / 4.0,
-                    b.v0 + dv * j as f64 / 4.0,
-                );
+                let d = b.derivs2(b.u0 + du * i as f64 / 4.0, b.v0 + dv * j as f64 / 4.0);
                 m.0 = m.0.max(d.suu.norm());
                 m.1 = m.1.max(d.suv.norm());
                 m.2 = m.2.max(d.svv.norm());
@@ -85,13 +82,16 @@ fn second_bounds(b: &BezierPatch) -> (f64, f64, f64) {
     for i in 0..=p {
         for j in 0..=q {
             if i + 2 <= p {
-                m.0 = m.0.max((at(i + 2, j) - at(i + 1, j) * 2.0 + at(i, j)).norm());
+                m.0 =
+                    m.0.max((at(i + 2, j) - at(i + 1, j) * 2.0 + at(i, j)).norm());
             }
             if i < p && j < q {
-                m.1 = m.1.max((at(i + 1, j + 1) - at(i + 1, j) - at(i, j + 1) + at(i, j)).norm());
+                m.1 =
+                    m.1.max((at(i + 1, j + 1) - at(i + 1, j) - at(i, j + 1) + at(i, j)).norm());
             }
             if j + 2 <= q {
-                m.2 = m.2.max((at(i, j + 2) - at(i, j + 1) * 2.0 + at(i, j)).norm());
+                m.2 =
+                    m.2.max((at(i, j + 2) - at(i, j + 1) * 2.0 + at(i, j)).norm());
             }
         }
     }
@@ -154,7 +154,8 @@ pub fn tessellate(surface: &NurbsSurface, chord_tol: f64) -> Result<Mesh, Tessel
     // Every round doubles the counts of failing spans, so the loop ends by verification or
     // by the vertex limit.
     loop {
-        let total = (nu.iter().sum::<usize>() as f64 + 1.0) * (nv.iter().sum::<usize>() as f64 + 1.0);
+        let total =
+            (nu.iter().sum::<usize>() as f64 + 1.0) * (nv.iter().sum::<usize>() as f64 + 1.0);
         if total > MAX_VERTICES as f64 {
             return Err(TessellateError::TooManyVertices {
                 needed: total,

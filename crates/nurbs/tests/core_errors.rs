@@ -1,5 +1,8 @@
-//! Bad input: every `NurbsError` variant is reached by a test here (or, for the operation
-//! errors, in the tests of that operation — listed in `every_variant_is_covered`).
+//! Bad input: the validation variants of `NurbsError` are reached here; the operation
+//! errors are reached in the tests of their operations: `ParameterOutOfDomain`,
+//! `InsertionExceedsMultiplicity` (and `DegreeOutOfRange`, `EmptyDomain` from operations)
+//! in `core_knot_ops.rs`, `InvalidGeometry` in `core_constructors.rs`, `SurfaceKnots` also
+//! in `core_serde.rs`.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use nalgebra::{Vector2, Vector3};

@@ -1,4 +1,5 @@
 //! Fitting: interpolation, least squares, smoothing, surface interpolation, skinning.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use nalgebra::{Vector2, Vector3};
 use nurbs::fit::{
@@ -127,7 +128,10 @@ fn least_squares_error_is_reported_and_ends_fixed() {
         .map(|(u, q)| (fit.curve.point(*u) - q).norm())
         .fold(0.0, f64::max);
     assert!((direct - fit.max_error).abs() <= 1e-12);
-    assert!(fit.max_error > 1e-4, "10 control points cannot interpolate 60 wiggly points");
+    assert!(
+        fit.max_error > 1e-4,
+        "10 control points cannot interpolate 60 wiggly points"
+    );
     assert_eq!(fit.curve.point(0.0), pts[0]);
     assert_eq!(fit.curve.point(1.0), pts[59]);
     // n_ctrl = number of points: the interpolant.
@@ -144,7 +148,11 @@ fn approximation_to_tolerance_uses_the_fewest_control_points() {
     let n = fit.curve.control_points().len();
     assert!(n < 80, "should not need the interpolant ({n})");
     let fewer = approximate_curve(&pts, 3, n - 1, Parametrisation::ChordLength).unwrap();
-    assert!(fewer.max_error > tol, "n - 1 = {} control points already pass", n - 1);
+    assert!(
+        fewer.max_error > tol,
+        "n - 1 = {} control points already pass",
+        n - 1
+    );
 }
 
 /// Bending energy ∫|C''|² by dense midpoint rule.
@@ -163,25 +171,57 @@ fn smoothing_trades_error_for_bending_energy() {
         .map(|k| Vector3::new(k as f64, if k % 2 == 0 { 0.2 } else { -0.2 }, 0.0))
         .collect();
     let plain = approximate_curve(&pts, 3, 30, Parametrisation::ChordLength).unwrap();
-    let zero = smooth_curve(&pts, 3, 30, Parametrisation::ChordLength, Energy::SecondDerivative, 0.0).unwrap();
+    let zero = smooth_curve(
+        &pts,
+        3,
+        30,
+        Parametrisation::ChordLength,
+        Energy::SecondDerivative,
+        0.0,
+    )
+    .unwrap();
     assert!((plain.max_error - zero.max_error).abs() <= 1e-9);
     let mut last = bending(&zero.curve);
     for w in [1e-2, 1.0, 1e2] {
-        let s = smooth_curve(&pts, 3, 30, Parametrisation::ChordLength, Energy::SecondDerivative, w).unwrap();
+        let s = smooth_curve(
+            &pts,
+            3,
+            30,
+            Parametrisation::ChordLength,
+            Energy::SecondDerivative,
+            w,
+        )
+        .unwrap();
         let e = bending(&s.curve);
         assert!(e < last, "energy must drop with the weight ({e} !< {last})");
         last = e;
         assert_eq!(s.curve.point(0.0), pts[0]);
     }
-    let stiff = smooth_curve(&pts, 3, 30, Parametrisation::ChordLength, Energy::FirstDerivative, 1e4).unwrap();
+    let stiff = smooth_curve(
+        &pts,
+        3,
+        30,
+        Parametrisation::ChordLength,
+        Energy::FirstDerivative,
+        1e4,
+    )
+    .unwrap();
     // A stiff membrane pulls the curve onto the segment between the fixed ends.
     let (a, b) = (pts[0], pts[49]);
     let off = |p: Vector3<f64>| {
         let t = ((p - a).dot(&(b - a)) / (b - a).norm_squared()).clamp(0.0, 1.0);
         (p - (a + (b - a) * t)).norm()
     };
-    let dev = |c: &NurbsCurve<3>| (0..=200).map(|k| off(c.point(k as f64 / 200.0))).fold(0.0, f64::max);
-    assert!(dev(&stiff.curve) < 0.02, "membrane deviation {}", dev(&stiff.curve));
+    let dev = |c: &NurbsCurve<3>| {
+        (0..=200)
+            .map(|k| off(c.point(k as f64 / 200.0)))
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        dev(&stiff.curve) < 0.02,
+        "membrane deviation {}",
+        dev(&stiff.curve)
+    );
     assert!(dev(&plain.curve) > 0.1, "the plain fit follows the noise");
 }
 
@@ -206,7 +246,10 @@ fn circle(r: f64, z: f64, degree_elevated: bool) -> NurbsCurve<3> {
 fn skinning_reproduces_its_sections() {
     // Cubic sections with different knot vectors, plus a linear section.
     let a = interpolate_curve(&wiggle(7), 3, Parametrisation::ChordLength, None).unwrap();
-    let b_pts: Vec<Vector3<f64>> = wiggle(11).iter().map(|p| p + Vector3::new(0.0, 5.0, 20.0)).collect();
+    let b_pts: Vec<Vector3<f64>> = wiggle(11)
+        .iter()
+        .map(|p| p + Vector3::new(0.0, 5.0, 20.0))
+        .collect();
     let b = interpolate_curve(&b_pts, 3, Parametrisation::ChordLength, None).unwrap();
     let c = NurbsCurve::<3>::new(
         1,
@@ -215,7 +258,10 @@ fn skinning_reproduces_its_sections() {
         None,
     )
     .unwrap();
-    let d_pts: Vec<Vector3<f64>> = wiggle(9).iter().map(|p| p + Vector3::new(0.0, -3.0, 60.0)).collect();
+    let d_pts: Vec<Vector3<f64>> = wiggle(9)
+        .iter()
+        .map(|p| p + Vector3::new(0.0, -3.0, 60.0))
+        .collect();
     let d = interpolate_curve(&d_pts, 2, Parametrisation::ChordLength, None).unwrap();
     let sections = [a, b, c, d];
     let s = skin(&sections, 3, Parametrisation::ChordLength).unwrap();
@@ -225,7 +271,11 @@ fn skinning_reproduces_its_sections() {
         let target = sec.point(lo);
         let v = (0..=20000)
             .map(|k| k as f64 / 20000.0)
-            .min_by(|x, y| (s.point(0.0, *x) - target).norm().total_cmp(&(s.point(0.0, *y) - target).norm()))
+            .min_by(|x, y| {
+                (s.point(0.0, *x) - target)
+                    .norm()
+                    .total_cmp(&(s.point(0.0, *y) - target).norm())
+            })
             .unwrap();
         // refine v with the closest point on the v-iso curve: use a fine bisection on the
         // monotone distance near the minimum
@@ -233,7 +283,9 @@ fn skinning_reproduces_its_sections() {
         let mut step = 1.0 / 20000.0;
         for _ in 0..60 {
             for cand in [best_v - step, best_v + step] {
-                if (0.0..=1.0).contains(&cand) && (s.point(0.0, cand) - target).norm() < (s.point(0.0, best_v) - target).norm() {
+                if (0.0..=1.0).contains(&cand)
+                    && (s.point(0.0, cand) - target).norm() < (s.point(0.0, best_v) - target).norm()
+                {
                     best_v = cand;
                 }
             }
@@ -242,7 +294,11 @@ fn skinning_reproduces_its_sections() {
         for k in 0..=20 {
             let t = k as f64 / 20.0;
             let p = sec.point(lo + (hi - lo) * t);
-            assert!((s.point(t, best_v) - p).norm() <= 1e-9, "section mismatch {}", (s.point(t, best_v) - p).norm());
+            assert!(
+                (s.point(t, best_v) - p).norm() <= 1e-9,
+                "section mismatch {}",
+                (s.point(t, best_v) - p).norm()
+            );
         }
     }
 }
@@ -250,14 +306,22 @@ fn skinning_reproduces_its_sections() {
 #[test]
 fn skinning_rational_sections_gives_a_surface_of_circles() {
     // Half circles of radii 10, 14, 12 at heights 0, 10, 20 (one elevated to degree 3).
-    let sections = [circle(10.0, 0.0, false), circle(14.0, 10.0, true), circle(12.0, 20.0, false)];
+    let sections = [
+        circle(10.0, 0.0, false),
+        circle(14.0, 10.0, true),
+        circle(12.0, 20.0, false),
+    ];
     let s = skin(&sections, 2, Parametrisation::ChordLength).unwrap();
     assert!(s.is_rational());
     for k in 0..=10 {
         let u = k as f64 / 10.0;
         for (v, r) in [(0.0, 10.0), (1.0, 12.0)] {
             let p = s.point(u, v);
-            assert!((p.xy().norm() - r).abs() <= 1e-10, "radius {} vs {r}", p.xy().norm());
+            assert!(
+                (p.xy().norm() - r).abs() <= 1e-10,
+                "radius {} vs {r}",
+                p.xy().norm()
+            );
         }
     }
 }
@@ -267,7 +331,11 @@ fn every_fit_error_is_reported() {
     let pts = wiggle(10);
     assert!(matches!(
         interpolate_curve(&pts[..3], 3, Parametrisation::ChordLength, None),
-        Err(FitError::TooFewPoints { needed: 4, got: 3, .. })
+        Err(FitError::TooFewPoints {
+            needed: 4,
+            got: 3,
+            ..
+        })
     ));
     assert!(matches!(
         interpolate_curve(&pts, 0, Parametrisation::ChordLength, None),
@@ -287,27 +355,49 @@ fn every_fit_error_is_reported() {
     ));
     assert!(matches!(
         approximate_curve(&pts, 3, 11, Parametrisation::ChordLength),
-        Err(FitError::InvalidControlCount { n_ctrl: 11, min: 4, max: 10 })
+        Err(FitError::InvalidControlCount {
+            n_ctrl: 11,
+            min: 4,
+            max: 10
+        })
     ));
     assert!(matches!(
         approximate_curve_to_tolerance(&pts, 3, 0.0, Parametrisation::ChordLength),
         Err(FitError::InvalidValue { field: "tol", .. })
     ));
     assert!(matches!(
-        smooth_curve(&pts, 3, 6, Parametrisation::ChordLength, Energy::FirstDerivative, -1.0),
-        Err(FitError::InvalidValue { field: "weight", .. })
+        smooth_curve(
+            &pts,
+            3,
+            6,
+            Parametrisation::ChordLength,
+            Energy::FirstDerivative,
+            -1.0
+        ),
+        Err(FitError::InvalidValue {
+            field: "weight",
+            ..
+        })
     ));
     let ragged = vec![pts.clone(), pts[..9].to_vec(), pts.clone(), pts.clone()];
     assert!(matches!(
         interpolate_surface(&ragged, 2, 2, Parametrisation::ChordLength),
-        Err(FitError::RaggedGrid { row: 1, expected: 10, got: 9 })
+        Err(FitError::RaggedGrid {
+            row: 1,
+            expected: 10,
+            got: 9
+        })
     ));
     // (SingularSystem is reached by the unit test of the rank-revealing solver in
     // src/fit/solve.rs: the public fits build regular systems by construction.)
     let single = [circle(10.0, 0.0, false)];
     assert!(matches!(
         skin(&single, 1, Parametrisation::ChordLength),
-        Err(FitError::TooFewPoints { what: "sections", needed: 2, got: 1 })
+        Err(FitError::TooFewPoints {
+            what: "sections",
+            needed: 2,
+            got: 1
+        })
     ));
     // Core errors pass through: chords that overflow give non-finite knots, which the core
     // knot-vector validation rejects.
@@ -319,5 +409,4 @@ fn every_fit_error_is_reported() {
     ];
     let err = interpolate_curve(&huge, 2, Parametrisation::ChordLength, None).unwrap_err();
     assert!(matches!(err, FitError::Nurbs(_)), "{err:?}");
-
 }

@@ -149,7 +149,14 @@ fn finish_derivs(a: &[[f64; 4]; 6], rational: bool, du: f64, dv: f64) -> Surface
         let svv = (v3(&a[5]) - sv * (2.0 * wv) - p * wvv) * inv;
         (p, su, sv, suu, suv, svv)
     } else {
-        (v3(&a[0]), v3(&a[1]), v3(&a[2]), v3(&a[3]), v3(&a[4]), v3(&a[5]))
+        (
+            v3(&a[0]),
+            v3(&a[1]),
+            v3(&a[2]),
+            v3(&a[3]),
+            v3(&a[4]),
+            v3(&a[5]),
+        )
     };
     SurfaceDerivs2 {
         p,

@@ -266,7 +266,11 @@ impl<const D: usize> CurveProjector<D> {
                 break;
             }
             let du = -g / h;
-            if (e[1] * ((u + du).clamp(lo, hi) - u)).norm() <= self.step_tol {
+            let predicted = (e[1] * ((u + du).clamp(lo, hi) - u)).norm();
+            if predicted <= self.step_tol
+                && (g.abs() <= super::newton::ANGLE_TOL * f.sqrt() * a.sqrt()
+                    || predicted <= 1e-3 * self.step_tol)
+            {
                 break;
             }
             let mut t = 1.0;
@@ -275,7 +279,7 @@ impl<const D: usize> CurveProjector<D> {
                 let un = (u + t * du).clamp(lo, hi);
                 let en = ev(un);
                 let fnew = (en[0] - q).norm_squared();
-                if fnew <= f * (1.0 + 4.0 * f64::EPSILON) + 1e-300 {
+                if fnew <= f + super::newton::noise(f, &en[0], q) {
                     accepted = Some((un, en, fnew));
                     break;
                 }

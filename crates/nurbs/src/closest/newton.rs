@@ -15,6 +15,9 @@ use crate::SurfaceDerivs2;
 /// Largest number of Newton iterations (a well-started iteration needs 3–6).
 pub(crate) const MAX_ITER: usize = 40;
 
+/// Cosine of the angle between `S − q` and a tangent accepted as "orthogonal".
+pub(crate) const ANGLE_TOL: f64 = 1e-11;
+
 /// Result of a bound-constrained Newton run.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Local {
@@ -27,6 +30,19 @@ pub(crate) struct Local {
     pub active: [i8; 2],
     /// The iteration met its step tolerance (otherwise it stopped at MAX_ITER).
     pub converged: bool,
+}
+
+/// Round-off level of `|S − q|²` near `f`: evaluation errors of a few ulps of the
+/// coordinates, `δ(|r|²) ≈ 2|r|·δp`. Steps that increase `f` by less are accepted, so the
+/// iteration can finish converging where `f` itself no longer resolves the progress.
+#[inline]
+pub(crate) fn noise<const D: usize>(
+    f: f64,
+    p: &nalgebra::SVector<f64, D>,
+    q: &nalgebra::SVector<f64, D>,
+) -> f64 {
+    let scale = p.amax().max(q.amax()) + 1e-300;
+    2.0 * f.sqrt() * 64.0 * f64::EPSILON * scale + 1e-300
 }
 
 /// Minimises `½|S − q|²` over `[lo.0, hi.0] × [lo.1, hi.1]` from `(u, v)`.
@@ -114,9 +130,25 @@ pub(crate) fn minimise<F: Fn(f64, f64) -> SurfaceDerivs2>(
         // converges quadratically, so the error left is far below `step_tol`.
         let pu = (u + du).clamp(lo.0, hi.0) - u;
         let pv = (v + dv).clamp(lo.1, hi.1) - v;
-        if (e.su * pu + e.sv * pv).norm() <= step_tol {
-            converged = true;
-            break;
+        let predicted = (e.su * pu + e.sv * pv).norm();
+        if predicted <= step_tol {
+            // Also require the angle condition (relative orthogonality) unless the step is
+            // at round-off level: near-cusps make tiny steps with a sizeable angle left.
+            let rn = f.sqrt();
+            let cu = if fix_u {
+                0.0
+            } else {
+                gu.abs() / (rn * auu.sqrt())
+            };
+            let cv = if fix_v {
+                0.0
+            } else {
+                gv.abs() / (rn * avv.sqrt())
+            };
+            if !(cu > ANGLE_TOL || cv > ANGLE_TOL) || predicted <= 1e-3 * step_tol {
+                converged = true;
+                break;
+            }
         }
         // Backtracking on the projected step.
         let mut t = 1.0;
@@ -129,7 +161,7 @@ pub(crate) fn minimise<F: Fn(f64, f64) -> SurfaceDerivs2>(
             vn = (v + t * dv).clamp(lo.1, hi.1);
             en = eval(un, vn);
             fnew = (en.p - q).norm_squared();
-            if fnew <= f * (1.0 + 4.0 * f64::EPSILON) + 1e-300 {
+            if fnew <= f + noise(f, &en.p, q) {
                 accepted = true;
                 break;
             }

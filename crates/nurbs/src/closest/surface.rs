@@ -225,12 +225,210 @@ pub(crate) struct Leaf {
     /// `[u0, u1, v0, v1]` (edge interior to the surface and C¹ across it)?
     exclude_towards: [bool; 4],
     samples: [(f64, f64, Vector3<f64>); 9],
+    /// Interval data of the Hessian certificate.
+    hess: HessianBounds,
+}
+
+/// Closed interval.
+#[derive(Debug, Clone, Copy)]
+struct Iv {
+    lo: f64,
+    hi: f64,
+}
+
+impl Iv {
+    fn add(self, o: Iv) -> Iv {
+        Iv {
+            lo: self.lo + o.lo,
+            hi: self.hi + o.hi,
+        }
+    }
+    fn mul(self, o: Iv) -> Iv {
+        let c = [
+            self.lo * o.lo,
+            self.lo * o.hi,
+            self.hi * o.lo,
+            self.hi * o.hi,
+        ];
+        Iv {
+            lo: c.iter().copied().fold(f64::INFINITY, f64::min),
+            hi: c.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+}
+
+/// Box (per-component intervals) of a vector quantity over a leaf.
+#[derive(Debug, Clone, Copy)]
+struct VBox([Iv; 3]);
+
+impl VBox {
+    fn of(vs: &[Vector3<f64>]) -> VBox {
+        let mut b = [Iv {
+            lo: f64::INFINITY,
+            hi: f64::NEG_INFINITY,
+        }; 3];
+        for v in vs {
+            for k in 0..3 {
+                b[k].lo = b[k].lo.min(v[k]);
+                b[k].hi = b[k].hi.max(v[k]);
+            }
+        }
+        if vs.is_empty() {
+            b = [Iv { lo: 0.0, hi: 0.0 }; 3];
+        }
+        VBox(b)
+    }
+    /// Widens every interval by `rel` of its width plus `rel` of its magnitude.
+    fn widen(mut self, rel: f64) -> VBox {
+        for iv in &mut self.0 {
+            let pad = rel * ((iv.hi - iv.lo) + iv.lo.abs().max(iv.hi.abs()));
+            iv.lo -= pad;
+            iv.hi += pad;
+        }
+        self
+    }
+    fn dot(&self, o: &VBox) -> Iv {
+        let mut acc = Iv { lo: 0.0, hi: 0.0 };
+        for k in 0..3 {
+            acc = acc.add(self.0[k].mul(o.0[k]));
+        }
+        acc
+    }
+    /// `{x·x}` (tighter than `dot` with itself: squares are non-negative).
+    fn sq(&self) -> Iv {
+        let mut acc = Iv { lo: 0.0, hi: 0.0 };
+        for iv in &self.0 {
+            let (a, b) = (iv.lo * iv.lo, iv.hi * iv.hi);
+            let lo = if iv.lo <= 0.0 && iv.hi >= 0.0 {
+                0.0
+            } else {
+                a.min(b)
+            };
+            acc = acc.add(Iv { lo, hi: a.max(b) });
+        }
+        acc
+    }
+}
+
+/// Interval bounds over a leaf of the first fundamental form `JᵀJ` and of the second
+/// derivatives, for the query-time test that the Hessian of `½|S − q|²`,
+/// `H = JᵀJ + [r·S_uu, r·S_uv; r·S_uv, r·S_vv]` with `r ∈ box(leaf) − q`, is positive definite
+/// on the whole leaf (then the distance is strictly convex there and Newton's minimum is the
+/// leaf's only one). Polynomial leaves: rigorous boxes of the hodograph control vectors.
+/// Rational leaves: boxes of a 5×5 sample widened by 25% (a heuristic).
+#[derive(Debug, Clone, Copy)]
+struct HessianBounds {
+    a: Iv,
+    b: Iv,
+    c: Iv,
+    suu: VBox,
+    suv: VBox,
+    svv: VBox,
+}
+
+impl HessianBounds {
+    /// The test for a query `q`, with `r = S − q` bounded by the leaf's oriented box (the
+    /// vector boxes are stored in the same frame).
+    #[inline]
+    fn certifies(&self, obb: &Obb, q: &Vector3<f64>) -> bool {
+        let cq = obb.c - q;
+        let r = VBox([0, 1, 2].map(|k| {
+            let m = cq.dot(&obb.axes[k]);
+            Iv {
+                lo: m - obb.h[k],
+                hi: m + obb.h[k],
+            }
+        }));
+        let huu = self.a.add(r.dot(&self.suu));
+        let hvv = self.c.add(r.dot(&self.svv));
+        let huv = self.b.add(r.dot(&self.suv));
+        let m = huv.lo.abs().max(huv.hi.abs());
+        huu.lo > 0.0 && hvv.lo > 0.0 && huu.lo * hvv.lo > m * m
+    }
+
+    fn of(sub: &BezierPatch, pts: &[Vector3<f64>], axes: &[Vector3<f64>; 3]) -> HessianBounds {
+        let frame =
+            |v: Vector3<f64>| Vector3::new(v.dot(&axes[0]), v.dot(&axes[1]), v.dot(&axes[2]));
+        let (p, q) = (sub.p, sub.q);
+        let (du, dv) = (sub.u1 - sub.u0, sub.v1 - sub.v0);
+        let (su, sv, suu, suv, svv) = if sub.rational {
+            let mut d = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            for i in 0..=4 {
+                for j in 0..=4 {
+                    let e = sub.derivs2(sub.u0 + du * i as f64 / 4.0, sub.v0 + dv * j as f64 / 4.0);
+                    d.0.push(frame(e.su));
+                    d.1.push(frame(e.sv));
+                    d.2.push(frame(e.suu));
+                    d.3.push(frame(e.suv));
+                    d.4.push(frame(e.svv));
+                }
+            }
+            (
+                VBox::of(&d.0).widen(0.25),
+                VBox::of(&d.1).widen(0.25),
+                VBox::of(&d.2).widen(0.25),
+                VBox::of(&d.3).widen(0.25),
+                VBox::of(&d.4).widen(0.25),
+            )
+        } else {
+            let at = |i: usize, j: usize| pts[i * (q + 1) + j];
+            let (pf, qf) = (p as f64, q as f64);
+            let mut d = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            for i in 0..=p {
+                for j in 0..=q {
+                    if i < p {
+                        d.0.push(frame((at(i + 1, j) - at(i, j)) * (pf / du)));
+                    }
+                    if j < q {
+                        d.1.push(frame((at(i, j + 1) - at(i, j)) * (qf / dv)));
+                    }
+                    if i + 2 <= p {
+                        d.2.push(frame(
+                            (at(i + 2, j) - at(i + 1, j) * 2.0 + at(i, j))
+                                * (pf * (pf - 1.0) / (du * du)),
+                        ));
+                    }
+                    if i < p && j < q {
+                        d.3.push(frame(
+                            (at(i + 1, j + 1) - at(i + 1, j) - at(i, j + 1) + at(i, j))
+                                * (pf * qf / (du * dv)),
+                        ));
+                    }
+                    if j + 2 <= q {
+                        d.4.push(frame(
+                            (at(i, j + 2) - at(i, j + 1) * 2.0 + at(i, j))
+                                * (qf * (qf - 1.0) / (dv * dv)),
+                        ));
+                    }
+                }
+            }
+            // Round-off guard.
+            (
+                VBox::of(&d.0).widen(1e-12),
+                VBox::of(&d.1).widen(1e-12),
+                VBox::of(&d.2).widen(1e-12),
+                VBox::of(&d.3).widen(1e-12),
+                VBox::of(&d.4).widen(1e-12),
+            )
+        };
+        HessianBounds {
+            a: su.sq(),
+            b: su.dot(&sv),
+            c: sv.sq(),
+            suu,
+            suv,
+            svv,
+        }
+    }
 }
 
 /// BVH node: box plus either two children or a leaf index.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Node {
     pub aabb: Aabb,
+    /// Oriented box around the leaves' oriented boxes, in their mean frame: much tighter
+    /// than the axis-aligned box across the surface, which is what the walk prunes with.
+    pub obb: Obb,
     /// Children (`left`, `right`) for inner nodes; `right == u32::MAX` marks a leaf whose
     /// index is `left`.
     pub left: u32,
@@ -405,9 +603,21 @@ impl SurfaceProjector {
                 continue;
             }
             let (l, r) = (node.left, node.right);
-            let dl = self.nodes[l as usize].aabb.dist2(q);
-            let dr = self.nodes[r as usize].aabb.dist2(q);
-            let ((near, dn), (far, df)) = if dl <= dr { ((l, dl), (r, dr)) } else { ((r, dr), (l, dl)) };
+            let lb = |n: &Node| {
+                let a = n.aabb.dist2(q);
+                if a >= bound {
+                    a
+                } else {
+                    a.max(n.obb.dist2(q))
+                }
+            };
+            let dl = lb(&self.nodes[l as usize]);
+            let dr = lb(&self.nodes[r as usize]);
+            let ((near, dn), (far, df)) = if dl <= dr {
+                ((l, dl), (r, dr))
+            } else {
+                ((r, dr), (l, dl))
+            };
             if df < bound && sp < stack.len() {
                 stack[sp] = (far, df);
                 sp += 1;
@@ -415,6 +625,22 @@ impl SurfaceProjector {
             if dn < bound && sp < stack.len() {
                 stack[sp] = (near, dn);
                 sp += 1;
+            }
+        }
+        // A best point held on an interior leaf edge is not yet stationary for the whole
+        // surface (its true minimum lies within round-off across the edge): polish it on
+        // the whole domain.
+        if let Some((b, false)) = best {
+            let l = minimise(
+                |u, v| self.derivs2(u, v),
+                q,
+                (ua, va),
+                (ub, vb),
+                (b.u, b.v),
+                self.step_tol,
+            );
+            if l.d2 <= b.d2 * (1.0 + 8.0 * f64::EPSILON) {
+                best = Some((l, true));
             }
         }
         let l = match best {
@@ -454,9 +680,18 @@ impl SurfaceProjector {
         if leaf.obb.dist2(q) >= bound {
             return None;
         }
+        // The convexity certificate is computed only when it is needed (skip test below or
+        // before solving), after the cheaper cone tests.
+        let mut certified: Option<bool> = None;
         if let Some((b, true)) = best {
+            // A stationary point of the surface inside a leaf where the distance is convex
+            // is that leaf's minimum.
             if b.u >= leaf.u0 && b.u <= leaf.u1 && b.v >= leaf.v0 && b.v <= leaf.v1 {
-                return None;
+                let c = leaf.hess.certifies(&leaf.obb, q);
+                certified = Some(c);
+                if c {
+                    return None;
+                }
             }
         }
         let cq = leaf.obb.c - q;
@@ -483,7 +718,9 @@ impl SurfaceProjector {
             // next to the leaf's own minimum.
             let cu = b.u.clamp(leaf.u0, leaf.u1);
             let cv = b.v.clamp(leaf.v0, leaf.v1);
-            if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0) && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0) {
+            if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0)
+                && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0)
+            {
                 start = (cu, cv);
                 d_start = (patch.point(cu, cv) - q).norm_squared();
             }
@@ -495,7 +732,7 @@ impl SurfaceProjector {
                 start = (*u, *v);
             }
         }
-        let l = minimise(
+        let mut l = minimise(
             |u, v| patch.derivs2(u, v),
             q,
             (leaf.u0, leaf.v0),
@@ -503,6 +740,12 @@ impl SurfaceProjector {
             start,
             self.step_tol,
         );
+        if !certified.unwrap_or_else(|| leaf.hess.certifies(&leaf.obb, q)) {
+            // The distance may have several minima on this leaf (query beyond a centre of
+            // curvature): search the leaf by branch and bound.
+            let sub = patch.sub_patch(leaf.u0, leaf.u1, leaf.v0, leaf.v1);
+            self.branch_and_bound(patch, &sub, &leaf.obb.axes, q, &mut l, 1);
+        }
         let ((ua, ub), (va, vb)) = self.domain;
         let kkt_u = match l.active[0] {
             0 => true,
@@ -515,6 +758,81 @@ impl SurfaceProjector {
             _ => l.v >= vb,
         };
         Some((l, l.converged && kkt_u && kkt_v))
+    }
+}
+
+/// Deepest query-time subdivision of a leaf whose distance function is not certified
+/// convex (pieces of 1/64 of the leaf per direction).
+const MAX_BB_DEPTH: usize = 6;
+
+impl SurfaceProjector {
+    /// Branch and bound over de Casteljau pieces of a leaf on which the distance may have
+    /// several minima: a piece is dropped when its control-net box is at least the best
+    /// distance away, minimised by Newton when its Hessian certificate holds (or at the
+    /// depth limit), and split into four otherwise, nearer pieces first. Allocates the
+    /// pieces; only reached for queries beyond a centre of curvature of the leaf.
+    fn branch_and_bound(
+        &self,
+        patch: &BezierPatch,
+        sub: &BezierPatch,
+        axes: &[Vector3<f64>; 3],
+        q: &Vector3<f64>,
+        best: &mut Local,
+        depth: usize,
+    ) {
+        let pts: Vec<Vector3<f64>> = sub.points().collect();
+        let obb = Obb::from_points(&pts, *axes);
+        if obb.dist2(q) >= best.d2 {
+            return;
+        }
+        if depth >= MAX_BB_DEPTH || HessianBounds::of(sub, &pts, axes).certifies(&obb, q) {
+            // Start from the nearest of the corners and the centre.
+            let (um, vm) = (0.5 * (sub.u0 + sub.u1), 0.5 * (sub.v0 + sub.v1));
+            let mut start = (um, vm);
+            let mut ds = (patch.point(um, vm) - q).norm_squared();
+            for (u, v) in [
+                (sub.u0, sub.v0),
+                (sub.u1, sub.v0),
+                (sub.u0, sub.v1),
+                (sub.u1, sub.v1),
+            ] {
+                let d = (patch.point(u, v) - q).norm_squared();
+                if d < ds {
+                    ds = d;
+                    start = (u, v);
+                }
+            }
+            let l = minimise(
+                |u, v| patch.derivs2(u, v),
+                q,
+                (sub.u0, sub.v0),
+                (sub.u1, sub.v1),
+                start,
+                self.step_tol,
+            );
+            if l.d2 < best.d2 {
+                *best = l;
+            }
+            return;
+        }
+        let (um, vm) = (0.5 * (sub.u0 + sub.u1), 0.5 * (sub.v0 + sub.v1));
+        let mut kids: Vec<(f64, BezierPatch)> = [(sub.u0, um), (um, sub.u1)]
+            .iter()
+            .flat_map(|&(a, b)| {
+                [(sub.v0, vm), (vm, sub.v1)].map(|(c, d)| sub.sub_patch(a, b, c, d))
+            })
+            .map(|k| {
+                let mut bx = Aabb::empty();
+                for p in k.points() {
+                    bx.add(&p);
+                }
+                (bx.dist2(q), k)
+            })
+            .collect();
+        kids.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for (_, k) in &kids {
+            self.branch_and_bound(patch, k, axes, q, best, depth + 1);
+        }
     }
 }
 
@@ -556,8 +874,15 @@ fn leaf_split(patch: &BezierPatch) -> (usize, usize) {
                 }
             }
         }
-        let split_u = worst_u < LEAF_NORMAL_COS;
-        let split_v = worst_v < LEAF_NORMAL_COS;
+        let mut split_u = worst_u < LEAF_NORMAL_COS;
+        let mut split_v = worst_v < LEAF_NORMAL_COS;
+        if !split_u && !split_v {
+            // Convexity certificate for typical queries: every piece should certify queries
+            // at a distance of its own size above or below any of its corners' footprints.
+            let (fail_u, fail_v) = certificate_failures(patch, su, sv);
+            split_u = fail_u;
+            split_v = fail_v;
+        }
         if !split_u && !split_v {
             break;
         }
@@ -569,6 +894,63 @@ fn leaf_split(patch: &BezierPatch) -> (usize, usize) {
         }
     }
     (su, sv)
+}
+
+/// Oriented frame of a piece: `S_u` direction, binormal, normal at the centre (or the
+/// coordinate axes where the surface is singular).
+fn piece_axes(patch: &BezierPatch, sub: &BezierPatch) -> [Vector3<f64>; 3] {
+    let d = patch.derivs2(0.5 * (sub.u0 + sub.u1), 0.5 * (sub.v0 + sub.v1));
+    match (d.su.try_normalize(0.0), d.normal()) {
+        (Some(e1), Some(n)) => [e1, n.cross(&e1), n],
+        _ => [Vector3::x(), Vector3::y(), Vector3::z()],
+    }
+}
+
+/// Whether some piece of the `su × sv` split fails the Hessian certificate for the typical
+/// queries `c ± D·n ± h₁ e₁ ± h₂ e₂` (`D` the piece's larger half extent), and in which
+/// direction the parametric distortion (`|S_uu|` vs `|S_vv|` times the extent) is larger.
+fn certificate_failures(patch: &BezierPatch, su: usize, sv: usize) -> (bool, bool) {
+    let (mut fu, mut fv) = (false, false);
+    for i in 0..su {
+        for j in 0..sv {
+            let sub = patch.sub_patch(
+                lerp(patch.u0, patch.u1, i, su),
+                lerp(patch.u0, patch.u1, i + 1, su),
+                lerp(patch.v0, patch.v1, j, sv),
+                lerp(patch.v0, patch.v1, j + 1, sv),
+            );
+            let pts: Vec<Vector3<f64>> = sub.points().collect();
+            let axes = piece_axes(patch, &sub);
+            let obb = Obb::from_points(&pts, axes);
+            let hess = HessianBounds::of(&sub, &pts, &axes);
+            let dd = obb.h[0].max(obb.h[1]);
+            let mut ok = true;
+            for s in [-1.0, 1.0] {
+                for t1 in [-1.0, 1.0] {
+                    for t2 in [-1.0, 1.0] {
+                        let q = obb.c
+                            + axes[2] * (s * dd)
+                            + axes[0] * (t1 * obb.h[0])
+                            + axes[1] * (t2 * obb.h[1]);
+                        ok &= hess.certifies(&obb, &q);
+                    }
+                }
+            }
+            if !ok {
+                let mag = |b: &VBox| {
+                    b.0.iter()
+                        .map(|iv| iv.lo.abs().max(iv.hi.abs()))
+                        .fold(0.0, f64::max)
+                };
+                if mag(&hess.suu) * obb.h[0] >= mag(&hess.svv) * obb.h[1] {
+                    fu = true;
+                } else {
+                    fv = true;
+                }
+            }
+        }
+    }
+    (fu, fv)
 }
 
 fn make_leaf(
@@ -583,16 +965,7 @@ fn make_leaf(
     for p in &pts {
         aabb.add(p);
     }
-    let uc = 0.5 * (sub.u0 + sub.u1);
-    let vc = 0.5 * (sub.v0 + sub.v1);
-    let d = patch.derivs2(uc, vc);
-    let axes = match (d.su.try_normalize(0.0), d.normal()) {
-        (Some(e1), Some(n)) => {
-            let e2 = n.cross(&e1);
-            [e1, e2, n]
-        }
-        _ => [Vector3::x(), Vector3::y(), Vector3::z()],
-    };
+    let axes = piece_axes(patch, sub);
     let obb = Obb::from_points(&pts, axes);
     let obb_half_diag = Vector3::new(obb.h[0], obb.h[1], obb.h[2]).norm();
     let (cone_u, cone_v) = if rational {
@@ -613,6 +986,7 @@ fn make_leaf(
         }
         (Cone::of(&du, &obb), Cone::of(&dv, &obb))
     };
+    let hess = HessianBounds::of(sub, &pts, &obb.axes);
     let mut samples = [(0.0, 0.0, Vector3::zeros()); 9];
     for a in 0..3 {
         for b in 0..3 {
@@ -634,6 +1008,7 @@ fn make_leaf(
         obb_half_diag,
         exclude_towards,
         samples,
+        hess,
     }
 }
 
@@ -643,6 +1018,11 @@ fn build_bvh(leaves: &[Leaf]) -> Vec<Node> {
     let mut idx: Vec<usize> = (0..leaves.len()).collect();
     nodes.push(Node {
         aabb: Aabb::empty(),
+        obb: Obb {
+            c: Vector3::zeros(),
+            axes: [Vector3::x(), Vector3::y(), Vector3::z()],
+            h: [0.0; 3],
+        },
         left: 0,
         right: u32::MAX,
     });
@@ -655,9 +1035,11 @@ fn build_rec(leaves: &[Leaf], idx: &mut [usize], at: usize, nodes: &mut Vec<Node
     for &i in idx.iter() {
         aabb.merge(&leaves[i].aabb);
     }
+    let obb = group_obb(leaves, idx);
     if idx.len() == 1 {
         nodes[at] = Node {
             aabb,
+            obb: leaves[idx[0]].obb,
             left: idx[0] as u32,
             right: u32::MAX,
         };
@@ -683,20 +1065,56 @@ fn build_rec(leaves: &[Leaf], idx: &mut [usize], at: usize, nodes: &mut Vec<Node
     let l = nodes.len();
     nodes.push(Node {
         aabb: Aabb::empty(),
+        obb,
         left: 0,
         right: u32::MAX,
     });
     nodes.push(Node {
         aabb: Aabb::empty(),
+        obb,
         left: 0,
         right: u32::MAX,
     });
     nodes[at] = Node {
         aabb,
+        obb,
         left: l as u32,
         right: (l + 1) as u32,
     };
     let (a, b) = idx.split_at_mut(mid);
     build_rec(leaves, a, l, nodes);
     build_rec(leaves, b, l + 1, nodes);
+}
+
+/// Oriented box containing the oriented boxes of `idx`, in their mean frame (the axes of
+/// the world when the mean normal vanishes).
+fn group_obb(leaves: &[Leaf], idx: &[usize]) -> Obb {
+    let mut n = Vector3::zeros();
+    let mut t = Vector3::zeros();
+    for &i in idx {
+        n += leaves[i].obb.axes[2];
+        t += leaves[i].obb.axes[0];
+    }
+    let axes = match n.try_normalize(1e-9) {
+        Some(n) => {
+            let t = t - n * t.dot(&n);
+            match t.try_normalize(1e-9) {
+                Some(e1) => [e1, n.cross(&e1), n],
+                None => [Vector3::x(), Vector3::y(), Vector3::z()],
+            }
+        }
+        None => [Vector3::x(), Vector3::y(), Vector3::z()],
+    };
+    let mut corners = Vec::with_capacity(8 * idx.len());
+    for &i in idx {
+        let o = &leaves[i].obb;
+        for s0 in [-1.0, 1.0] {
+            for s1 in [-1.0, 1.0] {
+                for s2 in [-1.0, 1.0] {
+                    corners.push(o.c + o.axes[0] * (s0 * o.h[0]) + o.axes[1] * (s1 * o.h[1]) + o.axes[2] * (s2 * o.h[2]));
+                }
+            }
+        }
+    }
+    Obb::from_points(&corners, axes)
 }

@@ -129,7 +129,10 @@ pub fn skin(
             .enumerate()
             .find(|(_, w)| !(w.is_finite() && **w > 0.0))
         {
-            return Err(FitError::Nurbs(crate::NurbsError::InvalidWeight { index, value }));
+            return Err(FitError::Nurbs(crate::NurbsError::InvalidWeight {
+                index,
+                value,
+            }));
         }
     }
     Ok(NurbsSurface::new(

@@ -61,7 +61,10 @@ mod tests {
         // Fewer rows than unknowns.
         let a = Mat::from_fn(1, 2, |_, j| 1.0 + j as f64);
         let b = Mat::from_fn(1, 1, |_, _| 1.0);
-        assert!(matches!(solve_lstsq(&a, &b), Err(FitError::SingularSystem { .. })));
+        assert!(matches!(
+            solve_lstsq(&a, &b),
+            Err(FitError::SingularSystem { .. })
+        ));
         // A regular system is solved.
         let a = Mat::from_fn(2, 2, |i, j| if i == j { 2.0 } else { 0.0 });
         let b = Mat::from_fn(2, 1, |i, _| 4.0 * (i + 1) as f64);
