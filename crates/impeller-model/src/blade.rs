@@ -10,8 +10,10 @@
 use crate::error::ModelError;
 use crate::thickness::ThicknessLaw;
 use nalgebra::{Rotation3, Vector3};
+use nurbs::closest::SurfaceProjector;
 use nurbs::NurbsSurface;
 use std::f64::consts::TAU;
+use std::sync::{Arc, OnceLock};
 
 /// How a blade was designed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -89,6 +91,9 @@ pub struct Blade {
     /// The side facing +θ (toward blade k+1 of the row).
     plus_theta: Side,
     design: Option<BladeDesign>,
+    /// Global closest-point structures of [pressure, suction], built on first use and shared
+    /// by clones (not by rotated copies).
+    projectors: Arc<OnceLock<[SurfaceProjector; 2]>>,
 }
 
 fn mid(s: &NurbsSurface) -> (f64, f64) {
@@ -147,6 +152,7 @@ impl Blade {
             suction_sign,
             plus_theta,
             design: None,
+            projectors: Arc::new(OnceLock::new()),
         })
     }
 
@@ -209,6 +215,21 @@ impl Blade {
             .map(|n| n * self.outward_sign(side))
     }
 
+    /// The global closest-point structure of `side` (nurbs' `SurfaceProjector`: Bézier
+    /// patches in a bounding-volume tree, Newton per candidate leaf), built on first use.
+    pub fn projector(&self, side: Side) -> &SurfaceProjector {
+        let p = self.projectors.get_or_init(|| {
+            [
+                SurfaceProjector::new(&self.pressure),
+                SurfaceProjector::new(&self.suction),
+            ]
+        });
+        match side {
+            Side::Pressure => &p[0],
+            Side::Suction => &p[1],
+        }
+    }
+
     /// This blade turned by `angle` (radians) about +Z (exact: control points rotate).
     pub fn rotated(&self, angle: f64) -> Blade {
         let rot = Rotation3::from_axis_angle(&Vector3::z_axis(), angle);
@@ -221,6 +242,7 @@ impl Blade {
             suction_sign: self.suction_sign,
             plus_theta: self.plus_theta,
             design: self.design.clone(),
+            projectors: Arc::new(OnceLock::new()),
         }
     }
 }

@@ -1,6 +1,9 @@
 //! Point queries on blade sides, hub and shroud: closest point and signed distance.
 //!
-//! Closest point on a NURBS surface (NURBS Book §6.1, point inversion): minimise |S(u,v) − p|²
+//! Blade sides are queried globally with the `nurbs` crate's `SurfaceProjector` (cached per
+//! blade); hub and shroud exactly through their meridional contours. [`closest_point`] is the
+//! local solver used where a good start is known (thickness, ruled deviations):
+//! closest point on a NURBS surface (NURBS Book §6.1, point inversion): minimise |S(u,v) − p|²
 //! by Newton's method on the stationarity conditions f = (S − p)·S_u = 0, g = (S − p)·S_v = 0
 //! with Jacobian [[|S_u|² + r·S_uu, S_u·S_v + r·S_uv], [·, |S_v|² + r·S_vv]], r = S − p,
 //! parameters clamped to the domain (a boundary minimum is then found with the clamped
@@ -99,14 +102,21 @@ pub fn closest_point(s: &NurbsSurface, p: &Vector3<f64>, hint: Option<(f64, f64)
 }
 
 /// Closest point on one side of a blade and the signed distance (positive outside the blade
-/// material, along the side's outward normal).
+/// material, along the side's outward normal). Global: uses the blade's cached
+/// [`nurbs::closest::SurfaceProjector`] (the hint, if any, only warm-starts it).
 pub fn blade_side_distance(
     blade: &Blade,
     side: Side,
     p: &Vector3<f64>,
     hint: Option<(f64, f64)>,
 ) -> (SurfacePoint, f64) {
-    let sp = closest_point(blade.side(side), p, hint);
+    let g = blade.projector(side).closest_point_with_hint(p, hint);
+    let sp = SurfacePoint {
+        u: g.u,
+        v: g.v,
+        point: g.point,
+        distance: g.distance,
+    };
     let sign = match blade.outward_normal(side, sp.u, sp.v) {
         Some(n) if (p - sp.point).dot(&n) < 0.0 => -1.0,
         _ => 1.0,

@@ -22,7 +22,7 @@ use std::f64::consts::PI;
 pub enum EdgeShape {
     /// Thickness kept to the edge; the edge is a flat face between the two sides.
     Blunt,
-    /// Elliptic nose, about a half circle of diameter τ.
+    /// Rounded nose of tip radius about τ/2 (see the module docs).
     Rounded,
 }
 

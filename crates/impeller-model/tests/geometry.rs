@@ -1,0 +1,180 @@
+//! Geometric properties of parametrically built impellers (issue 3, "Tests").
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use impeller_model::channel::min_edge_distance;
+use impeller_model::query::{blade_side_distance, Part};
+use impeller_model::revolved::RevolvedSurface;
+use impeller_model::{fixtures, load, Impeller, Side};
+use nalgebra::Vector3;
+
+fn fixture(name: &str) -> Impeller {
+    load(format!(
+        "{}/../../fixtures/{name}/impeller.toml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+}
+
+#[test]
+fn hub_and_shroud_radii_equal_their_meridional_curves() {
+    let imp = fixtures::default_impeller().unwrap();
+    for wall in [imp.hub(), imp.shroud()] {
+        let (a, b) = wall.meridional().domain();
+        for i in 0..=40 {
+            let t = a + (b - a) * i as f64 / 40.0;
+            let zr = wall.meridional().point(t);
+            for k in 0..16 {
+                let phi = k as f64 * 0.41;
+                let p = wall.surface().point(t, RevolvedSurface::v_of_angle(phi));
+                let r = (p.x * p.x + p.y * p.y).sqrt();
+                assert!((r - zr[1]).abs() < 1e-9, "r {r} vs {}", zr[1]);
+                assert!((p.z - zr[0]).abs() < 1e-9);
+                assert!((p.y.atan2(p.x) - phi.sin().atan2(phi.cos())).abs() < 1e-9);
+            }
+        }
+    }
+}
+
+/// Normal thickness along the camber normal against the designed distribution, on the hub
+/// and shroud rows of ruled blades (where the ruled sides are offset exactly).
+#[test]
+fn ruled_blade_thickness_matches_distribution() {
+    let imp = fixtures::default_impeller().unwrap();
+    let splitter = imp.splitter().unwrap();
+    for blade in [imp.main().blade(), splitter.blade()] {
+        let d = blade.design().unwrap();
+        let nose = d.thickness.nose_lengths().0;
+        for s in [0.0, 1.0] {
+            let v = d.v_of_span(s);
+            let (mut far, mut near) = (0.0f64, 0.0f64);
+            for i in 0..=1200 {
+                let u = i as f64 / 1200.0;
+                let m = d.m_local(u);
+                if m < 1e-3 {
+                    continue; // the normal line is tangent to both sides at the nose tip
+                }
+                let t = blade.normal_thickness(u, v).unwrap();
+                let e = (t - d.thickness.thickness(m)).abs();
+                if m > 2.0 * nose {
+                    far = far.max(e);
+                } else {
+                    near = near.max(e);
+                }
+            }
+            assert!(far < 1e-6, "thickness error {far} mm away from the nose");
+            assert!(near < 2e-4, "thickness error {near} mm in the rounded nose");
+        }
+        // Exactly the nominal 0.8 mm wherever no nose is involved.
+        assert!((d.thickness.nominal(0.5) - 0.8).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn blades_do_not_intersect_and_channels_are_positive() {
+    for name in [
+        "impeller-8+8",
+        "impeller-11+11-freeform",
+        "impeller-30-narrow",
+    ] {
+        let imp = fixture(name);
+        let c = imp.channel(0);
+        let mut pairs = vec![(&c.left, c.left_side(), &c.right, c.right_side())];
+        if let Some(s) = &c.splitter {
+            pairs.push((&c.left, c.left_side(), s, s.plus_theta_side().other()));
+            pairs.push((s, s.plus_theta_side(), &c.right, c.right_side()));
+        }
+        for (a, sa, b, sb) in pairs {
+            // Points of b's facing side between hub and shroud lie outside blade a.
+            let d = b.design().unwrap();
+            for i in 0..=12 {
+                for j in 0..=4 {
+                    let (u, v) = (i as f64 / 12.0, d.v_of_span(j as f64 / 4.0));
+                    let p = b.side(sb).point(u, v);
+                    let (_, sd) = blade_side_distance(a, sa, &p, None);
+                    assert!(sd > 0.5, "{name}: blade sides too close ({sd} mm)");
+                }
+            }
+            for wall in [imp.hub(), imp.shroud()] {
+                let (w, _, _) = min_edge_distance(a, sa, b, sb, wall).unwrap();
+                assert!(w > 1.0, "{name}: channel width {w}");
+            }
+        }
+        let s = imp.summary();
+        assert!(s.min_channel_width_hub_mm > 0.0 && s.min_channel_width_shroud_mm > 0.0);
+    }
+}
+
+#[test]
+fn n_fold_symmetry_holds() {
+    let imp = fixtures::default_impeller().unwrap();
+    let n = imp.main().count();
+    let pitch = std::f64::consts::TAU / n as f64;
+    for set in [imp.main(), imp.splitter().unwrap()] {
+        let b0 = set.blade();
+        for k in 0..n {
+            let bk = set.instance(k);
+            let rot = set.rotation(k);
+            for side in [Side::Pressure, Side::Suction] {
+                for (u, v) in [(0.1, 0.2), (0.5, 0.5), (0.9, 0.8)] {
+                    let p0 = b0.side(side).point(u, v);
+                    let pk = bk.side(side).point(u, v);
+                    assert!((rot * p0 - pk).norm() < 1e-9);
+                    // Same radius and z, angle advanced by k pitches.
+                    let dphi = (pk.y.atan2(pk.x) - p0.y.atan2(p0.x) - k as f64 * pitch)
+                        .rem_euclid(std::f64::consts::TAU);
+                    assert!(!(1e-9..=std::f64::consts::TAU - 1e-9).contains(&dphi));
+                }
+            }
+        }
+    }
+    // Every channel is as wide as channel 0.
+    let w0 = {
+        let c = imp.channel(0);
+        min_edge_distance(&c.left, c.left_side(), &c.right, c.right_side(), imp.hub())
+            .unwrap()
+            .0
+    };
+    let c = imp.channel(5);
+    let w5 = min_edge_distance(&c.left, c.left_side(), &c.right, c.right_side(), imp.hub())
+        .unwrap()
+        .0;
+    assert!((w0 - w5).abs() < 1e-6);
+    assert_eq!(imp.channel(n).index, 0);
+}
+
+#[test]
+fn signed_distances_have_the_documented_signs() {
+    let imp = fixtures::default_impeller().unwrap();
+    let b = imp.main().blade();
+    let d = b.design().unwrap();
+    let (u, v) = (0.5, d.v_of_span(0.5));
+    let camber = b.camber().unwrap().point(u, v);
+    // The camber point is inside the blade: negative distance to both sides, about -0.4 mm.
+    for side in [Side::Pressure, Side::Suction] {
+        let (_, sd) = blade_side_distance(b, side, &camber, None);
+        assert!(sd < -0.3 && sd > -0.5, "{sd}");
+        let n = b.outward_normal(side, u, v).unwrap();
+        let p = b.side(side).point(u, v) + n * 0.25;
+        let (_, out) = blade_side_distance(b, side, &p, Some((u, v)));
+        assert!((out - 0.25).abs() < 1e-6, "{out}");
+    }
+    // Rotated blade queries through the impeller.
+    let rot = imp.main().rotation(3);
+    let (_, sd) = imp
+        .signed_distance(Part::Main(3, Side::Pressure), &(rot * camber))
+        .unwrap();
+    assert!(sd < 0.0);
+    // Hub: a point on the axis side of the hub contour is negative, one in the channel positive.
+    let mid = imp.hub().meridional().point_at_fraction(0.5);
+    let n = imp
+        .hub()
+        .meridional()
+        .normal(imp.hub().meridional().param_at_fraction(0.5));
+    let inside = Vector3::new(mid[1] + 2.0 * n[1], 0.0, mid[0] + 2.0 * n[0]);
+    let (_, dh) = imp.signed_distance(Part::Hub, &inside).unwrap();
+    assert!((dh - 2.0).abs() < 1e-9, "{dh}");
+    assert!(imp
+        .signed_distance(Part::Splitter(8, Side::Pressure), &inside)
+        .is_none());
+}

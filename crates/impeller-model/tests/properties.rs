@@ -1,0 +1,130 @@
+//! Property tests: malformed parametric files never panic; random valid designs build blades
+//! with the designed thickness, the documented side order and N-fold symmetry.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use impeller_model::{from_toml_str, Side};
+use proptest::prelude::*;
+
+const SAMPLES: [&str; 5] = [
+    include_str!("../../../fixtures/impeller-8+8/impeller.toml"),
+    include_str!("../../../fixtures/impeller-5-freeform/impeller.toml"),
+    include_str!("../../../fixtures/impeller-11+11-freeform/impeller.toml"),
+    include_str!("../../../fixtures/impeller-30-narrow/impeller.toml"),
+    include_str!("../../../fixtures/impeller-plunge-400/impeller.toml"),
+];
+
+#[derive(Debug, Clone)]
+enum Mutation {
+    Truncate(usize),
+    Flip(usize, u8),
+    /// Replace the n-th number with a special value.
+    Number(usize, &'static str),
+}
+
+fn mutation() -> impl Strategy<Value = Mutation> {
+    prop_oneof![
+        any::<usize>().prop_map(Mutation::Truncate),
+        (any::<usize>(), any::<u8>()).prop_map(|(i, b)| Mutation::Flip(i, b)),
+        (
+            any::<usize>(),
+            prop::sample::select(vec!["nan", "-inf", "inf", "-1.0", "0", "1e300", "-0.0", "7"])
+        )
+            .prop_map(|(i, s)| Mutation::Number(i, s)),
+    ]
+}
+
+fn apply(text: &str, m: &Mutation) -> Vec<u8> {
+    let mut bytes = text.as_bytes().to_vec();
+    match *m {
+        Mutation::Truncate(i) => bytes.truncate(i % (bytes.len() + 1)),
+        Mutation::Flip(i, b) => {
+            let k = i % bytes.len();
+            bytes[k] ^= b.max(1);
+        }
+        Mutation::Number(i, s) => {
+            // Positions of numbers (a digit not preceded by a digit, letter, '.' or '_').
+            let starts: Vec<usize> = (0..bytes.len())
+                .filter(|&k| {
+                    bytes[k].is_ascii_digit()
+                        && (k == 0
+                            || !(bytes[k - 1].is_ascii_alphanumeric()
+                                || bytes[k - 1] == b'.'
+                                || bytes[k - 1] == b'_'
+                                || bytes[k - 1] == b'+'))
+                })
+                .collect();
+            if !starts.is_empty() {
+                let a = starts[i % starts.len()];
+                let mut e = a;
+                while e < bytes.len() && (bytes[e].is_ascii_digit() || bytes[e] == b'.') {
+                    e += 1;
+                }
+                bytes.splice(a..e, s.bytes());
+            }
+        }
+    }
+    bytes
+}
+
+proptest! {
+    #[test]
+    fn mutated_files_give_a_model_or_a_typed_error(k in 0usize..5, m in mutation()) {
+        let bytes = apply(SAMPLES[k], &m);
+        let text = String::from_utf8_lossy(&bytes);
+        if let Ok(imp) = from_toml_str(&text, "mutated.toml") {
+            // Whatever builds is a usable model.
+            prop_assert!(imp.main().count() >= 1);
+            let b = imp.main().blade();
+            let p = b.pressure().point(0.5, 0.5);
+            prop_assert!(p.iter().all(|c| c.is_finite()));
+        }
+    }
+
+    #[test]
+    fn random_ruled_designs_have_designed_thickness_and_order(
+        count in 3usize..24,
+        wrap_hub in 0.0f64..50.0,
+        wrap_shroud in 0.0f64..50.0,
+        t0 in 0.3f64..2.0,
+        t1 in 0.3f64..2.0,
+        rounded in any::<bool>(),
+        split in any::<bool>(),
+    ) {
+        let edge = if rounded { "rounded" } else { "blunt" };
+        let splitter = if split {
+            format!("[splitter]\ncount = {count}\nstart_fraction = 0.4\n")
+        } else {
+            String::new()
+        };
+        let text = format!(
+            "name = \"random\"\nfillet_radius_mm = 1.0\n\
+             [hub]\ntype = \"quarter_ellipse\"\ninlet_zr_mm = [60.0, 15.0]\noutlet_zr_mm = [8.0, 80.0]\n\
+             [shroud]\ntype = \"quarter_ellipse\"\ninlet_zr_mm = [60.0, 40.0]\noutlet_zr_mm = [20.0, 80.0]\n\
+             [main]\ncount = {count}\nkind = \"ruled\"\nthickness_mm = [[0.0, {t0}], [1.0, {t1}]]\n\
+             leading_edge = \"{edge}\"\ntrailing_edge = \"blunt\"\n\
+             [[main.wrap]]\nspan = 0.0\ntheta_deg = [[0.0, 0.0], [1.0, {wrap_hub}]]\n\
+             [[main.wrap]]\nspan = 1.0\ntheta_deg = [[0.0, 0.0], [1.0, {wrap_shroud}]]\n\
+             {splitter}[stock]\ndiameter_mm = 170.0\nheight_mm = 62.0\n"
+        );
+        let imp = from_toml_str(&text, "random.toml").unwrap();
+        let b = imp.main().blade();
+        let d = b.design().unwrap();
+        // Thickness at the interpolation sections of the hub and shroud rows.
+        for i in 1..=10 {
+            let u = i as f64 / 10.0;
+            for s in [0.0, 1.0] {
+                let t = b.normal_thickness(u, d.v_of_span(s)).unwrap();
+                let want = d.thickness.thickness(d.m_local(u));
+                prop_assert!((t - want).abs() < 1e-6, "u {u} s {s}: {t} vs {want}");
+            }
+        }
+        // The suction side faces +θ, toward the next blade.
+        prop_assert_eq!(b.plus_theta_side(), Side::Suction);
+        // N-fold symmetry: blade k is blade 0 turned by k pitches.
+        let k = count - 1;
+        let p0 = b.suction().point(0.3, 0.6);
+        let pk = imp.main().instance(k).suction().point(0.3, 0.6);
+        prop_assert!((imp.main().rotation(k) * p0 - pk).norm() < 1e-9);
+    }
+}
