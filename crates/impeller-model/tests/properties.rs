@@ -28,7 +28,9 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         (any::<usize>(), any::<u8>()).prop_map(|(i, b)| Mutation::Flip(i, b)),
         (
             any::<usize>(),
-            prop::sample::select(vec!["nan", "-inf", "inf", "-1.0", "0", "1e300", "-0.0", "7"])
+            prop::sample::select(vec![
+                "nan", "-inf", "inf", "-1.0", "0", "1e300", "-0.0", "7"
+            ])
         )
             .prop_map(|(i, s)| Mutation::Number(i, s)),
     ]

@@ -10,7 +10,9 @@
 //!   the leading and trailing edges) the side's isoparametric line is cut with hub and shroud
 //!   (v_h(u), v_s(u), found as in [`crate::channel::edge_v`]; the side's own v limits when it
 //!   does not reach a wall) and the point at v_h + s·(v_s − v_h) is taken. Each profile is a
-//!   closed loop: pressure side LE → TE, then suction side TE → LE, ending on its first point.
+//!   closed loop: pressure side LE → TE, then suction side TE → LE, ending on its first point;
+//!   the pressure side's TE point is written twice, which marks the trailing edge for the
+//!   importer (the loop's first point marks the leading edge).
 //!   Blades whose sides are of degree 1 across the span (ruled) get exactly two sections, hub
 //!   and shroud, so they are re-imported as ruled blades; a free-form blade is resampled, so
 //!   the re-imported
@@ -99,7 +101,10 @@ fn profile_text(imp: &Impeller, blade: &Blade, sampling: &CurveSampling) -> Stri
         let _ = writeln!(out, "# Profile {} at {:.4}%", k + 1, 100.0 * span);
         let p = side_section(imp, blade, Side::Pressure, span, sampling.n_chord);
         let s = side_section(imp, blade, Side::Suction, span, sampling.n_chord);
+        // The loop starts at the leading edge and writes the trailing edge point twice: the
+        // importer splits at these marks.
         let mut loop_pts = p.clone();
+        loop_pts.push(p[p.len() - 1]);
         loop_pts.extend(s.iter().rev());
         loop_pts.push(p[0]);
         for q in loop_pts {
