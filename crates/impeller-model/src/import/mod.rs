@@ -7,10 +7,10 @@
 //!    in millimetres with the rotation axis along +Z, in the file's axial sense. Every
 //!    malformed file is an [`ImportError`] naming the file, the line and what was expected
 //!    there (CRLF and LF files alike; non-finite numbers rejected).
-//! 2. **Prepare** ([`prepare`]): blade sides from loops (split at the leading and trailing
+//! 2. **Prepare** ([`mod@prepare`]): blade sides from loops (split at the leading and trailing
 //!    edges), camber lines (± half thickness) or given sides; flow direction, pressure /
 //!    suction labels, the workpiece frame, contours trimmed to the bladed part.
-//! 3. **Fit** ([`fit`]): meridional contours and blade sides as B-splines within a stated
+//! 3. **Fit** ([`mod@fit`]): meridional contours and blade sides as B-splines within a stated
 //!    tolerance (default [`DEFAULT_FIT_TOL_MM`] = 0.01 mm); sides skinned across the spans.
 //!    The deviation reached is reported per entity.
 //! 4. **Assemble** ([`build`]): hub and shroud revolved exactly, blades via
