@@ -12,7 +12,8 @@
 //!   does not reach a wall) and the point at v_h + s·(v_s − v_h) is taken. Each profile is a
 //!   closed loop: pressure side LE → TE, then suction side TE → LE, ending on its first point;
 //!   the pressure side's TE point is written twice, which marks the trailing edge for the
-//!   importer (the loop's first point marks the leading edge).
+//!   importer (the loop's first point marks the leading edge); where the sides end apart (a
+//!   blunt edge) the suction side's end point is written twice too, marking the edge face.
 //!   Blades whose sides are of degree 1 across the span (ruled) get exactly two sections, hub
 //!   and shroud, so they are re-imported as ruled blades; a free-form blade is resampled, so
 //!   the re-imported
@@ -102,11 +103,21 @@ fn profile_text(imp: &Impeller, blade: &Blade, sampling: &CurveSampling) -> Stri
         let p = side_section(imp, blade, Side::Pressure, span, sampling.n_chord);
         let s = side_section(imp, blade, Side::Suction, span, sampling.n_chord);
         // The loop starts at the leading edge and writes the trailing edge point twice: the
-        // importer splits at these marks.
+        // importer splits at these marks. At a blunt edge (sides ending apart) the suction
+        // side's corner is written twice as well, marking the edge face between them.
+        let apart = |a: &Vector3<f64>, b: &Vector3<f64>| (a - b).norm() > 1e-6;
+        let (p_le, p_te) = (p[0], p[p.len() - 1]);
+        let (s_le, s_te) = (s[0], s[s.len() - 1]);
         let mut loop_pts = p.clone();
-        loop_pts.push(p[p.len() - 1]);
+        loop_pts.push(p_te);
+        if apart(&s_te, &p_te) {
+            loop_pts.push(s_te);
+        }
         loop_pts.extend(s.iter().rev());
-        loop_pts.push(p[0]);
+        if apart(&s_le, &p_le) {
+            loop_pts.push(s_le);
+        }
+        loop_pts.push(p_le);
         for q in loop_pts {
             let _ = writeln!(out, "{:18.10} {:18.10} {:18.10}", q.x, q.y, q.z);
         }

@@ -200,7 +200,9 @@ pub fn from_cylindrical(r: f64, theta: f64, z: f64) -> Vector3<f64> {
 /// dropped. Where the file marks an edge — the loop's first point (BladeGen starts loops at
 /// the leading edge) or a point written twice in a row (our exporter repeats each edge
 /// point) — within 2 % of the meridional chord of an extreme, the split is moved to that
-/// mark, so the sides end where the writer put the edges. Both returned sides run from the
+/// mark, so the sides end where the writer put the edges; two adjacent marks at one edge are
+/// the corners of a blunt edge face, which then belongs to neither side. Both returned sides
+/// run from the
 /// first edge (lower loop index) to the other; callers orient and label them. At a blunt edge
 /// (one side leaves the extreme point across a flat edge face — under 25 % of the step along
 /// the meridional chord, then a turn of more than 60° — while the other runs along the blade,
@@ -275,6 +277,27 @@ pub fn split_loop(points: &[Vector3<f64>], eps: f64) -> Option<SidePair> {
         }
         k = if k == 0 { n - 1 } else { k - 1 };
     }
+    // Marked edge faces: two adjacent marked points at the same edge are the corners of a
+    // blunt edge face (our exporter writes both corners twice); the face belongs to neither
+    // side, so the side that would cross it starts or ends at its own corner.
+    let near = |k: usize, e: usize| (m[k].dot(&dir) - m[e].dot(&dir)).abs() <= 0.02 * chord;
+    let face_at = |k: usize, e: usize| marked[k] && marked[e] && near(k, e);
+    let (next, prev) = (|k: usize| (k + 1) % n, |k: usize| (k + n - 1) % n);
+    let mut handled = [false, false]; // [start, end]
+    if side_a.len() > 2 && face_at(next(bi), bi) {
+        side_a.remove(0);
+        handled[0] = true;
+    } else if side_b.len() > 2 && face_at(prev(bi), bi) {
+        side_b.remove(0);
+        handled[0] = true;
+    }
+    if side_a.len() > 2 && face_at(prev(bj), bj) {
+        side_a.pop();
+        handled[1] = true;
+    } else if side_b.len() > 2 && face_at(next(bj), bj) {
+        side_b.pop();
+        handled[1] = true;
+    }
     // Blunt edges: where one side leaves the edge point across a flat edge face (a step with
     // little progress along the chord, followed by a sharp turn of more than 60° into the
     // side) while the other runs along the blade, the face is not part of that side: it
@@ -299,7 +322,10 @@ pub fn split_loop(points: &[Vector3<f64>], eps: f64) -> Option<SidePair> {
             1.0
         }
     };
-    for at_start in [true, false] {
+    for (at_start, done) in [(true, handled[0]), (false, handled[1])] {
+        if done {
+            continue;
+        }
         // (first-step progress, turn cosine at the second point) of a side's end.
         let ends = |s: &[Vector3<f64>]| -> (f64, f64) {
             if s.len() < 3 {
@@ -404,6 +430,31 @@ mod tests {
         assert_eq!(b.len(), 9);
         assert!((a[0].z).abs() < 1e-12 && (b[0].z).abs() < 1e-12);
         assert!((a[8].z - 4.0).abs() < 1e-12 && (b[8].z - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn marked_blunt_face_belongs_to_neither_side() {
+        // Pressure side at θ = +0.01, suction at −0.01 (r = 10), LE shared, blunt TE whose
+        // corners are both written twice (the exporter's convention).
+        let side = |sign: f64| -> Vec<Vector3<f64>> {
+            (0..=8)
+                .map(|k| from_cylindrical(10.0, sign * 0.01, 0.5 * k as f64))
+                .collect()
+        };
+        let (p, s) = (side(1.0), side(-1.0));
+        let mut pts = vec![p[0]];
+        pts.extend(&p[1..]);
+        pts.push(p[8]);
+        pts.push(s[8]);
+        pts.extend(s[1..].iter().rev());
+        pts.push(p[0]);
+        let (a, b) = split_loop(&pts, 1e-12).unwrap();
+        assert_eq!((a.len(), b.len()), (9, 9));
+        assert!((a[8] - p[8]).norm() < 1e-12 || (a[8] - s[8]).norm() < 1e-12);
+        assert!(
+            (a[8] - b[8]).norm() > 0.1,
+            "each side ends at its own corner"
+        );
     }
 
     #[test]
