@@ -32,6 +32,7 @@ use super::raw::{positive, BladeRole};
 use nalgebra::{DMatrix, Vector2, Vector3};
 use nurbs::fit::{approximate_curve_to_tolerance, averaged_knots, Parametrisation};
 use nurbs::{Curve2, KnotVector, NurbsCurve, NurbsSurface};
+use rayon::prelude::*;
 use std::path::PathBuf;
 
 /// Default fit tolerance, mm.
@@ -395,31 +396,46 @@ pub fn fit(
     let (hub, hub_fit_mm) = fit_contour(&prepared.hub, tol_mm).map_err(|e| err("hub".into(), e))?;
     let (shroud, shroud_fit_mm) =
         fit_contour(&prepared.shroud, tol_mm).map_err(|e| err("shroud".into(), e))?;
-    let mut blades = Vec::with_capacity(prepared.blades.len());
-    for b in &prepared.blades {
-        let side =
-            |name: &str, pick: &dyn Fn(&super::prepare::SectionSides) -> Vec<Vector3<f64>>| {
-                let secs: Vec<Vec<Vector3<f64>>> = b.sections.iter().map(pick).collect();
-                let entity = || format!("blade {:?} {name} side", b.name);
-                let (kv, mut ctrls, e) =
-                    fit_compatible(&secs, tol_mm).map_err(|r| err(entity(), r))?;
-                extend_sections(&mut ctrls, span_extension);
-                let surf = skin(&kv, &ctrls).map_err(|r| err(entity(), r))?;
-                Ok::<_, ImportError>((surf, e))
-            };
-        let (pressure, pressure_fit_mm) = side("pressure", &|s| s.pressure.clone())?;
-        let (suction, suction_fit_mm) = side("suction", &|s| s.suction.clone())?;
-        blades.push(FittedBlade {
-            name: b.name.clone(),
-            role: b.role,
-            count: b.count,
-            sections: b.sections.len(),
-            pressure,
-            suction,
-            pressure_fit_mm,
-            suction_fit_mm,
-        });
-    }
+    // Every side of every blade is fitted independently (rayon).
+    let fit_side = |b: &super::prepare::PreparedBlade, pressure: bool| {
+        let secs: Vec<Vec<Vector3<f64>>> = b
+            .sections
+            .iter()
+            .map(|s| {
+                if pressure {
+                    s.pressure.clone()
+                } else {
+                    s.suction.clone()
+                }
+            })
+            .collect();
+        let entity = || {
+            let name = if pressure { "pressure" } else { "suction" };
+            format!("blade {:?} {name} side", b.name)
+        };
+        let (kv, mut ctrls, e) = fit_compatible(&secs, tol_mm).map_err(|r| err(entity(), r))?;
+        extend_sections(&mut ctrls, span_extension);
+        let surf = skin(&kv, &ctrls).map_err(|r| err(entity(), r))?;
+        Ok::<_, ImportError>((surf, e))
+    };
+    let blades = prepared
+        .blades
+        .par_iter()
+        .map(|b| {
+            let (p, s) = rayon::join(|| fit_side(b, true), || fit_side(b, false));
+            let ((pressure, pressure_fit_mm), (suction, suction_fit_mm)) = (p?, s?);
+            Ok(FittedBlade {
+                name: b.name.clone(),
+                role: b.role,
+                count: b.count,
+                sections: b.sections.len(),
+                pressure,
+                suction,
+                pressure_fit_mm,
+                suction_fit_mm,
+            })
+        })
+        .collect::<Result<Vec<_>, ImportError>>()?;
     Ok(FittedImpeller {
         source: prepared.source.clone(),
         hub,
