@@ -123,3 +123,39 @@ fn parametric_default_round_trip() {
     assert!(dev <= opts.fit_tol_mm, "{dev}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Every parametric fixture through curve files and back: the import path is exercised on
+/// every fixture, within the fit tolerance of the design.
+#[test]
+fn every_parametric_fixture_round_trips() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+    let opts = ImportOptions::default();
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&root).unwrap() {
+        let toml = entry.unwrap().path().join("impeller.toml");
+        let Ok(text) = std::fs::read_to_string(&toml) else {
+            continue;
+        };
+        if impeller_model::import::is_import_toml(&text) {
+            continue; // imported fixtures are covered above
+        }
+        let design = impeller_model::load(&toml).unwrap();
+        let tag = toml
+            .parent()
+            .unwrap()
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        let dir = tmp_dir(&tag);
+        let files = write_curves(&design, &dir, "export", &CurveSampling::default()).unwrap();
+        let back = import_file(&files.inf, &opts).unwrap();
+        let dev = deviation(&design, &back.impeller);
+        eprintln!("{tag}: design → curves → import {dev:.2e} mm");
+        assert_eq!(back.impeller.main().count(), design.main().count(), "{tag}");
+        assert!(dev <= opts.fit_tol_mm, "{tag}: {dev}");
+        let _ = std::fs::remove_dir_all(&dir);
+        seen += 1;
+    }
+    assert!(seen >= 1);
+}

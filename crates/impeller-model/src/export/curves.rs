@@ -48,7 +48,7 @@ impl Default for CurveSampling {
         Self {
             n_contour: 201,
             n_chord: 151,
-            n_spans: 11,
+            n_spans: 21,
         }
     }
 }
