@@ -149,7 +149,7 @@ proptest! {
 
     /// Curves: optimality and dense-sample bound.
     #[test]
-    fn curve_closest_point_is_global(seed in 0u64..10_000, x in -10.0f64..60.0, y in -30.0f64..30.0) {
+    fn curve_closest_point_is_global(seed in 0u64..10_000, x in -60.0f64..110.0, y in -80.0f64..80.0) {
         let pts: Vec<Vector2<f64>> = (0..9)
             .map(|k| Vector2::new(6.0 * k as f64, 15.0 * ((seed as f64) * 0.3 + k as f64 * 1.7).sin()))
             .collect();
@@ -301,4 +301,41 @@ fn crease_surface_global_minimum() {
         a.u
     );
     assert!((a.distance - 8.0).abs() <= 1e-9);
+}
+
+#[test]
+fn closest_point_on_a_sphere_with_poles() {
+    // Half circle in the xz-plane revolved about z: a sphere of radius 15 with poles.
+    let profile = NurbsCurve::<3>::circle_arc(
+        Vector3::zeros(),
+        Vector3::x(),
+        Vector3::z(),
+        15.0,
+        -std::f64::consts::FRAC_PI_2,
+        std::f64::consts::FRAC_PI_2,
+    )
+    .unwrap();
+    let s = NurbsSurface::revolution(
+        &profile,
+        Vector3::zeros(),
+        Vector3::z(),
+        std::f64::consts::TAU,
+    )
+    .unwrap();
+    let p = SurfaceProjector::new(&s);
+    for q in [
+        Vector3::new(3.0, 4.0, 30.0),
+        Vector3::new(0.0, 0.0, 40.0),
+        Vector3::new(0.0, 0.0, -2.0),
+        Vector3::new(-20.0, 5.0, 1.0),
+        Vector3::new(1.0, -2.0, 3.0),
+    ] {
+        let a = p.closest_point(&q);
+        assert!(
+            (a.distance - (q.norm() - 15.0).abs()).abs() <= 1e-9,
+            "{q:?}: {}",
+            a.distance
+        );
+        assert!(a.distance <= dense_min(&s, &q, 101) + 1e-12);
+    }
 }

@@ -208,8 +208,9 @@ pub fn smooth_curve<const D: usize>(
 /// `max_k |C(ū_k) − Q_k|` is at most `tol` (§9.4.1 with the control-point count searched).
 ///
 /// The count is found by doubling from `degree + 1` and then bisection, assuming the error
-/// decreases with the count (true in practice for dense data; the result always satisfies
-/// the tolerance because `points.len()` control points interpolate). O(log m) fits.
+/// decreases with the count (true in practice for dense data). `points.len()` control points
+/// interpolate, so the tolerance is always met unless it lies below the interpolant's
+/// round-off (~1e-12 relative), in which case the interpolant is returned. O(log m) fits.
 ///
 /// Errors: `tol` not finite and positive, plus those of [`approximate_curve`].
 pub fn approximate_curve_to_tolerance<const D: usize>(

@@ -88,7 +88,7 @@ pub(crate) fn interpolate_families<const W: usize>(
 }
 
 /// Global interpolation of a `(n+1) × (m+1)` grid `points[k][l]` (`k` along u, `l` along v)
-/// by a non-rational B-spline surface of degrees `(degree_u, degree_v)` on [0,1]²
+/// by a non-rational B-spline surface of degrees `(degree_u, degree_v)` on `[0, 1]²`
 /// (NURBS Book A9.4): parameters averaged over rows/columns (eqs. 9.15–9.16), knots by
 /// averaging (eq. 9.8), then curve interpolation along u for every l followed by curve
 /// interpolation along v of the resulting control points. Each direction factors its matrix
