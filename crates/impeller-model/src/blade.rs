@@ -45,6 +45,16 @@ impl Side {
     }
 }
 
+/// The leading or the trailing edge of a blade.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BladeEdge {
+    /// u = start of the side domains.
+    Leading,
+    /// u = end of the side domains.
+    Trailing,
+}
+
 /// Design data kept by the parametric builder (absent for imported blades).
 #[derive(Debug, Clone)]
 pub struct BladeDesign {
@@ -213,6 +223,58 @@ impl Blade {
         self.side(side)
             .normal(u, v)
             .map(|n| n * self.outward_sign(side))
+    }
+
+    /// The flat face closing a blunt edge: the ruled surface between the pressure and suction
+    /// isocurves at that edge, exact via `NurbsSurface::ruled`: its u runs along the edge (the
+    /// sides' v mapped to [0, 1], hub to shroud), its v from the pressure (0) to the suction
+    /// side (1).
+    /// `None` for a rounded (closed) edge, where both isocurves coincide within 1e-9 mm.
+    pub fn edge_face(&self, edge: BladeEdge) -> Result<Option<NurbsSurface>, ModelError> {
+        let at = |s: &NurbsSurface| {
+            let ((u0, u1), _) = s.domain();
+            match edge {
+                BladeEdge::Leading => u0,
+                BladeEdge::Trailing => u1,
+            }
+        };
+        let cp = self.pressure.iso_curve_at_u(at(&self.pressure))?;
+        let cs = self.suction.iso_curve_at_u(at(&self.suction))?;
+        let (a, b) = cp.domain();
+        let (c, d) = cs.domain();
+        let gap = (0..=16)
+            .map(|k| {
+                let t = k as f64 / 16.0;
+                (cp.point(a + (b - a) * t) - cs.point(c + (d - c) * t)).norm()
+            })
+            .fold(0.0, f64::max);
+        if gap < 1e-9 {
+            return Ok(None);
+        }
+        Ok(Some(NurbsSurface::ruled(&cp, &cs)?))
+    }
+
+    /// A point inside the blade near its middle: the camber point at mid-parameters, or the
+    /// midpoint of the two sides there.
+    pub fn mid_point(&self) -> Vector3<f64> {
+        if let Some(c) = &self.camber {
+            let (u, v) = mid(c);
+            return c.point(u, v);
+        }
+        let (up, vp) = mid(&self.pressure);
+        let (us, vs) = mid(&self.suction);
+        0.5 * (self.pressure.point(up, vp) + self.suction.point(us, vs))
+    }
+
+    /// The isoparametric curve u = const of `side` (a blade section line from hub to shroud;
+    /// a straight ruling on ruled blades).
+    pub fn iso_u(&self, side: Side, u: f64) -> Result<nurbs::NurbsCurve<3>, ModelError> {
+        Ok(self.side(side).iso_curve_at_u(u)?)
+    }
+
+    /// The isoparametric curve v = const of `side` (a flow line from leading to trailing edge).
+    pub fn iso_v(&self, side: Side, v: f64) -> Result<nurbs::NurbsCurve<3>, ModelError> {
+        Ok(self.side(side).iso_curve_at_v(v)?)
     }
 
     /// The global closest-point structure of `side` (nurbs' `SurfaceProjector`: Bézier

@@ -23,7 +23,8 @@ impl Impeller {
     ///
     /// Checks: non-empty name; fillet radius finite and ≥ 0; the shroud contour lies on the
     /// channel side of the hub contour (sampled at 33 meridional fractions, gap > 0); a splitter
-    /// row has as many blades as the main row.
+    /// row has as many blades as the main row. A splitter row is renumbered (its reference
+    /// blade turned by whole pitches) so that splitter k lies between main blades k and k+1.
     pub fn from_parts(
         name: impl Into<String>,
         hub: RevolvedSurface,
@@ -50,15 +51,28 @@ impl Impeller {
                 )));
             }
         }
-        if let Some(s) = &splitter {
-            if s.count() != main.count() {
-                return Err(ModelError::Geometry(format!(
-                    "splitter count {} differs from main blade count {}",
-                    s.count(),
-                    main.count()
-                )));
+        let splitter = match splitter {
+            Some(s) => {
+                if s.count() != main.count() {
+                    return Err(ModelError::Geometry(format!(
+                        "splitter count {} differs from main blade count {}",
+                        s.count(),
+                        main.count()
+                    )));
+                }
+                let angle = |p: nalgebra::Vector3<f64>| p.y.atan2(p.x);
+                let pitch = main.pitch_rad();
+                let offset = (angle(s.blade().mid_point()) - angle(main.blade().mid_point()))
+                    .rem_euclid(std::f64::consts::TAU);
+                let k = (offset / pitch).floor();
+                if k >= 1.0 {
+                    Some(BladeSet::new(s.count(), s.blade().rotated(-k * pitch))?)
+                } else {
+                    Some(s)
+                }
             }
-        }
+            None => None,
+        };
         Ok(Self {
             name,
             hub,

@@ -11,6 +11,18 @@
 //! [`Impeller::from_parts`] and [`Blade::from_sides`] (for importers),
 //! [`fixtures::default_impeller`].
 //!
+//! Modules by idea: [`params`] (the TOML schema and its validation), [`builder`] (parameters →
+//! NURBS), [`law`] and [`thickness`] (design laws), [`meridional`] and [`revolved`] (hub and
+//! shroud), [`blade`] (sides, camber, rows), [`impeller`], [`stock`], [`channel`] (edges on
+//! hub/shroud, channels, widths), [`query`] (closest points, signed distances), [`summary`],
+//! [`ruled`] (ruled and sub-ruled approximation), [`fit`] (interpolation of sampled design).
+//!
+//! Conventions: the hub's channel-side normal points into the channel, the shroud's out of
+//! it; each blade side has an outward normal ([`Blade::outward_normal`]); blade k+1 of a row
+//! is blade k turned by +2π/N about +Z, and channel k lies between main blades k and k+1. In
+//! parametric impellers the suction side faces +θ, the pressure side −θ (the impeller turns
+//! toward −θ; positive wrap angles sweep blades backward).
+//!
 //! Dependencies: `nurbs` (the project's kernel), `nalgebra` (small vectors, dense LU for
 //! interpolation), `serde` + `toml` (the parametric file), `thiserror`, `rayon` (blades are
 //! independent).
@@ -34,7 +46,7 @@ pub mod stock;
 pub mod summary;
 pub mod thickness;
 
-pub use blade::{Blade, BladeDesign, BladeKind, BladeSet, Side};
+pub use blade::{Blade, BladeDesign, BladeEdge, BladeKind, BladeSet, Side};
 pub use error::ModelError;
 pub use impeller::Impeller;
 pub use meridional::MeridionalCurve;

@@ -5,12 +5,14 @@
 //! normalised arc length; the table from curve parameter to arc length is built once with
 //! 5-point Gauss–Legendre quadrature on 256 parameter intervals (relative error far below
 //! 1e-12 for the smooth contours used here) and inverted by bisection plus Newton steps
-//! (|dm/dt| = |C'(t)| / L). The *channel-side normal* N = (t_r, −t_z)/|t| of the unit tangent
+//! (|dm/dt| = |C'(t)| / L). Closest points use the `nurbs` crate's global `CurveProjector`,
+//! built once per contour. The *channel-side normal* N = (t_r, −t_z)/|t| of the unit tangent
 //! (t_z, t_r) points to +r at an axial inlet and to +z at a radial outlet: from the hub into
 //! the channel, and from the shroud out of it.
 
 use crate::error::ModelError;
 use nalgebra::{Vector2, Vector3};
+use nurbs::closest::CurveProjector;
 use nurbs::NurbsCurve;
 
 const GL5_X: [f64; 5] = [
@@ -33,6 +35,8 @@ const ARC_INTERVALS: usize = 256;
 #[derive(Debug, Clone)]
 pub struct MeridionalCurve {
     curve: NurbsCurve<2>,
+    /// Global closest-point structure of the contour.
+    projector: CurveProjector<2>,
     /// Parameter breakpoints and cumulative arc length at each.
     t_tab: Vec<f64>,
     s_tab: Vec<f64>,
@@ -69,6 +73,7 @@ impl MeridionalCurve {
             ));
         }
         Ok(Self {
+            projector: CurveProjector::new(&curve),
             curve,
             t_tab,
             s_tab,
@@ -175,56 +180,16 @@ impl MeridionalCurve {
     }
 
     /// Closest point of the contour to `zr`: (parameter, signed distance along the
-    /// channel-side normal). Global: 64 seeds, then safeguarded Newton on
-    /// (C(t) − q)·C'(t) = 0 (NURBS Book §6.1), end points included.
+    /// channel-side normal). Global, by the `nurbs` crate's `CurveProjector` (Bézier pieces in
+    /// a bounding tree, Newton per candidate piece, end points included).
     pub fn closest(&self, zr: Vector2<f64>) -> (f64, f64) {
-        let (a, b) = self.domain();
-        let n = 64;
-        let mut best = (a, f64::INFINITY);
-        for k in 0..=n {
-            let t = a + (b - a) * k as f64 / n as f64;
-            let d = (self.point(t) - zr).norm_squared();
-            if d < best.1 {
-                best = (t, d);
-            }
-        }
-        let h = (b - a) / n as f64;
-        let (mut lo, mut hi) = ((best.0 - h).max(a), (best.0 + h).min(b));
-        let mut t = best.0;
-        for _ in 0..50 {
-            let d = self.curve.derivs(t, 2);
-            let r = d[0] - zr;
-            let f = r.dot(&d[1]);
-            let fp = d[1].norm_squared() + r.dot(&d[2]);
-            if f > 0.0 {
-                hi = t;
-            } else {
-                lo = t;
-            }
-            let tn = if fp > 0.0 {
-                t - f / fp
-            } else {
-                0.5 * (lo + hi)
-            };
-            let tn = if tn >= lo && tn <= hi {
-                tn
-            } else {
-                0.5 * (lo + hi)
-            };
-            if (tn - t).abs() < 1e-15 * (b - a).max(1.0) {
-                t = tn;
-                break;
-            }
-            t = tn;
-        }
-        let p = self.point(t);
-        let dist = (zr - p).norm();
-        let sign = if (zr - p).dot(&self.normal(t)) >= 0.0 {
+        let cp = self.projector.closest_point(&zr);
+        let sign = if (zr - cp.point).dot(&self.normal(cp.u)) >= 0.0 {
             1.0
         } else {
             -1.0
         };
-        (t, sign * dist)
+        (cp.u, sign * cp.distance)
     }
 
     /// (z, r) of a 3-D point.

@@ -104,6 +104,17 @@ impl RevolvedSurface {
         (q + 0.5 * (lo + hi)) * 0.25
     }
 
+    /// The meridian at polar angle φ: the isocurve v(φ) of the surface, an exact NURBS copy of
+    /// the contour turned into the plane of φ.
+    pub fn meridian(&self, phi: f64) -> Result<nurbs::NurbsCurve<3>, ModelError> {
+        Ok(self.surface.iso_curve_at_v(Self::v_of_angle(phi))?)
+    }
+
+    /// The parallel circle at contour parameter t: the isocurve u = t (exact rational circle).
+    pub fn parallel(&self, t: f64) -> Result<nurbs::NurbsCurve<3>, ModelError> {
+        Ok(self.surface.iso_curve_at_u(t)?)
+    }
+
     /// Point at contour parameter t and polar angle φ (closed form).
     pub fn point(&self, t: f64, phi: f64) -> Vector3<f64> {
         let zr = self.meridional.point(t);

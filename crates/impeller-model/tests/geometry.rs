@@ -36,6 +36,74 @@ fn hub_and_shroud_radii_equal_their_meridional_curves() {
     }
 }
 
+#[test]
+fn isoparametric_curves_lie_on_their_surfaces() {
+    let imp = fixtures::default_impeller().unwrap();
+    let m = imp.hub().meridian(0.7).unwrap();
+    let c = imp.hub().parallel(0.3).unwrap();
+    let r = imp.hub().meridional().point(0.3)[1];
+    for k in 0..=10 {
+        let t = k as f64 / 10.0;
+        let p = m.point(t);
+        assert!((p.y.atan2(p.x) - 0.7).abs() < 1e-12);
+        assert!((p - imp.hub().point(t, 0.7)).norm() < 1e-9);
+        let (a, b) = c.domain();
+        let q = c.point(a + (b - a) * t);
+        assert!(((q.x * q.x + q.y * q.y).sqrt() - r).abs() < 1e-9);
+    }
+    let b = imp.main().blade();
+    let ruling = b.iso_u(Side::Suction, 0.4).unwrap();
+    let flow = b.iso_v(Side::Pressure, 0.5).unwrap();
+    for k in 0..=10 {
+        let t = k as f64 / 10.0;
+        assert!((ruling.point(t) - b.suction().point(0.4, t)).norm() < 1e-9);
+        assert!((flow.point(t) - b.pressure().point(t, 0.5)).norm() < 1e-9);
+    }
+    // Rulings of a ruled blade are straight: the midpoint is the mean of the ends.
+    let mid = ruling.point(0.5);
+    assert!((mid - 0.5 * (ruling.point(0.0) + ruling.point(1.0))).norm() < 1e-9);
+}
+
+#[test]
+fn blunt_edges_have_faces_and_rounded_edges_are_closed() {
+    use impeller_model::BladeEdge;
+    let imp = fixtures::default_impeller().unwrap();
+    let b = imp.main().blade();
+    assert!(b.edge_face(BladeEdge::Leading).unwrap().is_none());
+    let face = b.edge_face(BladeEdge::Trailing).unwrap().unwrap();
+    let ((_, pu1), _) = b.pressure().domain();
+    // The face joins the two sides' trailing isocurves; its width is the 0.8 mm blade.
+    let d = b.design().unwrap();
+    let v = d.v_of_span(0.0);
+    let p = b.pressure().point(pu1, v);
+    let s = b.suction().point(pu1, v);
+    // Face u runs along the edge (the sides' v, here on [0, 1]); face v from pressure to suction.
+    assert!((face.point(v, 0.0) - p).norm() < 1e-9);
+    assert!((face.point(v, 1.0) - s).norm() < 1e-9);
+    assert!(((p - s).norm() - 0.8).abs() < 1e-6);
+}
+
+#[test]
+fn splitters_are_numbered_between_their_main_blades() {
+    use impeller_model::BladeSet;
+    let imp = fixtures::default_impeller().unwrap();
+    let split = imp.splitter().unwrap();
+    // Hand the importer's constructor a splitter row referenced one pitch too far on.
+    let shifted = BladeSet::new(8, split.instance(3)).unwrap();
+    let again = Impeller::from_parts(
+        "x",
+        imp.hub().clone(),
+        imp.shroud().clone(),
+        imp.main().clone(),
+        Some(shifted),
+        1.0,
+        imp.stock().clone(),
+    )
+    .unwrap();
+    let p = again.splitter().unwrap().blade().suction().point(0.5, 0.5);
+    assert!((p - split.blade().suction().point(0.5, 0.5)).norm() < 1e-9);
+}
+
 /// Normal thickness along the camber normal against the designed distribution, on the hub
 /// and shroud rows of ruled blades (where the ruled sides are offset exactly).
 #[test]

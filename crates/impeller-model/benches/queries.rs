@@ -1,0 +1,56 @@
+//! Point queries on the default impeller: blade-side signed distance (global, cached
+//! projector), hub signed distance, local closest point with a hint, and building the model.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use impeller_model::query::{blade_side_distance, closest_point};
+use impeller_model::{fixtures, Side};
+use nalgebra::Vector3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::hint::black_box;
+
+fn queries(c: &mut Criterion) {
+    let imp = fixtures::default_impeller().unwrap();
+    let blade = imp.main().blade();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    // Points within 3 mm of the blade's suction side.
+    let pts: Vec<(Vector3<f64>, (f64, f64))> = (0..256)
+        .map(|_| {
+            let (u, v) = (rng.random::<f64>(), rng.random::<f64>());
+            let n = blade.outward_normal(Side::Suction, u, v).unwrap();
+            let p = blade.suction().point(u, v) + n * (rng.random::<f64>() * 6.0 - 3.0);
+            (p, (u, v))
+        })
+        .collect();
+    blade.projector(Side::Suction);
+    let mut i = 0;
+    c.bench_function("blade_side_signed_distance_global", |b| {
+        b.iter(|| {
+            i = (i + 1) % pts.len();
+            black_box(blade_side_distance(blade, Side::Suction, &pts[i].0, None))
+        })
+    });
+    c.bench_function("blade_side_closest_point_local_hint", |b| {
+        b.iter(|| {
+            i = (i + 1) % pts.len();
+            black_box(closest_point(blade.suction(), &pts[i].0, Some(pts[i].1)))
+        })
+    });
+    c.bench_function("hub_signed_distance", |b| {
+        b.iter(|| {
+            i = (i + 1) % pts.len();
+            black_box(imp.hub().signed_distance(&pts[i].0))
+        })
+    });
+    let mut g = c.benchmark_group("model");
+    g.sample_size(10);
+    g.bench_function("build_default_impeller", |b| {
+        b.iter(|| black_box(fixtures::default_impeller().unwrap()))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, queries);
+criterion_main!(benches);
