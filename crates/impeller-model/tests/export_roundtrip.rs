@@ -81,8 +81,8 @@ fn centrifugal_round_trip() {
     let (a, b, dev) = round_trip(&import_common::centrifugal_geomturbo(), "cc", &opts);
     let (sa, sb) = (a.impeller.summary(), b.impeller.summary());
     assert_eq!(
-        (sa.main_blade_count, sa.splitter_blade_count),
-        (sb.main_blade_count, sb.splitter_blade_count)
+        (sa.main_blade_count, sa.splitter_blade_count, sa.blade_kind),
+        (sb.main_blade_count, sb.splitter_blade_count, sb.blade_kind)
     );
     assert!(dev <= opts.fit_tol_mm, "{dev}");
 }
@@ -99,4 +99,63 @@ fn rotor37_round_trip() {
     let opts = ImportOptions::default();
     let (_, _, dev) = round_trip(&import_common::rotor37_inf(), "r37", &opts);
     assert!(dev <= opts.fit_tol_mm, "{dev}");
+}
+
+/// The parametric default impeller (fixture impeller-8+8, blunt trailing edges) through
+/// curve files: its import A lies within the fit tolerance of the design, and A → export →
+/// import B reproduces A within the fit tolerance.
+#[test]
+fn parametric_default_round_trip() {
+    let design = impeller_model::fixtures::default_impeller().unwrap();
+    let opts = ImportOptions::default();
+    let dir = tmp_dir("param");
+    let files = write_curves(&design, &dir, "export", &CurveSampling::default()).unwrap();
+    let a = import_file(&files.inf, &opts).unwrap();
+    let dev_design = deviation(&design, &a.impeller);
+    let _ = std::fs::remove_dir_all(&dir);
+    let files = write_curves(&a.impeller, &dir, "export", &CurveSampling::default()).unwrap();
+    let b = import_file(&files.inf, &opts).unwrap();
+    let dev = deviation(&a.impeller, &b.impeller);
+    eprintln!("impeller-8+8: design → A {dev_design:.2e} mm, A → B {dev:.2e} mm");
+    assert_eq!(a.impeller.main().count(), design.main().count());
+    assert_eq!(b.impeller.splitter().map(|s| s.count()), Some(8));
+    assert!(dev_design <= opts.fit_tol_mm, "{dev_design}");
+    assert!(dev <= opts.fit_tol_mm, "{dev}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every parametric fixture through curve files and back: the import path is exercised on
+/// every fixture, within the fit tolerance of the design.
+#[test]
+fn every_parametric_fixture_round_trips() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures");
+    let opts = ImportOptions::default();
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&root).unwrap() {
+        let toml = entry.unwrap().path().join("impeller.toml");
+        let Ok(text) = std::fs::read_to_string(&toml) else {
+            continue;
+        };
+        if impeller_model::import::is_import_toml(&text) {
+            continue; // imported fixtures are covered above
+        }
+        let design = impeller_model::load(&toml).unwrap();
+        let tag = toml
+            .parent()
+            .unwrap()
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        let dir = tmp_dir(&tag);
+        let files = write_curves(&design, &dir, "export", &CurveSampling::default()).unwrap();
+        let back = import_file(&files.inf, &opts).unwrap();
+        let dev = deviation(&design, &back.impeller);
+        eprintln!("{tag}: design → curves → import {dev:.2e} mm");
+        assert_eq!(back.impeller.main().count(), design.main().count(), "{tag}");
+        assert!(dev <= opts.fit_tol_mm, "{tag}: {dev}");
+        let _ = std::fs::remove_dir_all(&dir);
+        seen += 1;
+    }
+    assert!(seen >= 1);
 }

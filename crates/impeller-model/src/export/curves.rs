@@ -10,8 +10,13 @@
 //!   the leading and trailing edges) the side's isoparametric line is cut with hub and shroud
 //!   (v_h(u), v_s(u), found as in [`crate::channel::edge_v`]; the side's own v limits when it
 //!   does not reach a wall) and the point at v_h + s·(v_s − v_h) is taken. Each profile is a
-//!   closed loop: pressure side LE → TE, then suction side TE → LE, ending on its first point.
-//!   A ruled blade's sections are exact; a free-form blade is resampled, so the re-imported
+//!   closed loop: pressure side LE → TE, then suction side TE → LE, ending on its first point;
+//!   the pressure side's TE point is written twice, which marks the trailing edge for the
+//!   importer (the loop's first point marks the leading edge); where the sides end apart (a
+//!   blunt edge) the suction side's end point is written twice too, marking the edge face.
+//!   Blades whose sides are of degree 1 across the span (ruled) get exactly two sections, hub
+//!   and shroud, so they are re-imported as ruled blades; a free-form blade is resampled, so
+//!   the re-imported
 //!   surface differs from it by the interpolation error between sections (measured in the
 //!   round-trip test).
 //!
@@ -43,7 +48,7 @@ impl Default for CurveSampling {
         Self {
             n_contour: 201,
             n_chord: 151,
-            n_spans: 11,
+            n_spans: 21,
         }
     }
 }
@@ -89,14 +94,30 @@ fn side_section(
 
 fn profile_text(imp: &Impeller, blade: &Blade, sampling: &CurveSampling) -> String {
     let mut out = String::new();
-    for k in 0..sampling.n_spans {
-        let span = k as f64 / (sampling.n_spans - 1) as f64;
+    // Sides of degree 1 across the span are ruled: hub and shroud sections are exact.
+    let ruled = blade.pressure().degree_v() == 1 && blade.suction().degree_v() == 1;
+    let n_spans = if ruled { 2 } else { sampling.n_spans };
+    for k in 0..n_spans {
+        let span = k as f64 / (n_spans - 1) as f64;
         let _ = writeln!(out, "# Profile {} at {:.4}%", k + 1, 100.0 * span);
         let p = side_section(imp, blade, Side::Pressure, span, sampling.n_chord);
         let s = side_section(imp, blade, Side::Suction, span, sampling.n_chord);
+        // The loop starts at the leading edge and writes the trailing edge point twice: the
+        // importer splits at these marks. At a blunt edge (sides ending apart) the suction
+        // side's corner is written twice as well, marking the edge face between them.
+        let apart = |a: &Vector3<f64>, b: &Vector3<f64>| (a - b).norm() > 1e-6;
+        let (p_le, p_te) = (p[0], p[p.len() - 1]);
+        let (s_le, s_te) = (s[0], s[s.len() - 1]);
         let mut loop_pts = p.clone();
+        loop_pts.push(p_te);
+        if apart(&s_te, &p_te) {
+            loop_pts.push(s_te);
+        }
         loop_pts.extend(s.iter().rev());
-        loop_pts.push(p[0]);
+        if apart(&s_le, &p_le) {
+            loop_pts.push(s_le);
+        }
+        loop_pts.push(p_le);
         for q in loop_pts {
             let _ = writeln!(out, "{:18.10} {:18.10} {:18.10}", q.x, q.y, q.z);
         }

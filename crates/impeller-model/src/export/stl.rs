@@ -212,8 +212,11 @@ pub fn mesh_parts(imp: &Impeller, parts: &[Part], chord_tol: f64) -> Result<TriM
             continue;
         };
         let b = row.blade();
-        let p = tessellate(b.pressure(), chord_tol, &format!("{name} pressure side"))?;
-        let s = tessellate(b.suction(), chord_tol, &format!("{name} suction side"))?;
+        let (p, s) = rayon::join(
+            || tessellate(b.pressure(), chord_tol, &format!("{name} pressure side")),
+            || tessellate(b.suction(), chord_tol, &format!("{name} suction side")),
+        );
+        let (p, s) = (p?, s?);
         for k in 0..row.count() {
             let rot = row.rotation(k);
             mesh.append_mapped(&p, |q| rot * q);

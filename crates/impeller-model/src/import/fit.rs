@@ -5,7 +5,10 @@
 //!   with fixed end points and the fewest control points whose deviation at the data
 //!   parameters is within `tol` (`nurbs::fit::approximate_curve_to_tolerance`, NURBS Book
 //!   §9.4.1, chord-length parameters).
-//! - **Blade sides**: all sections of one side are fitted *compatibly* — one clamped cubic
+//! - **Blade sides**: all sections of one side are fitted *compatibly* — chord-length
+//!   parameters per section, or, when all sections have the same number of points, their
+//!   average (points of equal index then lie on one iso-parametric line across the span, as
+//!   AutoGrid's ruled sides intend) — one clamped cubic
 //!   knot vector shared by every section, knots at quantiles of the merged chord-length
 //!   parameters of all sections (the idea of eq. 9.69: every span holds data), least squares
 //!   with fixed leading- and trailing-edge points (§9.4.1, eqs. 9.63–9.67) solved by SVD —
@@ -29,6 +32,7 @@ use super::raw::{positive, BladeRole};
 use nalgebra::{DMatrix, Vector2, Vector3};
 use nurbs::fit::{approximate_curve_to_tolerance, averaged_knots, Parametrisation};
 use nurbs::{Curve2, KnotVector, NurbsCurve, NurbsSurface};
+use rayon::prelude::*;
 use std::path::PathBuf;
 
 /// Default fit tolerance, mm.
@@ -194,10 +198,22 @@ fn lsq_fixed_ends(
 /// Fits all `sections` (each LE → TE) with one shared knot vector within `tol`: returns the
 /// knot vector, each section's control points and the largest deviation.
 fn fit_compatible(sections: &[Vec<Vector3<f64>>], tol: f64) -> Result<CompatibleFit, String> {
-    let params: Vec<Vec<f64>> = sections
+    let mut params: Vec<Vec<f64>> = sections
         .iter()
         .map(|s| chord_params(s).ok_or_else(|| "a section has zero length".to_string()))
         .collect::<Result<_, _>>()?;
+    // Sections of equal point counts correspond point by point (AutoGrid sides, our own
+    // exports): one averaged parameter per index keeps those correspondences as the
+    // iso-parametric lines across the span (NURBS Book eq. 9.16's averaging).
+    let m0 = params[0].len();
+    if params.iter().all(|p| p.len() == m0) {
+        let avg: Vec<f64> = (0..m0)
+            .map(|i| params.iter().map(|p| p[i]).sum::<f64>() / params.len() as f64)
+            .collect();
+        for p in &mut params {
+            p.clone_from(&avg);
+        }
+    }
     let m_min = sections.iter().map(Vec::len).min().unwrap_or(0);
     if m_min < 2 {
         return Err("a section has fewer than 2 points".into());
@@ -380,31 +396,46 @@ pub fn fit(
     let (hub, hub_fit_mm) = fit_contour(&prepared.hub, tol_mm).map_err(|e| err("hub".into(), e))?;
     let (shroud, shroud_fit_mm) =
         fit_contour(&prepared.shroud, tol_mm).map_err(|e| err("shroud".into(), e))?;
-    let mut blades = Vec::with_capacity(prepared.blades.len());
-    for b in &prepared.blades {
-        let side =
-            |name: &str, pick: &dyn Fn(&super::prepare::SectionSides) -> Vec<Vector3<f64>>| {
-                let secs: Vec<Vec<Vector3<f64>>> = b.sections.iter().map(pick).collect();
-                let entity = || format!("blade {:?} {name} side", b.name);
-                let (kv, mut ctrls, e) =
-                    fit_compatible(&secs, tol_mm).map_err(|r| err(entity(), r))?;
-                extend_sections(&mut ctrls, span_extension);
-                let surf = skin(&kv, &ctrls).map_err(|r| err(entity(), r))?;
-                Ok::<_, ImportError>((surf, e))
-            };
-        let (pressure, pressure_fit_mm) = side("pressure", &|s| s.pressure.clone())?;
-        let (suction, suction_fit_mm) = side("suction", &|s| s.suction.clone())?;
-        blades.push(FittedBlade {
-            name: b.name.clone(),
-            role: b.role,
-            count: b.count,
-            sections: b.sections.len(),
-            pressure,
-            suction,
-            pressure_fit_mm,
-            suction_fit_mm,
-        });
-    }
+    // Every side of every blade is fitted independently (rayon).
+    let fit_side = |b: &super::prepare::PreparedBlade, pressure: bool| {
+        let secs: Vec<Vec<Vector3<f64>>> = b
+            .sections
+            .iter()
+            .map(|s| {
+                if pressure {
+                    s.pressure.clone()
+                } else {
+                    s.suction.clone()
+                }
+            })
+            .collect();
+        let entity = || {
+            let name = if pressure { "pressure" } else { "suction" };
+            format!("blade {:?} {name} side", b.name)
+        };
+        let (kv, mut ctrls, e) = fit_compatible(&secs, tol_mm).map_err(|r| err(entity(), r))?;
+        extend_sections(&mut ctrls, span_extension);
+        let surf = skin(&kv, &ctrls).map_err(|r| err(entity(), r))?;
+        Ok::<_, ImportError>((surf, e))
+    };
+    let blades = prepared
+        .blades
+        .par_iter()
+        .map(|b| {
+            let (p, s) = rayon::join(|| fit_side(b, true), || fit_side(b, false));
+            let ((pressure, pressure_fit_mm), (suction, suction_fit_mm)) = (p?, s?);
+            Ok(FittedBlade {
+                name: b.name.clone(),
+                role: b.role,
+                count: b.count,
+                sections: b.sections.len(),
+                pressure,
+                suction,
+                pressure_fit_mm,
+                suction_fit_mm,
+            })
+        })
+        .collect::<Result<Vec<_>, ImportError>>()?;
     Ok(FittedImpeller {
         source: prepared.source.clone(),
         hub,

@@ -1,9 +1,28 @@
 //! Importers of blade-design exports: TurboGrid curve sets, NUMECA AutoGrid `.geomTurbo`, and
-//! BladeGen `rtzt` meanline files.
+//! BladeGen `rtzt` meanline files, turned into an exact [`crate::Impeller`].
 //!
-//! Each importer reads its format into a [`RawImpeller`]: point data in millimetres with the
-//! rotation axis along +Z, still in the file's axial sense and not yet fitted. Every failure
-//! is an [`ImportError`] naming the file, the line and what was expected there.
+//! The pipeline, one module per step:
+//!
+//! 1. **Parse** ([`turbogrid`], [`geomturbo`], [`rtzt`]) into a [`RawImpeller`]: point data
+//!    in millimetres with the rotation axis along +Z, in the file's axial sense. Every
+//!    malformed file is an [`ImportError`] naming the file, the line and what was expected
+//!    there (CRLF and LF files alike; non-finite numbers rejected).
+//! 2. **Prepare** ([`mod@prepare`]): blade sides from loops (split at the leading and trailing
+//!    edges), camber lines (± half thickness) or given sides; flow direction, pressure /
+//!    suction labels, the workpiece frame, contours trimmed to the bladed part.
+//! 3. **Fit** ([`mod@fit`]): meridional contours and blade sides as B-splines within a stated
+//!    tolerance (default [`DEFAULT_FIT_TOL_MM`] = 0.01 mm); sides skinned across the spans.
+//!    The deviation reached is reported per entity.
+//! 4. **Assemble** ([`build`]): hub and shroud revolved exactly, blades via
+//!    [`crate::Blade::from_sides`], the impeller via [`crate::Impeller::from_parts`].
+//!
+//! [`import_file`] runs all four by file extension; [`spec`] reads TOML files that point at an
+//! export (`[import] file = ...`), which [`crate::load`] dispatches to. Achieved on the real
+//! exports in `../shared/data`: Rotor 37 (36 blades, cm) and the 12 + 12 centrifugal
+//! impeller (metres) both fit within 0.0099 mm at every data point.
+//!
+//! No new dependency: parsing is hand-written over lines (the formats are line-oriented and
+//! need line numbers in errors); linear algebra uses `nalgebra` (SVD least squares, LU).
 
 pub mod build;
 pub mod error;

@@ -18,7 +18,8 @@
 //!    by π about the x axis ((x, y, z) → (x, −y, −z), a rotation, so no side changes hand);
 //!    hub and shroud point lists are ordered from their inlet end and, on request, trimmed to
 //!    the bladed part plus a margin; then z is shifted so the hub's outlet end (the back face
-//!    of a centrifugal impeller) lies at z = 0.
+//!    of a centrifugal impeller) lies at z = 0 — except for data already in the workpiece
+//!    frame (not turned, no hub point below z = 0), which keep their z.
 
 use super::error::ImportError;
 use super::raw::{
@@ -323,7 +324,7 @@ pub fn prepare(
             let entity = || format!("blade {:?} section {} (line {})", b.name, k + 1, s.line);
             let pair: Pair = match &s.shape {
                 SectionShape::Loop(pts) => {
-                    let (a, c) = split_loop(&dedup(pts.clone(), eps)).ok_or_else(|| {
+                    let (a, c) = split_loop(pts, eps).ok_or_else(|| {
                         geom_err(
                             entity(),
                             "the loop has fewer than 4 distinct points or no meridional extent",
@@ -501,10 +502,14 @@ pub fn prepare(
             *wall = trim_contour(wall, &edges, margin);
         }
     }
-    // The hub's outlet end marks the back face (robust to fitted contours that overshoot).
-    let Some(z_shift) = hub.last().map(|p| -p.x) else {
+    // The hub's outlet end marks the back face (robust to fitted contours that overshoot),
+    // unless the data are already in the workpiece frame: inlet toward +Z and no hub point
+    // below z = 0 (our own exports, parametric designs with a disk below the hub).
+    let Some(z_end) = hub.last().map(|p| p.x) else {
         return Err(geom_err("hub".into(), "no points"));
     };
+    let in_frame = !flip && hub.iter().all(|p| p.x >= -eps);
+    let z_shift = if in_frame { 0.0 } else { -z_end };
     for p in hub.iter_mut().chain(shroud.iter_mut()) {
         p.x += z_shift;
     }

@@ -195,19 +195,41 @@ pub fn from_cylindrical(r: f64, theta: f64, z: f64) -> Vector3<f64> {
 /// Splits a closed section loop into its two sides at the leading and trailing edges.
 ///
 /// The edges are the two loop points farthest apart in the meridional (z, r) half-plane —
-/// the extreme meridional positions of the section (O(n²) in the loop size, n ≈ 300). A
-/// repeated closing point is dropped first. Both returned sides run from the first edge found
-/// (lower loop index) to the other; callers orient and label them. At a blunt edge (one side
-/// leaves the extreme point across the edge face, with under 25 % of the step along the
-/// meridional chord, while the other runs along the blade, over 50 %) the face is left out of
-/// the side that crosses it. Returns `None` when the
-/// loop has fewer than 4 distinct points or its meridional extent is zero.
-pub fn split_loop(points: &[Vector3<f64>]) -> Option<SidePair> {
-    let mut pts: Vec<Vector3<f64>> = points.to_vec();
+/// the extreme meridional positions of the section (O(n²) in the loop size, n ≈ 300).
+/// Points closer than `eps` to their predecessor are merged, and the closing point is
+/// dropped. Where the file marks an edge — the loop's first point (BladeGen starts loops at
+/// the leading edge) or a point written twice in a row (our exporter repeats each edge
+/// point) — within 2 % of the meridional chord of an extreme, the split is moved to that
+/// mark, so the sides end where the writer put the edges; two adjacent marks at one edge are
+/// the corners of a blunt edge face, which then belongs to neither side. Both returned sides
+/// run from the
+/// first edge (lower loop index) to the other; callers orient and label them. At a blunt edge
+/// (one side leaves the extreme point across a flat edge face — under 25 % of the step along
+/// the meridional chord, then a turn of more than 60° — while the other runs along the blade,
+/// over 50 %) the face is left out of the side that crosses it. Returns `None` when the loop
+/// has fewer than 4 distinct points or its meridional extent is zero.
+pub fn split_loop(points: &[Vector3<f64>], eps: f64) -> Option<SidePair> {
+    // Merge repeated points, remembering the marks (first point, repeated points).
+    let mut pts: Vec<Vector3<f64>> = Vec::with_capacity(points.len());
+    let mut marked: Vec<bool> = Vec::with_capacity(points.len());
+    for p in points {
+        match pts.last() {
+            Some(q) if (q - p).norm() <= eps => {
+                if let Some(m) = marked.last_mut() {
+                    *m = true;
+                }
+            }
+            _ => {
+                marked.push(pts.is_empty());
+                pts.push(*p);
+            }
+        }
+    }
     while pts.len() > 1 {
         let (first, last) = (pts[0], pts[pts.len() - 1]);
-        if (first - last).norm() <= 1e-12 * (1.0 + first.norm()) {
+        if (first - last).norm() <= eps {
             pts.pop();
+            marked.pop();
         } else {
             break;
         }
@@ -231,6 +253,19 @@ pub fn split_loop(points: &[Vector3<f64>]) -> Option<SidePair> {
     if !positive(best) {
         return None;
     }
+    // Snap each extreme to the nearest mark within 2 % of the chord (along the chord).
+    let chord = best.sqrt();
+    let dir = (m[bj] - m[bi]) / chord;
+    let snap = |e: usize, other: usize| -> usize {
+        let s_e = m[e].dot(&dir);
+        (0..n)
+            .filter(|&k| marked[k] && k != other && (m[k].dot(&dir) - s_e).abs() <= 0.02 * chord)
+            .min_by(|&a, &b| (m[a] - m[e]).norm().total_cmp(&(m[b] - m[e]).norm()))
+            .unwrap_or(e)
+    };
+    let si = snap(bi, bj);
+    let sj = snap(bj, si);
+    let (bi, bj) = if si < sj { (si, sj) } else { (sj, si) };
     let mut side_a: Vec<Vector3<f64>> = pts[bi..=bj].to_vec();
     // The other way round the loop: bi backwards (wrapping) to bj.
     let mut side_b = Vec::with_capacity(n - (bj - bi) + 1);
@@ -242,9 +277,32 @@ pub fn split_loop(points: &[Vector3<f64>]) -> Option<SidePair> {
         }
         k = if k == 0 { n - 1 } else { k - 1 };
     }
-    // Blunt edges: where one side leaves the edge point across the edge face (a step with
-    // little progress along the chord) while the other runs along the blade, the face is not
-    // part of that side: it starts (or ends) at its own corner instead.
+    // Marked edge faces: two adjacent marked points at the same edge are the corners of a
+    // blunt edge face (our exporter writes both corners twice); the face belongs to neither
+    // side, so the side that would cross it starts or ends at its own corner.
+    let near = |k: usize, e: usize| (m[k].dot(&dir) - m[e].dot(&dir)).abs() <= 0.02 * chord;
+    let face_at = |k: usize, e: usize| marked[k] && marked[e] && near(k, e);
+    let (next, prev) = (|k: usize| (k + 1) % n, |k: usize| (k + n - 1) % n);
+    let mut handled = [false, false]; // [start, end]
+    if side_a.len() > 2 && face_at(next(bi), bi) {
+        side_a.remove(0);
+        handled[0] = true;
+    } else if side_b.len() > 2 && face_at(prev(bi), bi) {
+        side_b.remove(0);
+        handled[0] = true;
+    }
+    if side_a.len() > 2 && face_at(prev(bj), bj) {
+        side_a.pop();
+        handled[1] = true;
+    } else if side_b.len() > 2 && face_at(next(bj), bj) {
+        side_b.pop();
+        handled[1] = true;
+    }
+    // Blunt edges: where one side leaves the edge point across a flat edge face (a step with
+    // little progress along the chord, followed by a sharp turn of more than 60° into the
+    // side) while the other runs along the blade, the face is not part of that side: it
+    // starts (or ends) at its own corner instead. A sampled round nose turns gradually and
+    // is kept.
     let d = (m[bj] - m[bi]).normalize();
     let progress = |p: &Vector3<f64>, q: &Vector3<f64>| {
         let step = (q - p).norm();
@@ -254,20 +312,41 @@ pub fn split_loop(points: &[Vector3<f64>]) -> Option<SidePair> {
             1.0
         }
     };
-    let lateral = |f: f64| f < 0.25;
-    let along = |f: f64| f > 0.5;
-    for at_start in [true, false] {
-        let ends = |s: &[Vector3<f64>]| {
+    // Cosine of the turn at q between the steps p→q and q→r.
+    let turn_cos = |p: &Vector3<f64>, q: &Vector3<f64>, r: &Vector3<f64>| {
+        let (u, v) = (q - p, r - q);
+        let den = u.norm() * v.norm();
+        if den > 0.0 {
+            u.dot(&v) / den
+        } else {
+            1.0
+        }
+    };
+    for (at_start, done) in [(true, handled[0]), (false, handled[1])] {
+        if done {
+            continue;
+        }
+        // (first-step progress, turn cosine at the second point) of a side's end.
+        let ends = |s: &[Vector3<f64>]| -> (f64, f64) {
+            if s.len() < 3 {
+                return (1.0, 1.0);
+            }
+            let n = s.len();
             if at_start {
-                progress(&s[0], &s[1])
+                (progress(&s[0], &s[1]), turn_cos(&s[0], &s[1], &s[2]))
             } else {
-                progress(&s[s.len() - 2], &s[s.len() - 1])
+                (
+                    progress(&s[n - 2], &s[n - 1]),
+                    turn_cos(&s[n - 3], &s[n - 2], &s[n - 1]),
+                )
             }
         };
-        let (fa, fb) = (ends(&side_a), ends(&side_b));
-        let target = if lateral(fa) && along(fb) && side_a.len() > 2 {
+        let face = |(f, c): (f64, f64)| f < 0.25 && c < 0.5;
+        let along = |(f, _): (f64, f64)| f > 0.5;
+        let (ea, eb) = (ends(&side_a), ends(&side_b));
+        let target = if face(ea) && along(eb) {
             Some(&mut side_a)
-        } else if lateral(fb) && along(fa) && side_b.len() > 2 {
+        } else if face(eb) && along(ea) {
             Some(&mut side_b)
         } else {
             None
@@ -346,11 +425,36 @@ mod tests {
             pts.push(from_cylindrical(10.0, -0.01 * (z * (4.0 - z)), z));
         }
         pts.push(pts[0]);
-        let (a, b) = split_loop(&pts).unwrap();
+        let (a, b) = split_loop(&pts, 1e-12).unwrap();
         assert_eq!(a.len(), 9);
         assert_eq!(b.len(), 9);
         assert!((a[0].z).abs() < 1e-12 && (b[0].z).abs() < 1e-12);
         assert!((a[8].z - 4.0).abs() < 1e-12 && (b[8].z - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn marked_blunt_face_belongs_to_neither_side() {
+        // Pressure side at θ = +0.01, suction at −0.01 (r = 10), LE shared, blunt TE whose
+        // corners are both written twice (the exporter's convention).
+        let side = |sign: f64| -> Vec<Vector3<f64>> {
+            (0..=8)
+                .map(|k| from_cylindrical(10.0, sign * 0.01, 0.5 * k as f64))
+                .collect()
+        };
+        let (p, s) = (side(1.0), side(-1.0));
+        let mut pts = vec![p[0]];
+        pts.extend(&p[1..]);
+        pts.push(p[8]);
+        pts.push(s[8]);
+        pts.extend(s[1..].iter().rev());
+        pts.push(p[0]);
+        let (a, b) = split_loop(&pts, 1e-12).unwrap();
+        assert_eq!((a.len(), b.len()), (9, 9));
+        assert!((a[8] - p[8]).norm() < 1e-12 || (a[8] - s[8]).norm() < 1e-12);
+        assert!(
+            (a[8] - b[8]).norm() > 0.1,
+            "each side ends at its own corner"
+        );
     }
 
     #[test]

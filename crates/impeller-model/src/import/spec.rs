@@ -83,6 +83,8 @@ pub fn resolve(base: &Path, rel: &Path) -> Option<PathBuf> {
     if rel.is_absolute() {
         return rel.exists().then(|| rel.to_path_buf());
     }
+    // Relative bases are made absolute first so the search can climb above them.
+    let base = std::fs::canonicalize(base).unwrap_or_else(|_| base.to_path_buf());
     base.ancestors().map(|a| a.join(rel)).find(|p| p.exists())
 }
 
