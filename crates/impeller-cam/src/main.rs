@@ -31,6 +31,8 @@ enum Command {
     Model(cmd::model::Args),
     /// Post-process an APT CLDATA file into a program for a machine and controller.
     Post(cmd::post::Args),
+    /// Verify a CL program against the impeller design (overcut, residual, collisions).
+    Verify(cmd::verify::Args),
 }
 
 fn main() -> ExitCode {
@@ -48,6 +50,9 @@ fn main() -> ExitCode {
         Command::Stiffness(args) => cmd::stiffness::run(args),
         Command::Model(args) => cmd::model::run(args),
         Command::Post(args) => cmd::post::run(args),
+        Command::Model(args) => cmd::model::run(args),
+        Command::Post(args) => cmd::post::run(args),
+        Command::Verify(args) => cmd::verify::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -32,6 +32,9 @@ pub enum SimError {
         /// Move index within the path.
         index: usize,
     },
+    /// The swept envelope of the cross-check could not be built or queried.
+    #[error("swept envelope: {0}")]
+    Envelope(cam_core::CamError),
     /// The design model could not be meshed or sampled.
     #[error("design model: {0}")]
     Design(String),

@@ -64,6 +64,11 @@ pub struct ImpellerDesign {
     sides_mesh: TriMesh,
     tri_info: Vec<(u32, Side, f64, f64)>,
     sampling: ImpellerSampling,
+    hub_z_max: f64,
+    hub_r_max: f64,
+    /// Half the largest blade thickness plus the side mesh's chord error (mm): beyond this
+    /// mesh distance a point is outside every blade.
+    far_mm: f64,
 }
 
 fn grid_tris(nu: usize, nv: usize, base: u32, out: &mut Vec<[u32; 3]>) {
@@ -130,7 +135,40 @@ impl ImpellerDesign {
         }
         let sides_mesh = TriMesh::new(vertices, tris)
             .map_err(|e| SimError::Design(format!("blade side mesh: {e:?}")))?;
+        // Largest blade thickness (pressure/suction points at equal parameters, an upper bound
+        // of the normal thickness for these side parametrisations, sampled) and the chord
+        // error of the side mesh (quad centre against the surface).
+        let mut t_max: f64 = 0.0;
+        let mut chord: f64 = 0.0;
+        for (_, blade) in blades.iter().take(2) {
+            let (ps, ss) = (blade.side(Side::Pressure), blade.side(Side::Suction));
+            let ((u0, u1), (v0, v1)) = ps.domain();
+            for j in 0..=mv {
+                for i in 0..=mu {
+                    let u = u0 + (u1 - u0) * i as f64 / mu as f64;
+                    let v = v0 + (v1 - v0) * j as f64 / mv as f64;
+                    t_max = t_max.max((ps.point(u, v) - ss.point(u, v)).norm());
+                    if i < mu && j < mv {
+                        let du = (u1 - u0) / mu as f64;
+                        let dv = (v1 - v0) / mv as f64;
+                        let c = (ps.point(u, v)
+                            + ps.point(u + du, v)
+                            + ps.point(u, v + dv)
+                            + ps.point(u + du, v + dv))
+                            / 4.0;
+                        chord = chord.max((ps.point(u + 0.5 * du, v + 0.5 * dv) - c).norm());
+                    }
+                }
+            }
+        }
+        let far_mm = 0.5 * t_max + 2.0 * chord + 0.05;
+        let m = impeller.hub().meridional();
+        let (t0, t1) = m.domain();
+        let (a, b) = (m.point(t0), m.point(t1));
         Ok(Self {
+            hub_z_max: a[0].max(b[0]),
+            hub_r_max: a[1].max(b[1]),
+            far_mm,
             impeller: impeller.clone(),
             blades,
             sides_mesh,
@@ -144,18 +182,34 @@ impl ImpellerDesign {
         blank_of(&self.impeller)
     }
 
+    /// Signed distance to the hub body: below the hub surface, capped by the plane of the
+    /// hub's inlet end (`z ≤ z_inlet`) and the cylinder of its outlet radius (`r ≤ r_outlet`),
+    /// where the meridional distance alone would extend the body past the contour's ends.
+    pub fn hub_signed_distance(&self, p: &Point3) -> f64 {
+        let d = self.impeller.hub().signed_distance(&p.coords);
+        let r = (p.x * p.x + p.y * p.y).sqrt();
+        d.max(p.z - self.hub_z_max).max(r - self.hub_r_max)
+    }
+
     /// Signed distance to the blade nearest to `p` (negative inside the blade, below the
     /// shroud).
     pub fn blade_signed_distance(&self, p: &Point3) -> f64 {
         let q = PVec::new(p.x, p.y, p.z);
-        let (_, (tri, _)) = self
+        let (proj, (tri, _)) = self
             .sides_mesh
             .project_local_point_and_get_location(q, false);
         let Some(&(bi, side, u, v)) = self.tri_info.get(tri as usize) else {
             return f64::INFINITY;
         };
-        let blade = &self.blades[bi as usize].1;
         let pv = p.coords;
+        let dm = (proj.point - q).length();
+        if dm > self.far_mm {
+            // Farther than half the thickest blade from every side: outside all blades, and
+            // the distance to the blade solids is at least dm − chord − t_max/2.
+            let ds = self.impeller.shroud().signed_distance(&pv);
+            return (dm - self.far_mm).max(ds).max(1e-9);
+        }
+        let blade = &self.blades[bi as usize].1;
         let (_, d1) = blade_side_distance(blade, side, &pv, Some((u, v)));
         let (_, d2) = blade_side_distance(blade, side.other(), &pv, Some((u, v)));
         let ds = self.impeller.shroud().signed_distance(&pv);
@@ -182,7 +236,7 @@ impl ImpellerDesign {
                     .outward_normal(side, u, v)
                     .unwrap_or_else(Vector3::zeros);
                 // Keep samples on the real blade: above the hub, below the shroud.
-                let keep = self.impeller.hub().signed_distance(&p) > 0.0
+                let keep = self.hub_signed_distance(&Point3::from(p)) > 0.0
                     && self.impeller.shroud().signed_distance(&p) < 0.0;
                 g.points.push(Point3::from(p));
                 g.normals.push(if keep { n } else { Vector3::zeros() });
@@ -294,8 +348,8 @@ pub fn blank_of(impeller: &Impeller) -> Result<RevolvedStock, SimError> {
 
 impl DesignModel for ImpellerDesign {
     fn signed_distance(&self, p: &Point3) -> f64 {
-        let d_hub = self.impeller.hub().signed_distance(&p.coords);
-        d_hub.min(self.blade_signed_distance(p))
+        self.hub_signed_distance(p)
+            .min(self.blade_signed_distance(p))
     }
 
     fn surface_grids(&self) -> Vec<SurfaceGrid> {

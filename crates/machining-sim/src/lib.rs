@@ -6,14 +6,36 @@
 //!
 //! Pipeline: [`TriDexel::from_shape`] samples the blank ([`BoxStock`], [`RevolvedStock`]);
 //! [`simulate`] sweeps every move's cutter through the stock ([`removal`]) and checks the
-//! non-cutting parts against the stock in process and against the design mesh
-//! ([`collision`]); [`measure`] probes the finished stock along design normals for overcut and
+//! non-cutting parts against the stock in process (on the dexels, exact along each ray) and
+//! against the design mesh (parry BVH, [`collision`]); [`measure`] probes the finished stock along design normals for overcut and
 //! residual; [`surface_mesh`] extracts an STL of the final stock.
+//!
+//! ```
+//! use cam_core::{Cutter, CutterLocation, CutterShape, Move, MoveKind, Point3, ToolPath};
+//! use machining_sim::{simulate, BoxDesign, BoxStock, SimOptions, TriDexel};
+//!
+//! // A 20 × 20 × 10 mm block at 0.25 mm; the design is its lower 6 mm.
+//! let blank = BoxStock::new([0.0, 0.0, 0.0], [20.0, 20.0, 10.0])?;
+//! let mut stock = TriDexel::from_shape(&blank, 0.25)?;
+//! let design = BoxDesign { min: [0.0, 0.0, 0.0], max: [20.0, 20.0, 6.0], sample_spacing: 1.0 };
+//! let cutter = Cutter::new("f6", CutterShape::FlatEnd { radius: 3.0 }, 20.0, 3.0, 40.0)?;
+//! let mut path = ToolPath::new("plunge", "f6");
+//! for (kind, z) in [(MoveKind::Rapid, 15.0), (MoveKind::Plunge, 5.5), (MoveKind::Retract, 15.0)] {
+//!     let cl = CutterLocation::vertical(Point3::new(10.0, 10.0, z));
+//!     path.moves.push(Move { kind, cl, feed_mm_per_min: None });
+//! }
+//! let report = simulate(&mut stock, &design, &[(cutter, path)], &SimOptions::default())?;
+//! // The plunge went 0.5 mm below the design's top face.
+//! assert!((report.metrics.max_overcut_mm - 0.5).abs() < 0.25);
+//! assert_eq!(report.metrics.collisions, 0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 //!
 //! Dependencies: parry3d-f64 (workspace choice) for the BVH over the design mesh; rayon for
 //! the per-row parallelism.
 
 pub mod collision;
+pub mod crosscheck;
 pub mod design;
 pub mod dexel;
 pub mod error;
@@ -25,8 +47,10 @@ pub mod removal;
 pub mod simulate;
 pub mod stock_shape;
 pub mod surface_mesh;
+pub mod synthetic;
 pub mod tool_solid;
 
+pub use crosscheck::{crosscheck_overcut, CrossCheckPoint, Envelopes};
 pub use design::{BoxDesign, CylinderDesign, DesignModel, SurfaceGrid, TriangleMesh, UnionDesign};
 pub use dexel::{DexelGrid, Segments, TriDexel};
 pub use error::SimError;

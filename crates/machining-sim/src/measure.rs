@@ -134,7 +134,7 @@ pub fn probe(
                         residual: t,
                     };
                 }
-                safe = next + (s - 0.5 * h).max(0.0) / 1.5;
+                safe = next + (s - 0.5 * h).max(0.0);
             }
             if !occ(next) {
                 return Probe {

@@ -1,5 +1,6 @@
 //! Exact cases: plunge of a flat end (volume, floor), ball-end groove profile, a deliberate
 //! gouge into a blade-like plate, the resolution study and collisions.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use cam_core::{
     Cutter, CutterLocation, CutterShape, HolderSegment, Move, MoveKind, Point3, ToolPath,
@@ -150,6 +151,10 @@ fn ball_end_groove_has_circular_profile() {
 /// Plate x ∈ [−1, 1] (blade-like), stock on its +x side, flank pass with a flat end along y
 /// plus a deliberate dip of `gouge` mm into the plate at y = 2.
 fn plate_case(h: f64, gouge: f64) -> machining_sim::Report {
+    plate_case_with_ops(h, gouge).0
+}
+
+fn plate_case_with_ops(h: f64, gouge: f64) -> (machining_sim::Report, Vec<(Cutter, ToolPath)>) {
     let design = BoxDesign {
         min: [-1.0, -10.0, 0.0],
         max: [1.0, 10.0, 15.0],
@@ -170,7 +175,9 @@ fn plate_case(h: f64, gouge: f64) -> machining_sim::Report {
         (MoveKind::Feed, vertical(x, 13.0, z)),
         (MoveKind::Retract, vertical(x, 13.0, 30.0)),
     ]);
-    simulate(&mut stock, &design, &[(cutter, p)], &SimOptions::default()).unwrap()
+    let ops = vec![(cutter, p)];
+    let rep = simulate(&mut stock, &design, &ops, &SimOptions::default()).unwrap();
+    (rep, ops)
 }
 
 #[test]
@@ -317,4 +324,25 @@ fn holder_hitting_the_design_is_reported_through_the_mesh() {
         .unwrap_or_else(|| panic!("{:?}", rep.collisions));
     // Holder face at x = 18 (circumscribed polygon: ≤ 18.14) against the wall [15, 17].
     assert!(hit.depth_mm > 1.5 && hit.depth_mm < 3.5, "{hit:?}");
+}
+
+#[test]
+fn dexel_overcut_agrees_with_the_swept_envelope_within_a_cell() {
+    let h = 0.2;
+    let (rep, ops) = plate_case_with_ops(h, 0.35);
+    let checks = machining_sim::crosscheck_overcut(&rep, &ops, 60).unwrap();
+    let on_face: Vec<_> = checks.iter().filter(|c| c.surface == "x_max").collect();
+    assert!(on_face.len() > 10);
+    for c in &on_face {
+        assert!(
+            (c.dexel_overcut_mm - c.envelope_overcut_mm).abs() < h,
+            "{c:?}"
+        );
+    }
+    let env_max = on_face
+        .iter()
+        .map(|c| c.envelope_overcut_mm)
+        .fold(0.0, f64::max);
+    assert!((env_max - 0.35).abs() < 1e-6, "{env_max}");
+    assert!((rep.metrics.max_overcut_mm - env_max).abs() < h);
 }

@@ -1,5 +1,6 @@
 //! The impeller fixture as a design model: signs of the signed distance, samples on the
 //! surfaces, and a verification run of a gouging cut.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use cam_core::{Cutter, CutterLocation, CutterShape, Move, MoveKind, Point3, ToolPath, Vector3};
 use impeller_model::fixtures::default_impeller;
@@ -39,6 +40,8 @@ fn signed_distance_signs_and_samples_on_surfaces() {
     // Deep below the hub surface near the axis: inside; far above the shroud: outside.
     assert!(d.signed_distance(&Point3::new(0.0, 0.0, 1.0)) < -1.0);
     assert!(d.signed_distance(&Point3::new(30.0, 0.0, 60.0)) > 1.0);
+    // On the axis above the hub's inlet end: outside (the hub body is capped there).
+    assert!(d.signed_distance(&Point3::new(0.0, 0.0, 60.0)) > 1.0);
     let grids = d.surface_grids();
     let mut kept = 0;
     for g in &grids {

@@ -4,3 +4,4 @@ pub mod model;
 pub mod post;
 pub mod run;
 pub mod stiffness;
+pub mod verify;
