@@ -711,17 +711,6 @@ impl SurfaceProjector {
                 }
                 continue;
             }
-            let (l, r) = (node.left, node.right);
-            let dl = self.nodes[l as usize].aabb.dist2(q);
-            let dr = self.nodes[r as usize].aabb.dist2(q);
-            let ((near, dn), (far, df)) = if dl <= dr {
-                ((l, dl), (r, dr))
-            } else {
-                ((r, dr), (l, dl))
-            };
-            if df < bound && sp < stack.len() {
-                stack[sp] = (far, df);
-                sp += 1;
             let node = &self.wide[index as usize];
             // (lower bound, centre distance, child) of the children closer than the bound.
             let mut kids = [(0.0f64, 0.0f64, 0u32); 4];
@@ -866,8 +855,6 @@ impl SurfaceProjector {
             if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0)
                 && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0)
             {
-                start = (cu, cv);
-                d_start = (patch.point(cu, cv) - q).norm_squared();
                 clamped = Some((cu, cv));
             }
         }
