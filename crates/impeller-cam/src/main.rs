@@ -50,8 +50,6 @@ fn main() -> ExitCode {
         Command::Stiffness(args) => cmd::stiffness::run(args),
         Command::Model(args) => cmd::model::run(args),
         Command::Post(args) => cmd::post::run(args),
-        Command::Model(args) => cmd::model::run(args),
-        Command::Post(args) => cmd::post::run(args),
         Command::Verify(args) => cmd::verify::run(args),
     };
     match result {

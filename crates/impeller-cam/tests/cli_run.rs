@@ -1,5 +1,6 @@
 //! `impeller-cam run` end to end: default job, a job with CL data from another CAM system
 //! (posted, accepted by LinuxCNC's rs274, verified by simulation), and user errors.
+#![allow(clippy::unwrap_used)] // test helpers
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
