@@ -5,6 +5,10 @@
 
 mod cmd;
 mod error;
+mod job;
+mod pipeline;
+mod plot;
+mod report;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -21,6 +25,8 @@ struct Cli {
 enum Command {
     /// Run the whole pipeline on a job file (or the embedded default job).
     Run(cmd::run::Args),
+    /// Rayleigh–Ritz stiffness indicator of a conical cutter.
+    Stiffness(cmd::stiffness::Args),
     /// Build an impeller and print its measured summary (blade counts, diameters, widths).
     Model(cmd::model::Args),
     /// Post-process an APT CLDATA file into a program for a machine and controller.
@@ -41,6 +47,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(args),
+        Command::Stiffness(args) => cmd::stiffness::run(args),
         Command::Model(args) => cmd::model::run(args),
         Command::Post(args) => cmd::post::run(args),
         Command::Verify(args) => cmd::verify::run(args),

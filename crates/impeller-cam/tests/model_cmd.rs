@@ -15,7 +15,11 @@ fn prints_the_fixture_summary_as_json() {
         env!("CARGO_MANIFEST_DIR")
     );
     let out = cli().args(["model", &path, "--json"]).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["main_blade_count"], 8);
     assert_eq!(v["splitter_blade_count"], 8);

@@ -8,7 +8,7 @@
 //! rulings); a *free-form* camber puts the meridional point at (1 − s)(z_h, r_h) + s (z_s, r_s)
 //! and θ(m, s) on the natural cubic spline through the span laws. The camber NURBS interpolates
 //! this design at NU = 161 flow samples (u, clustered at rounded edges, see
-//! [`crate::thickness`]) — a cubic×linear ruled surface, or cubic×cubic through 13 span rows.
+//! [`crate::thickness`]) — a cubic×linear ruled surface, or cubic×cubic through 41 span rows.
 //!
 //! **Sides.** With the unit camber normal n (oriented to +θ) and half thickness h = τ/2, the
 //! suction side (+θ) passes through C + h n and the pressure side (−θ) through C − h n.
@@ -36,7 +36,7 @@ use std::f64::consts::TAU;
 /// Samples along the flow for every blade surface.
 pub const FLOW_SAMPLES: usize = 161;
 /// Span rows of free-form surfaces.
-pub const SPAN_SAMPLES: usize = 13;
+pub const SPAN_SAMPLES: usize = 41;
 
 /// Builds the meridional contour of a spec.
 pub fn contour(spec: &ContourSpec) -> Result<MeridionalCurve, ModelError> {

@@ -13,6 +13,10 @@
 //! the splitter). It is found by brute force on 121 × 121 edge samples and refined by
 //! alternating golden-section searches in both curve parameters (error ≪ 1e-6 mm for smooth
 //! edges). Cost O(n²) point distances plus O(n) root solves per edge.
+//!
+//! A **channel section** ([`Channel::section`]) gives, at one contour parameter of hub or
+//! shroud, the polar angles where the bounding sides (and the splitter) meet that wall — the
+//! angular extent of the channel floor or opening there.
 
 use crate::blade::{Blade, Side};
 use crate::impeller::Impeller;
@@ -193,7 +197,75 @@ pub struct Channel {
     pub splitter: Option<Blade>,
 }
 
+/// Polar angle where `side` meets `wall` at the wall's contour parameter `t`: the u of the
+/// edge point whose meridional foot is `t` is found by bisection (60 steps; the foot moves
+/// monotonically with u along the flow). `None` if the side's edge does not reach `t`.
+pub fn edge_angle_at(blade: &Blade, side: Side, wall: &RevolvedSurface, t: f64) -> Option<f64> {
+    let s = blade.side(side);
+    let ((u0, u1), _) = s.domain();
+    let foot = |u: f64| {
+        edge_v(blade, side, wall, u).map(|v| {
+            let p = s.point(u, v);
+            (
+                wall.meridional()
+                    .closest(crate::meridional::MeridionalCurve::zr_of(&p))
+                    .0,
+                p,
+            )
+        })
+    };
+    let (ta, _) = foot(u0)?;
+    let (tb, _) = foot(u1)?;
+    let increasing = tb >= ta;
+    if t < ta.min(tb) || t > ta.max(tb) {
+        return None;
+    }
+    let (mut lo, mut hi) = (u0, u1);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        let (tm, _) = foot(mid)?;
+        if (tm < t) == increasing {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let (_, p) = foot(0.5 * (lo + hi))?;
+    Some(p.y.atan2(p.x))
+}
+
+/// Angular extent of a channel on hub or shroud at one contour parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChannelSection {
+    /// Polar angle of the left bounding side (radians).
+    pub left: f64,
+    /// Polar angle of the right bounding side, unwrapped so that `right > left`.
+    pub right: f64,
+    /// Angles of the splitter's −θ and +θ sides (unwrapped after `left`), where the splitter
+    /// reaches this contour parameter.
+    pub splitter: Option<(f64, f64)>,
+}
+
 impl Channel {
+    /// The channel's angular extent where it meets `wall` at contour parameter `t` (the floor
+    /// between the blades on the hub, or the opening on the shroud); `None` where a bounding
+    /// side does not reach `t`.
+    pub fn section(&self, wall: &RevolvedSurface, t: f64) -> Option<ChannelSection> {
+        let left = edge_angle_at(&self.left, self.left_side(), wall, t)?;
+        let after = |phi: f64| left + (phi - left).rem_euclid(std::f64::consts::TAU);
+        let right = after(edge_angle_at(&self.right, self.right_side(), wall, t)?);
+        let splitter = self.splitter.as_ref().and_then(|s| {
+            let a = edge_angle_at(s, s.plus_theta_side().other(), wall, t)?;
+            let b = edge_angle_at(s, s.plus_theta_side(), wall, t)?;
+            Some((after(a), after(b)))
+        });
+        Some(ChannelSection {
+            left,
+            right,
+            splitter,
+        })
+    }
+
     /// The side of the left blade bounding the channel.
     pub fn left_side(&self) -> Side {
         self.left.plus_theta_side()
@@ -216,6 +288,22 @@ impl Impeller {
             right: self.main().instance((k + 1) % n),
             splitter: self.splitter().map(|s| s.instance(k)),
         }
+    }
+
+    /// Side parameters (v_hub, v_shroud) of the isocurves that enclose the part of `side`
+    /// between hub and shroud: the smallest v of its hub edge and the largest v of its shroud
+    /// edge over 41 values of u. For imported blades (no design data) this is the v range a
+    /// ruled approximation ([`crate::ruled`]) should span. `None` if an edge misses its wall.
+    pub fn span_v_range(&self, blade: &Blade, side: Side) -> Option<(f64, f64)> {
+        let ((u0, u1), _) = blade.side(side).domain();
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for i in 0..=40 {
+            let u = u0 + (u1 - u0) * i as f64 / 40.0;
+            lo = lo.min(edge_v(blade, side, self.hub(), u)?);
+            hi = hi.max(edge_v(blade, side, self.shroud(), u)?);
+        }
+        (lo < hi).then_some((lo, hi))
     }
 
     /// Smallest distance between facing blade sides along `wall` (mm); every channel is the

@@ -14,7 +14,7 @@ pub enum ModelError {
         source: std::io::Error,
     },
     /// The file's extension names no supported format.
-    #[error("{path}: unsupported impeller format (expected .toml)")]
+    #[error("{path}: unsupported impeller format (expected .toml, .inf, .geomTurbo or .rtzt)")]
     UnsupportedFormat {
         /// The file concerned.
         path: PathBuf,
@@ -50,6 +50,9 @@ pub enum ModelError {
     /// The assembled geometry is inconsistent (e.g. blades intersect, sides swapped).
     #[error("invalid geometry: {0}")]
     Geometry(String),
+    /// A blade-design export (or an import file pointing at one) could not be imported.
+    #[error(transparent)]
+    Import(#[from] crate::import::ImportError),
     /// An error from the NURBS kernel while building a curve or surface.
     #[error("nurbs: {0}")]
     Nurbs(#[from] nurbs::NurbsError),

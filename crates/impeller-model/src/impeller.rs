@@ -5,6 +5,30 @@ use crate::error::ModelError;
 use crate::revolved::RevolvedSurface;
 use crate::stock::Stock;
 
+/// Polar angle of `other`'s mid point minus that of the point of `blade`'s pressure side at the
+/// nearest meridional position (z, r), reduced to [0, 2π): how far `other` sits from `blade`
+/// in +θ at the same place of the channel (pressure side sampled on 61 × 21 parameters).
+fn angular_offset(blade: &Blade, other: &Blade) -> f64 {
+    let p = other.mid_point();
+    let (z0, r0) = (p.z, p.x.hypot(p.y));
+    let s = blade.pressure();
+    let ((u0, u1), (v0, v1)) = s.domain();
+    let mut best = (f64::INFINITY, 0.0);
+    for i in 0..=60 {
+        for j in 0..=20 {
+            let q = s.point(
+                u0 + (u1 - u0) * i as f64 / 60.0,
+                v0 + (v1 - v0) * j as f64 / 20.0,
+            );
+            let d = (q.z - z0).powi(2) + (q.x.hypot(q.y) - r0).powi(2);
+            if d < best.0 {
+                best = (d, q.y.atan2(q.x));
+            }
+        }
+    }
+    (p.y.atan2(p.x) - best.1).rem_euclid(std::f64::consts::TAU)
+}
+
 /// A centrifugal impeller in the workpiece frame (axis +Z from the hub back face toward the
 /// inlet, origin on the axis at the back face; mm).
 #[derive(Debug, Clone)]
@@ -60,10 +84,8 @@ impl Impeller {
                         main.count()
                     )));
                 }
-                let angle = |p: nalgebra::Vector3<f64>| p.y.atan2(p.x);
                 let pitch = main.pitch_rad();
-                let offset = (angle(s.blade().mid_point()) - angle(main.blade().mid_point()))
-                    .rem_euclid(std::f64::consts::TAU);
+                let offset = angular_offset(main.blade(), s.blade());
                 let k = (offset / pitch).floor();
                 if k >= 1.0 {
                     Some(BladeSet::new(s.count(), s.blade().rotated(-k * pitch))?)

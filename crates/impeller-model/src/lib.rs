@@ -31,9 +31,11 @@ pub mod blade;
 pub mod builder;
 pub mod channel;
 pub mod error;
+pub mod export;
 pub mod fit;
 pub mod fixtures;
 pub mod impeller;
+pub mod import;
 pub mod law;
 pub mod meridional;
 pub mod params;
@@ -55,7 +57,10 @@ pub use thickness::{EdgeShape, ThicknessLaw};
 
 use std::path::Path;
 
-/// Loads an impeller from a file, choosing the reader by extension (`.toml`: parametric).
+/// Loads an impeller from a file, choosing the reader by extension: `.toml` parametric, or an
+/// import file when it has an `[import]` table ([`import::spec`]); `.inf` (TurboGrid curve
+/// set), `.geomTurbo` (AutoGrid) and `.rtzt` (BladeGen, mm) exports are imported with
+/// [`import::ImportOptions::default`].
 pub fn load(path: impl AsRef<Path>) -> Result<Impeller, ModelError> {
     let path = path.as_ref();
     let ext = path
@@ -68,7 +73,13 @@ pub fn load(path: impl AsRef<Path>) -> Result<Impeller, ModelError> {
                 path: path.to_path_buf(),
                 source,
             })?;
+            if import::is_import_toml(&text) {
+                return Ok(import::from_import_toml(&text, path)?.impeller);
+            }
             from_toml_str(&text, path)
+        }
+        Some("inf" | "geomturbo" | "rtzt") => {
+            Ok(import::import_file(path, &import::ImportOptions::default())?.impeller)
         }
         _ => Err(ModelError::UnsupportedFormat {
             path: path.to_path_buf(),

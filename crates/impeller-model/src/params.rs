@@ -202,6 +202,24 @@ fn check_zr(field: &str, p: [f64; 2]) -> Result<(), ModelError> {
     Ok(())
 }
 
+/// Checks that a thickness law stays positive between its table points (the cubic spline can
+/// undershoot), sampled at 401 fractions.
+fn check_positive_law(field: &str, law: &Law) -> Result<(), ModelError> {
+    for k in 0..=400 {
+        let m = k as f64 / 400.0;
+        let t = law.eval(m);
+        if t.is_nan() || t <= 0.0 {
+            return Err(ModelError::invalid(
+                field,
+                format!(
+                    "must stay > 0 between its points (the spline reaches {t:.4} mm at {m:.3})"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Checks a table of (fraction, value) pairs and builds its law.
 fn check_table(field: &str, table: &[[f64; 2]], positive: bool) -> Result<Law, ModelError> {
     for (i, p) in table.iter().enumerate() {
@@ -215,7 +233,11 @@ fn check_table(field: &str, table: &[[f64; 2]], positive: bool) -> Result<Law, M
             ));
         }
     }
-    Law::new(table).map_err(|r| ModelError::invalid(field, r))
+    let law = Law::new(table).map_err(|r| ModelError::invalid(field, r))?;
+    if positive {
+        check_positive_law(field, &law)?;
+    }
+    Ok(law)
 }
 
 impl ContourSpec {

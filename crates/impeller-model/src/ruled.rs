@@ -325,7 +325,9 @@ pub fn sub_ruled_strips(
 
 impl Blade {
     /// Side parameters v of the hub and shroud edges: the design values for parametric blades,
-    /// the whole v domain of the side otherwise.
+    /// the whole v domain of the side otherwise (for imported blades prefer
+    /// [`crate::Impeller::span_v_range`], which finds the isocurves enclosing the part between
+    /// hub and shroud).
     pub fn hub_shroud_v(&self, side: Side) -> (f64, f64) {
         match self.design() {
             Some(d) => d.span_v,

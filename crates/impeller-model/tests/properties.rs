@@ -130,3 +130,46 @@ proptest! {
         prop_assert!((imp.main().rotation(k) * p0 - pk).norm() < 1e-9);
     }
 }
+
+proptest! {
+    /// The natural cubic spline passes through its table and is C¹ at interior points.
+    #[test]
+    fn laws_interpolate_their_tables(ys in prop::collection::vec(-50.0f64..50.0, 1..8)) {
+        let n = ys.len();
+        let table: Vec<[f64; 2]> = ys
+            .iter()
+            .enumerate()
+            .map(|(i, &y)| [if n == 1 { 0.0 } else { i as f64 / (n - 1) as f64 }, y])
+            .collect();
+        let law = impeller_model::law::Law::new(&table).unwrap();
+        for p in &table {
+            prop_assert!((law.eval(p[0]) - p[1]).abs() < 1e-9);
+        }
+        for p in table.iter().skip(1).take(n.saturating_sub(2)) {
+            let (_, a) = law.eval_d(p[0] - 1e-9);
+            let (_, b) = law.eval_d(p[0] + 1e-9);
+            prop_assert!((a - b).abs() < 1e-4 * (1.0 + a.abs()));
+        }
+    }
+
+    /// Closest points on a quarter-ellipse contour: no sample of the contour is closer, and the
+    /// signed distance changes sign across the curve.
+    #[test]
+    fn contour_closest_point_is_global(
+        zi in 30.0f64..60.0, ri in 5.0f64..20.0, zo in 0.0f64..10.0, ro in 30.0f64..80.0,
+        qz in -10.0f64..70.0, qr in 0.0f64..90.0,
+    ) {
+        let c = impeller_model::MeridionalCurve::quarter_ellipse([zi, ri], [zo, ro]).unwrap();
+        let q = nalgebra::Vector2::new(qz, qr);
+        let (t, d) = c.closest(q);
+        let best = (0..=2000)
+            .map(|k| (c.point(k as f64 / 2000.0) - q).norm())
+            .fold(f64::INFINITY, f64::min);
+        prop_assert!(d.abs() <= best + 1e-9, "{} > {best}", d.abs());
+        prop_assert!(best - d.abs() < 1e-2);
+        let n = c.normal(t);
+        if d.abs() > 1e-6 && t > 1e-9 && t < 1.0 - 1e-9 {
+            prop_assert!(((q - c.point(t)).dot(&n) > 0.0) == (d > 0.0));
+        }
+    }
+}

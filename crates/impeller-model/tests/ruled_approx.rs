@@ -80,6 +80,29 @@ fn ruled_approximation_matches_dense_sampling_and_shares_edges() {
 }
 
 #[test]
+fn imported_blades_get_their_span_range_from_hub_and_shroud() {
+    let imp = fixtures::default_impeller().unwrap();
+    let b = imp.main().blade();
+    // The same sides without design data, as an importer would hand them over.
+    let bare =
+        Blade::from_sides(b.kind(), b.pressure().clone(), b.suction().clone(), None).unwrap();
+    assert_eq!(bare.hub_shroud_v(Side::Suction), (0.0, 1.0));
+    let (lo, hi) = imp.span_v_range(&bare, Side::Suction).unwrap();
+    let (dh, ds) = b.hub_shroud_v(Side::Suction);
+    // The design rows lie on hub and shroud at the camber; the sides' edges are within the
+    // extension of them.
+    assert!(lo <= dh + 1e-3 && (lo - dh).abs() < 0.05, "{lo} vs {dh}");
+    assert!(hi >= ds - 1e-3 && (hi - ds).abs() < 0.05, "{hi} vs {ds}");
+    for i in 0..=10 {
+        let u = i as f64 / 10.0;
+        let p = bare.suction().point(u, lo);
+        assert!(imp.hub().signed_distance(&p) <= 1e-9);
+        let q = bare.suction().point(u, hi);
+        assert!(imp.shroud().signed_distance(&q) >= -1e-9);
+    }
+}
+
+#[test]
 fn ruled_blade_is_its_own_ruled_approximation() {
     let imp = fixtures::default_impeller().unwrap();
     let blade = imp.main().blade();

@@ -154,6 +154,14 @@ fn every_validation_error_names_its_field_and_line() {
             "main.thickness_mm",
         ),
         (
+            replace(
+                BASE,
+                "thickness_mm = [[0.0, 0.8], [1.0, 0.8]]",
+                "thickness_mm = [[0.0, 0.1], [0.1, 3.0], [0.2, 0.1], [1.0, 0.1]]",
+            ),
+            "main.thickness_mm",
+        ),
+        (
             replace(BASE, "kind = \"ruled\"", "kind = \"free_form\""),
             "main.wrap",
         ),

@@ -339,3 +339,17 @@ fn closest_point_on_a_sphere_with_poles() {
         assert!(a.distance <= dense_min(&s, &q, 101) + 1e-12);
     }
 }
+
+#[test]
+fn non_finite_queries_do_not_panic() {
+    let (_, p) = reference();
+    let a = p.closest_point(&Vector3::new(f64::NAN, 1.0, 2.0));
+    assert!(a.distance.is_nan());
+    let b = p.closest_point_with_hint(&Vector3::new(1.0, 2.0, 3.0), Some((f64::NAN, 0.5)));
+    assert!(b.distance.is_finite());
+    let arc =
+        NurbsCurve::<2>::circle_arc(Vector2::zeros(), Vector2::x(), Vector2::y(), 1.0, 0.0, 1.0)
+            .unwrap();
+    let c = CurveProjector::new(&arc).closest_point(&Vector2::new(f64::INFINITY, 0.0));
+    assert!(c.distance.is_nan());
+}

@@ -110,3 +110,24 @@ fn invalid_projection_input_is_reported() {
         Err(ProjectError::InvalidInput(_))
     ));
 }
+
+proptest::proptest! {
+    /// A line through a known surface point is reported hitting it.
+    #[test]
+    fn line_through_a_surface_point_finds_it(u in 0.0f64..=1.0, v in 0.0f64..=1.0,
+                                              dx in -1.0f64..1.0, dy in -1.0f64..1.0, t0 in 1.0f64..20.0) {
+        let s = wavy();
+        let p = SurfaceProjector::new(&s);
+        let foot = s.point(u, v);
+        let n = s.normal(u, v).unwrap();
+        let d = (n + Vector3::new(dx, dy, 0.0)).normalize();
+        proptest::prop_assume!(d.dot(&n).abs() > 0.3);
+        let q = foot - d * t0;
+        let hits = p.intersect_line(&q, &d, RayMode::Line).unwrap();
+        let found = hits.iter().any(|h| (h.point - foot).norm() <= 1e-8 && (h.t - t0).abs() <= 1e-8);
+        proptest::prop_assert!(found, "no hit at the generating point; hits {:?}", hits);
+        for h in &hits {
+            proptest::prop_assert!(((q + d * h.t) - h.point).norm() <= 1e-8);
+        }
+    }
+}

@@ -3,4 +3,5 @@
 pub mod model;
 pub mod post;
 pub mod run;
+pub mod stiffness;
 pub mod verify;

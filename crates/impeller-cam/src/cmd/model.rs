@@ -1,6 +1,10 @@
-//! `impeller-cam model [IMPELLER] [--json]`: build an impeller and print its measured summary.
+//! `impeller-cam model [IMPELLER] [--json] [--stl FILE] [--curves DIR]`: build an impeller,
+//! print its measured summary, and optionally export it as a binary STL (hub and blades,
+//! within `--chord-tol`) and as TurboGrid curve files (`impeller.inf`, hub, shroud and
+//! profile curves, which `model` reads back).
 
 use crate::error::CliError;
+use impeller_model::export::{write_curves, write_stl, CurveSampling, Part};
 use std::path::PathBuf;
 
 /// Arguments of `impeller-cam model`.
@@ -12,6 +16,15 @@ pub struct Args {
     /// Print the summary as JSON on stdout (otherwise as aligned text).
     #[arg(long)]
     pub json: bool,
+    /// Write the hub and all blades as a binary STL file.
+    #[arg(long, value_name = "FILE")]
+    pub stl: Option<PathBuf>,
+    /// Largest distance between the STL triangles and the exact surfaces (mm).
+    #[arg(long, value_name = "MM", default_value_t = 0.01)]
+    pub chord_tol: f64,
+    /// Write TurboGrid curve files (impeller.inf, hub.curve, shroud.curve, profiles) into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub curves: Option<PathBuf>,
 }
 
 /// Loads the impeller, measures it and prints the summary.
@@ -34,6 +47,26 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 println!("{k:<30} {v}");
             }
         }
+    }
+    if let Some(path) = &args.stl {
+        let stats = write_stl(&imp, &[Part::Impeller], args.chord_tol, path)
+            .map_err(|e| CliError::Message(e.to_string()))?;
+        eprintln!(
+            "wrote {} ({} triangles, chord tolerance {} mm)",
+            path.display(),
+            stats.triangles,
+            stats.chord_tol_mm
+        );
+    }
+    if let Some(dir) = &args.curves {
+        let files = write_curves(&imp, dir, "impeller", &CurveSampling::default())
+            .map_err(|e| CliError::Message(e.to_string()))?;
+        eprintln!(
+            "wrote {} and {} curve files in {}",
+            files.inf.display(),
+            files.curves.len(),
+            dir.display()
+        );
     }
     Ok(())
 }

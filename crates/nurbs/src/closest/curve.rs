@@ -231,9 +231,19 @@ impl<const D: usize> CurveProjector<D> {
         self.closest_point_with_hint(q, None)
     }
 
-    /// The global closest point to `q`, starting Newton from parameter `hint` when given.
+    /// The global closest point to `q`, starting Newton from parameter `hint` when given
+    /// (the answer does not depend on it). A non-finite `q` gives a NaN distance.
     pub fn closest_point_with_hint(&self, q: &SVector<f64, D>, hint: Option<f64>) -> CurvePoint<D> {
         let (a, b) = self.domain;
+        if !q.iter().all(|c| c.is_finite()) {
+            // No point is closest to a non-finite query.
+            return CurvePoint {
+                u: a,
+                point: self.derivs2(a)[0],
+                distance: f64::NAN,
+                on_boundary: false,
+            };
+        }
         let mut best: Option<Local1<D>> = None;
         if let Some(h) = hint.filter(|h| h.is_finite()) {
             best = Some(self.newton(q, a, b, h, None));

@@ -7,7 +7,8 @@
 //!
 //! * per leaf, an oriented bounding box of its control net (convex-hull property: the leaf
 //!   lies inside; weights are positive) and an axis-aligned box; the same two boxes for every
-//!   node of a bounding-volume hierarchy over the leaves (median split of centroids);
+//!   node of a bounding-volume hierarchy over the leaves (median split of centroids, walked
+//!   as a 4-wide tree whose nodes store their children's boxes together);
 //! * per leaf of a polynomial surface, the *tangent cones* of `S_u` and `S_v` (cones
 //!   containing the hodograph control vectors, hence every tangent of the leaf);
 //! * per leaf, interval bounds of `S_u`, `S_v`, `S_uu`, `S_uv`, `S_vv` (boxes of the hodograph
@@ -51,7 +52,8 @@
 //! Tolerances: Newton stops when its predicted 3D step is below `1e-13 × (1 + surface size)`
 //! mm and the angle between `S − q` and each free tangent is within `1e-11` of 90°; steps
 //! are accepted up to the round-off of `|S − q|²`. Cost on the 12×12 bicubic reference surface
-//! (225 leaves): ≈ 1 µs cold, ≈ 0.5–0.7 µs warm (see `benches/nurbs.rs`). Queries take
+//! (225 leaves), CPU time per query on a busy 2-core machine: ≈ 1.0 µs cold, ≈ 0.6 µs warm,
+//! i.e. about 25 and 15 surface evaluations (see `benches/nurbs.rs`). Queries take
 //! `&self` and, outside the branch-and-bound fallback, do not allocate; the projector is
 //! `Send + Sync`.
 
@@ -236,6 +238,8 @@ pub(crate) struct Leaf {
     /// May the leaf be dropped because the distance decreases towards edge
     /// `[u0, u1, v0, v1]` (edge interior to the surface and C¹ across it)?
     exclude_towards: [bool; 4],
+    /// Leaves sharing the whole edge `[u0, u1, v0, v1]` (`u32::MAX` if none).
+    edge_neighbours: [u32; 4],
     samples: [(f64, f64, Vector3<f64>); 9],
     /// Interval data of the Hessian certificate.
     hess: HessianBounds,
@@ -447,6 +451,65 @@ pub(crate) struct Node {
     pub right: u32,
 }
 
+/// Marks a leaf index in [`Node4::child`] and on the walk's stack.
+const LEAF_BIT: u32 = 1 << 31;
+
+/// Node of the 4-wide hierarchy: boxes of up to four children stored together.
+#[derive(Debug, Clone)]
+struct Node4 {
+    aabb: [Aabb; 4],
+    obb: [Obb; 4],
+    /// Child node index, or leaf index with [`LEAF_BIT`] set.
+    child: [u32; 4],
+    n: u8,
+}
+
+/// Collapses binary node `at` (and its subtree) into 4-wide nodes; returns the index of the
+/// new node.
+fn collapse(nodes: &[Node], at: usize, wide: &mut Vec<Node4>) -> u32 {
+    let mut frontier: Vec<usize> = if nodes[at].right == u32::MAX {
+        vec![at]
+    } else {
+        vec![nodes[at].left as usize, nodes[at].right as usize]
+    };
+    // Replace inner nodes by their two children while there is room.
+    let mut k = 0;
+    while k < frontier.len() && frontier.len() < 4 {
+        let n = &nodes[frontier[k]];
+        if n.right != u32::MAX {
+            frontier[k] = n.left as usize;
+            frontier.insert(k + 1, n.right as usize);
+        } else {
+            k += 1;
+        }
+    }
+    let me = wide.len();
+    let empty_obb = Obb {
+        c: Vector3::zeros(),
+        axes: [Vector3::x(), Vector3::y(), Vector3::z()],
+        h: [0.0; 3],
+    };
+    wide.push(Node4 {
+        aabb: [Aabb::empty(); 4],
+        obb: [empty_obb; 4],
+        child: [0; 4],
+        n: frontier.len() as u8,
+    });
+    for (c, &f) in frontier.iter().enumerate() {
+        let n = &nodes[f];
+        let child = if n.right == u32::MAX {
+            n.left | LEAF_BIT
+        } else {
+            collapse(nodes, f, wide)
+        };
+        let w = &mut wide[me];
+        w.aabb[c] = n.aabb;
+        w.obb[c] = n.obb;
+        w.child[c] = child;
+    }
+    me as u32
+}
+
 /// Precomputed closest-point query structure for one surface. See the module docs.
 #[derive(Debug, Clone)]
 pub struct SurfaceProjector {
@@ -456,6 +519,8 @@ pub struct SurfaceProjector {
     pub(crate) v_breaks: Vec<f64>,
     pub(crate) leaves: Vec<Leaf>,
     pub(crate) nodes: Vec<Node>,
+    /// The same hierarchy collapsed to (up to) four children per node for the query walk.
+    wide: Vec<Node4>,
     pub(crate) domain: ((f64, f64), (f64, f64)),
     step_tol: f64,
 }
@@ -517,13 +582,17 @@ impl SurfaceProjector {
         }
         let diag = (size.max - size.min).norm();
         let step_tol = 1e-13 * (1.0 + if diag.is_finite() { diag } else { 0.0 });
+        link_edge_neighbours(&mut leaves);
         let nodes = build_bvh(&leaves);
+        let mut wide = Vec::with_capacity(nodes.len() / 2 + 1);
+        collapse(&nodes, 0, &mut wide);
         SurfaceProjector {
             patches,
             u_breaks,
             v_breaks,
             leaves,
             nodes,
+            wide,
             domain,
             step_tol,
         }
@@ -583,13 +652,24 @@ impl SurfaceProjector {
 
     /// The global closest point of the surface to `q`, starting from `hint = (u, v)` when
     /// given (typically the previous answer of a path of queries). The hint only speeds the
-    /// search up; the answer is the same global minimum as without it.
+    /// search up; the answer is the same global minimum as without it. A non-finite `q`
+    /// gives a NaN distance (and a non-finite hint is ignored).
     pub fn closest_point_with_hint(
         &self,
         q: &Vector3<f64>,
         hint: Option<(f64, f64)>,
     ) -> SurfacePoint {
         let ((ua, ub), (va, vb)) = self.domain;
+        if !q.iter().all(|c| c.is_finite()) {
+            // No point is closest to a non-finite query.
+            return SurfacePoint {
+                u: ua,
+                v: va,
+                point: self.point(ua, va),
+                distance: f64::NAN,
+                on_boundary: false,
+            };
+        }
         let mut best: Option<(Local, bool)> = None;
         // Patch of the previous evaluation: consecutive Newton iterates usually stay in it.
         let last = std::cell::Cell::new(0usize);
@@ -606,9 +686,10 @@ impl SurfaceProjector {
                 best = Some((l, l.converged));
             }
         }
-        // Depth-first walk, nearer child first; each stack entry keeps its box distance so
-        // it is re-tested against the (possibly improved) bound when popped.
-        let mut stack = [(0u32, 0.0f64); 64];
+        // Depth-first walk over the 4-wide hierarchy, nearer children first; each stack entry
+        // keeps its box distance so it is re-tested against the (possibly improved) bound
+        // when popped. Entries with `LEAF_BIT` set are leaves.
+        let mut stack = [(0u32, 0.0f64); 128];
         let mut sp = 1usize;
         let mut solves = 0usize;
         while sp > 0 {
@@ -618,12 +699,11 @@ impl SurfaceProjector {
             if d2 >= bound {
                 continue;
             }
-            let node = &self.nodes[index as usize];
-            if node.right == u32::MAX {
+            if index & LEAF_BIT != 0 {
                 if solves >= MAX_LEAF_SOLVES {
                     continue;
                 }
-                if let Some(l) = self.solve_leaf(node.left as usize, q, best, bound) {
+                if let Some(l) = self.solve_leaf((index & !LEAF_BIT) as usize, q, best, bound) {
                     solves += 1;
                     if l.0.d2 < bound {
                         best = Some(l);
@@ -631,37 +711,34 @@ impl SurfaceProjector {
                 }
                 continue;
             }
-            let (l, r) = (node.left, node.right);
-            let lb = |n: &Node| {
-                let a = n.aabb.dist2(q);
+            let node = &self.wide[index as usize];
+            // (lower bound, centre distance, child) of the children closer than the bound.
+            let mut kids = [(0.0f64, 0.0f64, 0u32); 4];
+            let mut nk = 0;
+            for c in 0..node.n as usize {
+                let a = node.aabb[c].dist2(q);
                 if a >= bound {
-                    a
-                } else {
-                    a.max(n.obb.dist2(q))
+                    continue;
                 }
-            };
-            let dl = lb(&self.nodes[l as usize]);
-            let dr = lb(&self.nodes[r as usize]);
-            // Nearer box first; when `q` is inside both (common near the root), the nearer
-            // box centre is the better guess.
-            let left_first = if dl == dr {
-                (self.nodes[l as usize].obb.c - q).norm_squared()
-                    <= (self.nodes[r as usize].obb.c - q).norm_squared()
-            } else {
-                dl < dr
-            };
-            let ((near, dn), (far, df)) = if left_first {
-                ((l, dl), (r, dr))
-            } else {
-                ((r, dr), (l, dl))
-            };
-            if df < bound && sp < stack.len() {
-                stack[sp] = (far, df);
-                sp += 1;
+                let lb = a.max(node.obb[c].dist2(q));
+                if lb >= bound {
+                    continue;
+                }
+                let key2 = (node.obb[c].c - q).norm_squared();
+                // Insertion sort, nearest first (ties: nearer box centre).
+                let mut at = nk;
+                while at > 0 && (kids[at - 1].0, kids[at - 1].1) > (lb, key2) {
+                    kids[at] = kids[at - 1];
+                    at -= 1;
+                }
+                kids[at] = (lb, key2, node.child[c]);
+                nk += 1;
             }
-            if dn < bound && sp < stack.len() {
-                stack[sp] = (near, dn);
-                sp += 1;
+            for k in (0..nk).rev() {
+                if sp < stack.len() {
+                    stack[sp] = (kids[k].2, kids[k].0);
+                    sp += 1;
+                }
             }
         }
         // A best point held on an interior leaf edge is not yet stationary for the whole
@@ -747,28 +824,52 @@ impl SurfaceProjector {
                 _ => {}
             }
         }
+        if let Some((b, true)) = best {
+            // The best is a stationary (KKT) point inside a neighbour sharing a whole edge
+            // across which the surface is C¹: if both leaves are certified convex, the
+            // distance is convex on their union (a rectangle; piecewise convex and C¹), whose
+            // unique minimum is then the best — nothing closer here.
+            for (k, &nb) in leaf.edge_neighbours.iter().enumerate() {
+                let Some(n) = self.leaves.get(nb as usize) else {
+                    continue;
+                };
+                if !leaf.exclude_towards[k] {
+                    continue;
+                }
+                if b.u >= n.u0 && b.u <= n.u1 && b.v >= n.v0 && b.v <= n.v1 {
+                    let c = *certified.get_or_insert_with(|| leaf.hess.certifies(&leaf.obb, q));
+                    if c && n.hess.certifies(&n.obb, q) {
+                        return None;
+                    }
+                    break;
+                }
+            }
+        }
         let patch = &self.patches[leaf.patch];
-        let mut start = (leaf.samples[0].0, leaf.samples[0].1);
-        let mut d_start = f64::INFINITY;
+        // Start from the current best clamped into the leaf when it lies just across an
+        // edge (it is then next to the leaf's own minimum), else from the nearest sample.
+        let mut clamped = None;
         if let Some((b, _)) = best {
-            // The current best clamped into the leaf: near a shared edge this starts Newton
-            // next to the leaf's own minimum.
             let cu = b.u.clamp(leaf.u0, leaf.u1);
             let cv = b.v.clamp(leaf.v0, leaf.v1);
             if (cu - b.u).abs() <= 0.25 * (leaf.u1 - leaf.u0)
                 && (cv - b.v).abs() <= 0.25 * (leaf.v1 - leaf.v0)
             {
-                start = (cu, cv);
-                d_start = (patch.point(cu, cv) - q).norm_squared();
+                clamped = Some((cu, cv));
             }
         }
-        for (u, v, p) in &leaf.samples {
-            let d = (p - q).norm_squared();
-            if d < d_start {
-                d_start = d;
-                start = (*u, *v);
+        let start = clamped.unwrap_or_else(|| {
+            let mut start = (leaf.samples[0].0, leaf.samples[0].1);
+            let mut d_start = f64::INFINITY;
+            for (u, v, p) in &leaf.samples {
+                let d = (p - q).norm_squared();
+                if d < d_start {
+                    d_start = d;
+                    start = (*u, *v);
+                }
             }
-        }
+            start
+        });
         let mut l = minimise(
             |u, v| patch.derivs2(u, v),
             q,
@@ -1044,8 +1145,41 @@ fn make_leaf(
         cone_v,
         obb_half_diag,
         exclude_towards,
+        edge_neighbours: [u32::MAX; 4],
         samples,
         hess,
+    }
+}
+
+/// Records, for every leaf, the leaves that share one of its edges entirely (same edge
+/// parameter and the same extent in the other direction).
+fn link_edge_neighbours(leaves: &mut [Leaf]) {
+    use std::collections::HashMap;
+    // Key: (direction, edge parameter, extent start, extent end) as bit patterns; value:
+    // (leaf, side) pairs on that edge.
+    type EdgeKey = (u8, u64, u64, u64);
+    let mut edges: HashMap<EdgeKey, Vec<(usize, usize)>> = HashMap::new();
+    for (i, l) in leaves.iter().enumerate() {
+        let keys = [
+            (
+                (0u8, l.u0.to_bits(), l.v0.to_bits(), l.v1.to_bits()),
+                0usize,
+            ),
+            ((0u8, l.u1.to_bits(), l.v0.to_bits(), l.v1.to_bits()), 1),
+            ((1u8, l.v0.to_bits(), l.u0.to_bits(), l.u1.to_bits()), 2),
+            ((1u8, l.v1.to_bits(), l.u0.to_bits(), l.u1.to_bits()), 3),
+        ];
+        for (key, side) in keys {
+            edges.entry(key).or_default().push((i, side));
+        }
+    }
+    for sharing in edges.values() {
+        if let [(a, sa), (b, sb)] = sharing[..] {
+            if sa != sb {
+                leaves[a].edge_neighbours[sa] = b as u32;
+                leaves[b].edge_neighbours[sb] = a as u32;
+            }
+        }
     }
 }
 

@@ -1,0 +1,328 @@
+//! `report.json` (fixed metric names, read by regressions and dashboards) and `report.html`
+//! (the same figures for a person, with inline SVG plots).
+
+use crate::error::CliError;
+use crate::plot::{heat_map, line_chart, Series};
+use impeller_model::{Impeller, Side};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One operation's figures (DESIGN §4: `moves`, `path_length_mm`, `cutting_time_s`,
+/// `plan_ms`).
+#[derive(Debug, Clone, Serialize)]
+pub struct OperationReport {
+    /// Operation name.
+    pub name: String,
+    /// Operation kind (`cl_import` for CL data read from a file).
+    pub kind: String,
+    /// Tool name.
+    pub tool: String,
+    /// Number of moves.
+    pub moves: usize,
+    /// Tool-tip travel, rapids included (mm).
+    pub path_length_mm: f64,
+    /// Estimated machining time (s).
+    pub cutting_time_s: f64,
+    /// Planning time (ms).
+    pub plan_ms: f64,
+}
+
+/// Post-processing figures summed over the operations.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct PostReport {
+    /// Machine name.
+    pub machine: String,
+    /// Dialect name.
+    pub dialect: String,
+    /// Program file written (empty when there was nothing to post).
+    pub program: String,
+    /// Whether a program was written.
+    pub written: bool,
+    /// NC blocks.
+    pub blocks: usize,
+    /// Rotary direction reversals before smoothing.
+    pub reverse_motions_before: usize,
+    /// Rotary direction reversals after smoothing.
+    pub reverse_motions_after: usize,
+    /// Largest tool-tip deviation from the straight line between blocks (mm).
+    pub max_linearisation_error_mm: f64,
+    /// Blocks outside the machine limits.
+    pub limit_violations: usize,
+}
+
+/// Verification figures.
+#[derive(Debug, Clone, Serialize)]
+pub struct VerificationReport {
+    /// Largest depth of removed design material (mm).
+    pub max_overcut_mm: f64,
+    /// Largest thickness of material left outside the design (mm).
+    pub max_residual_mm: f64,
+    /// Moves with a shank/holder collision or a rapid through material.
+    pub collisions: usize,
+    /// Dexel spacing used (mm).
+    pub resolution_mm: f64,
+    /// Locations of the extrema, collision list, simulation statistics.
+    pub details: serde_json::Value,
+}
+
+/// The whole report.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// Job name.
+    pub job: String,
+    /// `impeller-cam` version.
+    pub version: String,
+    /// Impeller summary.
+    pub impeller: serde_json::Value,
+    /// Operations in program order.
+    pub operations: Vec<OperationReport>,
+    /// Post-processing.
+    pub post: PostReport,
+    /// Verification (`null` when nothing was verified).
+    pub verification: Option<VerificationReport>,
+    /// Wall-clock time per stage (ms).
+    pub timings_ms: BTreeMap<String, f64>,
+    /// What was skipped and why, and reader warnings.
+    pub notes: Vec<String>,
+    #[serde(skip)]
+    plots: Vec<String>,
+}
+
+impl Report {
+    /// An empty report for job `name`.
+    pub fn new(name: &str) -> Self {
+        Self {
+            job: name.to_string(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            impeller: serde_json::Value::Null,
+            operations: Vec::new(),
+            post: PostReport::default(),
+            verification: None,
+            timings_ms: BTreeMap::new(),
+            notes: Vec::new(),
+            plots: Vec::new(),
+        }
+    }
+
+    /// Meridional view (hub and shroud contours, blade hub and shroud edges in (z, r)) and
+    /// the top view of all blades at hub and shroud.
+    pub fn set_geometry_plots(&mut self, imp: &Impeller) {
+        const N: usize = 80;
+        let contour = |m: &impeller_model::MeridionalCurve| -> Vec<(f64, f64)> {
+            let (t0, t1) = m.domain();
+            (0..=N)
+                .map(|i| {
+                    let p = m.point(t0 + (t1 - t0) * i as f64 / N as f64);
+                    (p.x, p.y)
+                })
+                .collect()
+        };
+        let mut merid = vec![
+            Series {
+                label: "hub".into(),
+                points: contour(imp.hub().meridional()),
+            },
+            Series {
+                label: "shroud".into(),
+                points: contour(imp.shroud().meridional()),
+            },
+        ];
+        let mut top = Vec::new();
+        let sets =
+            std::iter::once(("main", imp.main())).chain(imp.splitter().map(|s| ("splitter", s)));
+        for (label, set) in sets {
+            let side = set.blade().side(Side::Pressure);
+            let ((u0, u1), (v0, v1)) = side.domain();
+            let edge = |v: f64| -> Vec<cam_core::Vector3> {
+                (0..=N)
+                    .map(|i| side.point(u0 + (u1 - u0) * i as f64 / N as f64, v))
+                    .collect()
+            };
+            let (hub_edge, tip_edge) = (edge(v0), edge(v1));
+            let zr = |pts: &[cam_core::Vector3]| -> Vec<(f64, f64)> {
+                pts.iter().map(|p| (p.z, p.x.hypot(p.y))).collect()
+            };
+            merid.push(Series {
+                label: format!("{label} blade, hub edge"),
+                points: zr(&hub_edge),
+            });
+            merid.push(Series {
+                label: format!("{label} blade, tip edge"),
+                points: zr(&tip_edge),
+            });
+            // Top view: every instance of the blade's tip edge, separated by NaN gaps.
+            let mut pts = Vec::new();
+            for k in 0..set.count() {
+                let rot = set.rotation(k);
+                for p in &tip_edge {
+                    let q = rot * p;
+                    pts.push((q.x, q.y));
+                }
+                pts.push((f64::NAN, f64::NAN));
+            }
+            top.push(Series {
+                label: format!("{label} blades (tip edge)"),
+                points: pts,
+            });
+        }
+        self.plots.push(line_chart(
+            "Meridional view",
+            "z (mm)",
+            "r (mm)",
+            &merid,
+            true,
+        ));
+        self.plots
+            .push(line_chart("Top view", "x (mm)", "y (mm)", &top, true));
+    }
+
+    /// Heat maps of overcut and residual on the surfaces where each is largest (at most
+    /// three surfaces each).
+    pub fn add_map_plots(&mut self, maps: &[machining_sim::SurfaceMap]) {
+        let worst = |m: &machining_sim::SurfaceMap, residual: bool| -> f64 {
+            let v = if residual {
+                &m.residual_mm
+            } else {
+                &m.overcut_mm
+            };
+            v.iter().flatten().fold(0.0, |a: f64, &b| a.max(b))
+        };
+        for residual in [false, true] {
+            let mut order: Vec<&machining_sim::SurfaceMap> = maps
+                .iter()
+                .filter(|m| worst(m, residual) > 0.0 && m.nu > 0 && m.nv > 0)
+                .collect();
+            order.sort_by(|a, b| worst(b, residual).total_cmp(&worst(a, residual)));
+            for m in order.into_iter().take(3) {
+                let v = if residual {
+                    &m.residual_mm
+                } else {
+                    &m.overcut_mm
+                };
+                // Samples are stored v-major (index j·nu + i); rows of the plot are v.
+                let grid: Vec<Vec<f64>> = (0..m.nv)
+                    .map(|j| {
+                        (0..m.nu)
+                            .map(|i| v.get(j * m.nu + i).copied().flatten().unwrap_or(f64::NAN))
+                            .collect()
+                    })
+                    .collect();
+                let title = format!(
+                    "{} on {} (u along the flow → , v up)",
+                    if residual { "Residual" } else { "Overcut" },
+                    m.name
+                );
+                self.plots
+                    .push(heat_map(&title, &grid, 0.0, worst(m, residual), "mm"));
+            }
+        }
+    }
+
+    /// Writes `report.json` and `report.html` into `dir` (each through a temporary file).
+    pub fn write(&self, dir: &Path) -> Result<(), CliError> {
+        let json = serde_json::to_string_pretty(self)
+            .map_err(|e| CliError::Message(format!("cannot format report: {e}")))?;
+        write(&dir.join("report.json"), json.as_bytes())?;
+        write(&dir.join("report.html"), self.html().as_bytes())
+    }
+
+    fn html(&self) -> String {
+        let mut h = String::new();
+        let _ = write!(
+            h,
+            "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{0} — impeller-cam report</title>\
+             <style>body{{font-family:sans-serif;max-width:1200px;margin:2em auto}}\
+             table{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}\
+             th{{background:#f3f3f3}}td:first-child{{text-align:left}}</style></head><body>\
+             <h1>{0}</h1><p>impeller-cam {1}</p>",
+            esc(&self.job),
+            esc(&self.version)
+        );
+        h.push_str("<h2>Impeller</h2>");
+        table_of_object(&mut h, &self.impeller);
+        for svg in &self.plots {
+            h.push_str(svg);
+        }
+        h.push_str("<h2>Operations</h2>");
+        if self.operations.is_empty() {
+            h.push_str("<p>No operation.</p>");
+        } else {
+            h.push_str("<table><tr><th>name</th><th>kind</th><th>tool</th><th>moves</th><th>path length (mm)</th><th>cutting time (s)</th><th>plan (ms)</th></tr>");
+            for o in &self.operations {
+                let _ = write!(
+                    h,
+                    "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td></tr>",
+                    esc(&o.name),
+                    esc(&o.kind),
+                    esc(&o.tool),
+                    o.moves,
+                    o.path_length_mm,
+                    o.cutting_time_s,
+                    o.plan_ms
+                );
+            }
+            h.push_str("</table>");
+        }
+        h.push_str("<h2>Post-processing</h2>");
+        table_of_object(
+            &mut h,
+            &serde_json::to_value(&self.post).unwrap_or_default(),
+        );
+        h.push_str("<h2>Verification</h2>");
+        match &self.verification {
+            Some(v) => {
+                let _ = write!(
+                    h,
+                    "<table><tr><th>max overcut (mm)</th><th>max residual (mm)</th><th>collisions</th><th>resolution (mm)</th></tr>\
+                     <tr><td>{:.4}</td><td>{:.4}</td><td>{}</td><td>{}</td></tr></table>",
+                    v.max_overcut_mm, v.max_residual_mm, v.collisions, v.resolution_mm
+                );
+            }
+            None => h.push_str("<p>Nothing was verified.</p>"),
+        }
+        h.push_str("<h2>Timings (ms)</h2>");
+        table_of_object(
+            &mut h,
+            &serde_json::to_value(&self.timings_ms).unwrap_or_default(),
+        );
+        if !self.notes.is_empty() {
+            h.push_str("<h2>Notes</h2><ul>");
+            for n in &self.notes {
+                let _ = write!(h, "<li>{}</li>", esc(n));
+            }
+            h.push_str("</ul>");
+        }
+        h.push_str("</body></html>\n");
+        h
+    }
+}
+
+fn table_of_object(h: &mut String, v: &serde_json::Value) {
+    if let serde_json::Value::Object(m) = v {
+        h.push_str("<table>");
+        for (k, v) in m {
+            let text = match v {
+                serde_json::Value::Number(n) => match n.as_f64() {
+                    Some(f) if n.is_f64() => format!("{f:.4}"),
+                    _ => n.to_string(),
+                },
+                serde_json::Value::String(s) => s.clone(),
+                other => other.to_string(),
+            };
+            let _ = write!(h, "<tr><td>{}</td><td>{}</td></tr>", esc(k), esc(&text));
+        }
+        h.push_str("</table>");
+    }
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
+    gcode_emit::write_atomic(path, bytes).map_err(|e| CliError::Message(e.to_string()))
+}

@@ -1,0 +1,187 @@
+//! `impeller-cam run` end to end: default job, a job with CL data from another CAM system
+//! (posted, accepted by LinuxCNC's rs274, verified by simulation), and user errors.
+#![allow(clippy::unwrap_used)] // test helpers
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+fn cli() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_impeller-cam"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("impeller-cam-run-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn report(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn default_job_reports_the_impeller_and_says_nothing_was_machined() {
+    let out = scratch("default");
+    let st = cli().args(["run", "--out"]).arg(&out).output().unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let r = report(&out);
+    assert_eq!(r["impeller"]["main_blade_count"], 8);
+    assert_eq!(r["impeller"]["splitter_blade_count"], 8);
+    let d = r["impeller"]["blade_tip_diameter_mm"].as_f64().unwrap();
+    assert!((d - 77.0).abs() < 0.5, "{d}");
+    assert_eq!(r["operations"].as_array().unwrap().len(), 0);
+    assert!(r["notes"][0].as_str().unwrap().contains("no operation"));
+    for k in ["model_ms", "plan_ms", "post_ms", "verify_ms", "total_ms"] {
+        assert!(r["timings_ms"][k].as_f64().is_some(), "{k}");
+    }
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("<svg") && html.contains("Meridional view"));
+}
+
+/// A five-axis ring cut in the stock above the impeller's shroud contour (r = 30 mm, top
+/// 0.5 mm of the 44 mm blank, axis tilted 10° outward): it removes stock but must not touch
+/// the design.
+fn ring_cl() -> String {
+    let mut s = String::from(
+        "PARTNO RING TEST\nUNITS/MM\nMULTAX/ON\nLOADTL/1\nCUTTER/6.0,0.0,0.0,0.0,0.0,0.0,40.0\n\
+         SPINDL/RPM,10000,CLW\nRAPID\nGOTO/30.0,0.0,60.0,0.1736482,0.0,0.9848078\nFEDRAT/MMPM,800\n",
+    );
+    let tilt = 10f64.to_radians();
+    for k in 0..=72 {
+        let phi = (k as f64 * 2.5).to_radians();
+        let (c, sn) = (phi.cos(), phi.sin());
+        s.push_str(&format!(
+            "GOTO/{:.6},{:.6},{:.6},{:.7},{:.7},{:.7}\n",
+            30.0 * c,
+            30.0 * sn,
+            43.5,
+            tilt.sin() * c,
+            tilt.sin() * sn,
+            tilt.cos()
+        ));
+    }
+    s.push_str("FINI\n");
+    s
+}
+
+#[test]
+fn job_with_cl_data_is_posted_accepted_by_rs274_and_verified() {
+    let dir = scratch("cljob");
+    std::fs::write(dir.join("ring.cls"), ring_cl()).unwrap();
+    let imp = repo().join("fixtures/impeller-8+8/impeller.toml");
+    let machine = repo().join("fixtures/machines/xyzac-trt.toml");
+    std::fs::write(
+        dir.join("job.toml"),
+        format!(
+            "name = \"ring\"\nimpeller = {:?}\nmachine = {:?}\ndialect = \"linuxcnc\"\n\
+             [verification]\nresolution_mm = 0.5\n[[cl_files]]\npath = \"ring.cls\"\n",
+            imp.display().to_string(),
+            machine.display().to_string()
+        ),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let st = cli()
+        .arg("run")
+        .arg(dir.join("job.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let r = report(&out);
+    let op = &r["operations"][0];
+    assert_eq!(op["moves"], 74);
+    // 72 chords of a 2.5° step on r = 30 mm plus the 16.5 mm plunge from the rapid point.
+    let chord = 2.0 * 30.0 * (1.25f64.to_radians()).sin();
+    let expected = 72.0 * chord + 16.5;
+    let len = op["path_length_mm"].as_f64().unwrap();
+    assert!((len - expected).abs() < 1e-3, "{len} vs {expected}");
+    assert_eq!(r["post"]["limit_violations"], 0);
+    assert!(r["post"]["max_linearisation_error_mm"].as_f64().unwrap() <= 0.005 + 1e-9);
+    let v = &r["verification"];
+    // The ring stays outside the design: no overcut beyond the dexel resolution.
+    assert!(v["max_overcut_mm"].as_f64().unwrap() <= 0.5, "{v}");
+    assert_eq!(v["collisions"], 0, "{v}");
+    // The CL file written back contains every move.
+    let cls = std::fs::read_to_string(out.join("toolpath.cls")).unwrap();
+    assert_eq!(cls.matches("GOTO/").count(), 74);
+    // LinuxCNC's own interpreter accepts the program.
+    let program = out.join("program.ngc");
+    assert!(program.is_file());
+    match which("rs274") {
+        Some(rs) => {
+            let tbl = dir.join("tool.tbl");
+            std::fs::write(&tbl, "T1 P1 Z0 D6 ;ring\n").unwrap();
+            let res = Command::new(rs)
+                .arg("-t")
+                .arg(&tbl)
+                .arg("-g")
+                .arg(&program)
+                .current_dir(&dir)
+                .env("HOME", &dir)
+                .stdin(Stdio::null())
+                .output()
+                .unwrap();
+            let stderr = String::from_utf8_lossy(&res.stderr);
+            assert!(res.status.success(), "{stderr}");
+            let noise: Vec<&str> = stderr
+                .lines()
+                .filter(|l| !l.trim().is_empty() && l.trim() != "executing")
+                .collect();
+            assert!(noise.is_empty(), "rs274: {noise:?}");
+            let feeds = String::from_utf8_lossy(&res.stdout)
+                .matches("STRAIGHT_FEED")
+                .count();
+            assert!(feeds >= 73, "{feeds} feed moves");
+        }
+        None if std::env::var("IMPELLER_SKIP_RS274").as_deref() == Ok("1") => {}
+        None => panic!("rs274 not on PATH (apt-get install linuxcnc-uspace, as .ci/run does)"),
+    }
+}
+
+fn which(name: &str) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|d| d.join(name))
+        .find(|p| p.is_file())
+}
+
+#[test]
+fn bad_job_files_exit_1_with_file_and_line() {
+    let dir = scratch("bad");
+    std::fs::write(dir.join("job.toml"), "name = \"x\"\ndialekt = \"fanuc\"\n").unwrap();
+    let st = cli()
+        .arg("run")
+        .arg(dir.join("job.toml"))
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("job.toml:2:") && err.contains("dialekt"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"));
+    let st = cli()
+        .args(["run", "/nonexistent/job.toml", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(1));
+}

@@ -1,0 +1,52 @@
+//! `impeller-cam stiffness` end to end: JSON contract and user errors.
+#![allow(clippy::approx_constant)] // 3.14 mm is a published cutter radius, not π.
+
+use std::process::Command;
+
+fn cli() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_impeller-cam"))
+}
+
+#[test]
+fn json_has_the_contract_fields_and_matches_the_closed_form() {
+    let out = cli()
+        .args([
+            "stiffness",
+            "--tip-radius",
+            "3.14",
+            "--half-angle",
+            "3",
+            "--length",
+            "40",
+            "--youngs",
+            "600",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let k = v["stiffness_n_per_mm"].as_f64().unwrap();
+    let exact = v["exact_n_per_mm"].as_f64().unwrap();
+    // k = 3πE r R³ / (4L³), R = r + L tan θ, E = 600 000 N/mm².
+    let r_big = 3.14 + 40.0 * 3f64.to_radians().tan();
+    let closed = 3.0 * std::f64::consts::PI * 600e3 * 3.14 * r_big.powi(3) / (4.0 * 40f64.powi(3));
+    assert!((exact / closed - 1.0).abs() < 1e-12);
+    assert!((k / closed - 1.0).abs() < 1e-9);
+    assert!(v["terms"].as_u64().unwrap() >= 2);
+    assert!(v["d_stiffness_d_radius"].as_f64().unwrap() > 0.0);
+    assert!(v["d_stiffness_d_half_angle_deg"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn invalid_values_exit_1_with_one_line() {
+    let out = cli()
+        .args(["stiffness", "--tip-radius", "-1", "--length", "40"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("bottom_radius"), "{err}");
+    assert!(!err.contains("panicked"));
+}

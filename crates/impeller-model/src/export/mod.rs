@@ -1,0 +1,12 @@
+//! Exporters: binary STL of impeller parts within a chord tolerance, and TurboGrid curve
+//! files that the importer reads back. Every file is written to a temporary file and renamed.
+
+mod atomic;
+pub mod curves;
+pub mod error;
+pub mod stl;
+
+pub use atomic::write_atomic;
+pub use curves::{write_curves, CurveFiles, CurveSampling};
+pub use error::ExportError;
+pub use stl::{mesh_parts, stl_bytes, tessellate, write_stl, Part, StlStats, TriMesh};

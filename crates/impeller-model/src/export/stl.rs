@@ -1,0 +1,269 @@
+//! Triangulated export of impeller parts as binary STL.
+//!
+//! **Tessellation.** Each NURBS surface is sampled on a tensor-product grid of parameter
+//! breakpoints refined until the chord check passes: an interval of u is halved while, on any
+//! grid line of v, the surface point at the interval's midpoint is farther than `chord_tol`
+//! from the midpoint of the chord between the interval's end points (and likewise for v);
+//! each cell is then split into two triangles along a diagonal and both cells' centres are
+//! checked against that diagonal's midpoint, halving both intervals of a failing cell. The
+//! check is made at those sample points (edge midpoints and cell centres), the usual chord
+//! criterion. Refinement stops with an error past 2¹⁶ intervals in a direction.
+//! Cost O(n_u · n_v) surface evaluations per refinement pass.
+//!
+//! Blades are tessellated once per row and rotated to every copy. The file is a surface
+//! model (a triangle soup of the chosen faces, normals from the vertex order), not a closed
+//! solid: blade sides extend through hub and shroud as the model does.
+
+use super::atomic::write_atomic;
+use super::error::ExportError;
+use crate::impeller::Impeller;
+use nalgebra::Vector3;
+use nurbs::NurbsSurface;
+use std::path::Path;
+
+/// Largest number of intervals per parameter direction.
+const MAX_INTERVALS: usize = 1 << 16;
+
+/// A part of the impeller to export.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    /// The hub (full surface of revolution).
+    Hub,
+    /// The shroud contour surface (the casing side of the blade tips; not material).
+    Shroud,
+    /// Both sides of every main blade.
+    MainBlades,
+    /// Both sides of every splitter blade.
+    SplitterBlades,
+    /// Hub and all blades: the machined part.
+    Impeller,
+}
+
+/// A triangle mesh.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions, mm.
+    pub vertices: Vec<Vector3<f64>>,
+    /// Triangles as vertex indices (counter-clockwise seen from the S_u × S_v side).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriMesh {
+    /// Appends `other`, with every vertex mapped by `f`.
+    pub fn append_mapped(&mut self, other: &TriMesh, f: impl Fn(&Vector3<f64>) -> Vector3<f64>) {
+        let base = self.vertices.len() as u32;
+        self.vertices.extend(other.vertices.iter().map(f));
+        self.triangles.extend(
+            other
+                .triangles
+                .iter()
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
+    }
+}
+
+/// What was written.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StlStats {
+    /// Number of triangles.
+    pub triangles: usize,
+    /// The chord tolerance honoured, mm.
+    pub chord_tol_mm: f64,
+}
+
+fn mid_dev(s: &NurbsSurface, a: (f64, f64), b: (f64, f64)) -> f64 {
+    let pm = s.point(0.5 * (a.0 + b.0), 0.5 * (a.1 + b.1));
+    let chord = 0.5 * (s.point(a.0, a.1) + s.point(b.0, b.1));
+    (pm - chord).norm()
+}
+
+/// Splits each interval of `breaks` for which `fails(lo, hi)` holds; returns whether any was.
+fn refine(breaks: &mut Vec<f64>, fails: impl Fn(f64, f64) -> bool) -> bool {
+    let mut out = Vec::with_capacity(breaks.len() * 2);
+    let mut any = false;
+    for w in breaks.windows(2) {
+        out.push(w[0]);
+        if fails(w[0], w[1]) {
+            out.push(0.5 * (w[0] + w[1]));
+            any = true;
+        }
+    }
+    if let Some(&last) = breaks.last() {
+        out.push(last);
+    }
+    *breaks = out;
+    any
+}
+
+/// Triangulates a surface within `chord_tol` (see the module docs).
+pub fn tessellate(s: &NurbsSurface, chord_tol: f64, name: &str) -> Result<TriMesh, ExportError> {
+    if !(chord_tol.is_finite() && chord_tol > 0.0) {
+        return Err(ExportError::Invalid {
+            field: "chord_tol_mm",
+            reason: format!("{chord_tol} is not a positive length"),
+        });
+    }
+    let ((u0, u1), (v0, v1)) = s.domain();
+    // Start from the knot breaks so every polynomial piece is sampled.
+    let start = |knots: &[f64], a: f64, b: f64| {
+        let mut v: Vec<f64> = vec![a];
+        for &k in knots {
+            if k > a && k < b && v.last().is_some_and(|&l| k > l) {
+                v.push(k);
+            }
+        }
+        v.push(b);
+        v
+    };
+    let mut us = start(s.knots_u().knots(), u0, u1);
+    let mut vs = start(s.knots_v().knots(), v0, v1);
+    loop {
+        if us.len() > MAX_INTERVALS || vs.len() > MAX_INTERVALS {
+            return Err(ExportError::Tessellation {
+                part: name.to_string(),
+                reason: format!(
+                    "chord tolerance {chord_tol} mm not reached with {MAX_INTERVALS} intervals"
+                ),
+            });
+        }
+        let vs_now = vs.clone();
+        let us_now = us.clone();
+        let a = refine(&mut us, |lo, hi| {
+            vs_now
+                .iter()
+                .any(|&v| mid_dev(s, (lo, v), (hi, v)) > chord_tol)
+        });
+        let b = refine(&mut vs, |lo, hi| {
+            us_now
+                .iter()
+                .any(|&u| mid_dev(s, (u, lo), (u, hi)) > chord_tol)
+        });
+        if a || b {
+            continue;
+        }
+        // Cell centres against the diagonal (u_i, v_j) – (u_{i+1}, v_{j+1}).
+        let mut split_u = vec![false; us.len() - 1];
+        let mut split_v = vec![false; vs.len() - 1];
+        for i in 0..us.len() - 1 {
+            for j in 0..vs.len() - 1 {
+                if mid_dev(s, (us[i], vs[j]), (us[i + 1], vs[j + 1])) > chord_tol {
+                    split_u[i] = true;
+                    split_v[j] = true;
+                }
+            }
+        }
+        if !split_u.iter().any(|&x| x) {
+            break;
+        }
+        let split = |breaks: &mut Vec<f64>, flags: &[bool]| {
+            let mut out = Vec::with_capacity(breaks.len() * 2);
+            for (k, w) in breaks.windows(2).enumerate() {
+                out.push(w[0]);
+                if flags[k] {
+                    out.push(0.5 * (w[0] + w[1]));
+                }
+            }
+            out.extend(breaks.last().copied());
+            *breaks = out;
+        };
+        split(&mut us, &split_u);
+        split(&mut vs, &split_v);
+    }
+    let nv = vs.len();
+    let mut mesh = TriMesh::default();
+    for &u in &us {
+        for &v in &vs {
+            mesh.vertices.push(s.point(u, v));
+        }
+    }
+    for i in 0..us.len() - 1 {
+        for j in 0..nv - 1 {
+            let a = (i * nv + j) as u32;
+            let b = ((i + 1) * nv + j) as u32;
+            let c = ((i + 1) * nv + j + 1) as u32;
+            let d = (i * nv + j + 1) as u32;
+            mesh.triangles.push([a, b, c]);
+            mesh.triangles.push([a, c, d]);
+        }
+    }
+    Ok(mesh)
+}
+
+/// Triangulates the chosen parts of an impeller within `chord_tol` mm.
+pub fn mesh_parts(imp: &Impeller, parts: &[Part], chord_tol: f64) -> Result<TriMesh, ExportError> {
+    let mut mesh = TriMesh::default();
+    let want =
+        |p: Part| parts.contains(&p) || (parts.contains(&Part::Impeller) && p != Part::Shroud);
+    if want(Part::Hub) {
+        mesh.append_mapped(&tessellate(imp.hub().surface(), chord_tol, "hub")?, |p| *p);
+    }
+    if parts.contains(&Part::Shroud) {
+        mesh.append_mapped(
+            &tessellate(imp.shroud().surface(), chord_tol, "shroud")?,
+            |p| *p,
+        );
+    }
+    let rows = [
+        (Part::MainBlades, Some(imp.main()), "main blade"),
+        (Part::SplitterBlades, imp.splitter(), "splitter blade"),
+    ];
+    for (part, row, name) in rows {
+        let Some(row) = row.filter(|_| want(part)) else {
+            continue;
+        };
+        let b = row.blade();
+        let (p, s) = rayon::join(
+            || tessellate(b.pressure(), chord_tol, &format!("{name} pressure side")),
+            || tessellate(b.suction(), chord_tol, &format!("{name} suction side")),
+        );
+        let (p, s) = (p?, s?);
+        for k in 0..row.count() {
+            let rot = row.rotation(k);
+            mesh.append_mapped(&p, |q| rot * q);
+            mesh.append_mapped(&s, |q| rot * q);
+        }
+    }
+    Ok(mesh)
+}
+
+/// Binary STL bytes of a mesh (80-byte header, little-endian f32 normals and vertices).
+pub fn stl_bytes(mesh: &TriMesh, header: &str) -> Vec<u8> {
+    let mut out = Vec::with_capacity(84 + 50 * mesh.triangles.len());
+    let mut h = [b' '; 80];
+    for (d, s) in h.iter_mut().zip(header.bytes()) {
+        *d = s;
+    }
+    out.extend_from_slice(&h);
+    out.extend_from_slice(&(mesh.triangles.len() as u32).to_le_bytes());
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+        let n = (b - a)
+            .cross(&(c - a))
+            .try_normalize(0.0)
+            .unwrap_or_else(Vector3::zeros);
+        for v in [n, a, b, c] {
+            for x in v.iter() {
+                out.extend_from_slice(&(*x as f32).to_le_bytes());
+            }
+        }
+        out.extend_from_slice(&0u16.to_le_bytes());
+    }
+    out
+}
+
+/// Writes the chosen parts as a binary STL file within `chord_tol` mm (temporary file, then
+/// rename).
+pub fn write_stl(
+    imp: &Impeller,
+    parts: &[Part],
+    chord_tol: f64,
+    path: &Path,
+) -> Result<StlStats, ExportError> {
+    let mesh = mesh_parts(imp, parts, chord_tol)?;
+    let header = format!("impeller-cam {} chord {chord_tol} mm", imp.name());
+    write_atomic(path, &stl_bytes(&mesh, &header))?;
+    Ok(StlStats {
+        triangles: mesh.triangles.len(),
+        chord_tol_mm: chord_tol,
+    })
+}

@@ -1,0 +1,218 @@
+//! From an export file to an [`Impeller`]: read, prepare, fit, assemble.
+//!
+//! The stock of an imported impeller is a cylinder from z = 0 to the highest contour point
+//! plus `stock_margin_mm`, of radius the largest hub, shroud or blade radius plus the same
+//! margin (exports carry no blank). The fillet radius is not in any export format and comes
+//! from the options.
+
+use super::error::ImportError;
+use super::fit::{fit, FittedImpeller, DEFAULT_FIT_TOL_MM};
+use super::geomturbo::read_geomturbo;
+use super::prepare::prepare;
+use super::raw::{BladeRole, LengthUnit, RawImpeller};
+use super::rtzt::read_rtzt;
+use super::turbogrid::read_turbogrid;
+use crate::blade::{Blade, BladeKind, BladeSet};
+use crate::impeller::Impeller;
+use crate::meridional::MeridionalCurve;
+use crate::revolved::RevolvedSurface;
+use crate::stock::Stock;
+use std::path::Path;
+
+/// How an export is turned into an impeller.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImportOptions {
+    /// Largest allowed deviation of the fitted curves and surfaces from the data, mm.
+    pub fit_tol_mm: f64,
+    /// Cut hub and shroud to the bladed part widened by this fraction of its meridional
+    /// length on both sides; `None` keeps the contours whole.
+    pub trim_margin: Option<f64>,
+    /// Extension of blade sides beyond hub and shroud, fraction of the span.
+    pub span_extension: f64,
+    /// Blade-root fillet radius, mm.
+    pub fillet_radius_mm: f64,
+    /// Radial and axial allowance of the cylindrical stock beyond the part, mm.
+    pub stock_margin_mm: f64,
+    /// Name of the impeller (default: the file stem).
+    pub name: Option<String>,
+    /// Length unit of `rtzt` files (the format has none).
+    pub rtzt_unit: LengthUnit,
+}
+
+impl Default for ImportOptions {
+    fn default() -> Self {
+        Self {
+            fit_tol_mm: DEFAULT_FIT_TOL_MM,
+            trim_margin: Some(0.1),
+            span_extension: 0.05,
+            fillet_radius_mm: 0.0,
+            stock_margin_mm: 2.0,
+            name: None,
+            rtzt_unit: LengthUnit::Millimetre,
+        }
+    }
+}
+
+/// An imported impeller with the fitted geometry it was assembled from (fit deviations, the
+/// curves for export).
+#[derive(Debug, Clone)]
+pub struct Imported {
+    /// The impeller.
+    pub impeller: Impeller,
+    /// The fitted contours and blade sides with their achieved deviations.
+    pub fitted: FittedImpeller,
+}
+
+/// Which importer reads `path`, by extension: `.inf` TurboGrid, `.geomturbo` AutoGrid,
+/// `.rtzt` BladeGen (case-insensitive). `None` for anything else.
+pub fn is_import_extension(path: &Path) -> bool {
+    matches!(
+        path.extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+            .as_deref(),
+        Some("inf" | "geomturbo" | "rtzt")
+    )
+}
+
+/// Reads an export into raw point data, choosing the reader by extension (see
+/// [`is_import_extension`]).
+pub fn read_raw(path: &Path, rtzt_unit: LengthUnit) -> Result<RawImpeller, ImportError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("inf") => read_turbogrid(path),
+        Some("geomturbo") => read_geomturbo(path),
+        Some("rtzt") => read_rtzt(path, rtzt_unit),
+        _ => Err(ImportError::Invalid {
+            file: path.to_path_buf(),
+            line: 0,
+            field: "file extension".into(),
+            reason: "expected .inf (TurboGrid), .geomTurbo (AutoGrid) or .rtzt (BladeGen)".into(),
+        }),
+    }
+}
+
+/// Assembles an [`Impeller`] from fitted geometry.
+pub fn assemble(fitted: &FittedImpeller, opts: &ImportOptions) -> Result<Impeller, ImportError> {
+    let err = |entity: &str, e: crate::error::ModelError| ImportError::Geometry {
+        file: fitted.source.clone(),
+        entity: entity.to_string(),
+        reason: e.to_string(),
+    };
+    let hub_m = MeridionalCurve::new(fitted.hub.clone()).map_err(|e| err("hub", e))?;
+    let shroud_m = MeridionalCurve::new(fitted.shroud.clone()).map_err(|e| err("shroud", e))?;
+    let mut main = None;
+    let mut splitter = None;
+    let mut r_max: f64 = 0.0;
+    let mut z_max: f64 = 0.0;
+    for c in [&fitted.hub, &fitted.shroud] {
+        for p in c.control_points() {
+            r_max = r_max.max(p[1]);
+            z_max = z_max.max(p[0]);
+        }
+    }
+    for b in &fitted.blades {
+        let entity = format!("blade {:?}", b.name);
+        let kind = if b.sections == 2 {
+            BladeKind::Ruled
+        } else {
+            BladeKind::FreeForm
+        };
+        for s in [&b.pressure, &b.suction] {
+            for p in s.control_points() {
+                r_max = r_max.max(p.xy().norm());
+                z_max = z_max.max(p.z);
+            }
+        }
+        let blade = Blade::from_sides(kind, b.pressure.clone(), b.suction.clone(), None)
+            .map_err(|e| err(&entity, e))?;
+        let set = BladeSet::new(b.count, blade).map_err(|e| err(&entity, e))?;
+        let slot = match b.role {
+            BladeRole::Main => &mut main,
+            BladeRole::Splitter => &mut splitter,
+        };
+        if slot.is_some() {
+            return Err(ImportError::Geometry {
+                file: fitted.source.clone(),
+                entity,
+                reason: "only one main blade and one splitter row per impeller are supported"
+                    .into(),
+            });
+        }
+        *slot = Some(set);
+    }
+    let main = main.ok_or_else(|| ImportError::Geometry {
+        file: fitted.source.clone(),
+        entity: "blades".into(),
+        reason: "no main blade".into(),
+    })?;
+    let m = opts.stock_margin_mm.max(0.0);
+    let stock = Stock::from_profile(vec![[0.0, r_max + m], [z_max + m, r_max + m]])
+        .map_err(|e| err("stock", e))?;
+    let name = opts.name.clone().unwrap_or_else(|| {
+        fitted
+            .source
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("imported impeller")
+            .to_string()
+    });
+    Impeller::from_parts(
+        name,
+        RevolvedSurface::new(hub_m).map_err(|e| err("hub", e))?,
+        RevolvedSurface::new(shroud_m).map_err(|e| err("shroud", e))?,
+        main,
+        splitter,
+        opts.fillet_radius_mm,
+        stock,
+    )
+    .map_err(|e| err("impeller", e))
+}
+
+/// Fails when a fitted curve or surface misses its data by more than the tolerance, naming
+/// the entity and the deviation reached.
+pub fn check_tolerance(fitted: &FittedImpeller) -> Result<(), ImportError> {
+    let mut entities = vec![
+        ("hub".to_string(), fitted.hub_fit_mm),
+        ("shroud".to_string(), fitted.shroud_fit_mm),
+    ];
+    for b in &fitted.blades {
+        entities.push((
+            format!("blade {:?} pressure side", b.name),
+            b.pressure_fit_mm,
+        ));
+        entities.push((format!("blade {:?} suction side", b.name), b.suction_fit_mm));
+    }
+    match entities
+        .into_iter()
+        .find(|(_, e)| e.is_nan() || *e > fitted.tol_mm)
+    {
+        Some((entity, e)) => Err(ImportError::Geometry {
+            file: fitted.source.clone(),
+            entity,
+            reason: format!(
+                "the closest fit misses the data by {e:.4} mm, more than the tolerance {} mm \
+                 (an outlier or a kink in the data; a larger fit tolerance accepts it)",
+                fitted.tol_mm
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Prepares, fits and assembles raw export data; fails when the fit tolerance is not met.
+pub fn import_raw(raw: &RawImpeller, opts: &ImportOptions) -> Result<Imported, ImportError> {
+    let prepared = prepare(raw, opts.trim_margin)?;
+    let fitted = fit(&prepared, opts.fit_tol_mm, opts.span_extension)?;
+    check_tolerance(&fitted)?;
+    let impeller = assemble(&fitted, opts)?;
+    Ok(Imported { impeller, fitted })
+}
+
+/// Reads an export file (by extension) and turns it into an impeller.
+pub fn import_file(path: &Path, opts: &ImportOptions) -> Result<Imported, ImportError> {
+    import_raw(&read_raw(path, opts.rtzt_unit)?, opts)
+}

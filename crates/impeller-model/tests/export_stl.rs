@@ -1,0 +1,116 @@
+//! Binary STL export: the file format, the chord tolerance, atomic writing.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)]
+
+mod import_common;
+
+use impeller_model::export::{mesh_parts, stl_bytes, tessellate, write_stl, ExportError, Part};
+use impeller_model::fixtures::default_impeller;
+use impeller_model::meridional::MeridionalCurve;
+use nalgebra::Vector3;
+
+/// Every triangle's centroid and edge midpoints lie within the chord tolerance of the hub, a
+/// surface of revolution whose distance is known exactly through its meridional contour.
+#[test]
+fn hub_triangles_within_chord_tolerance() {
+    let imp = default_impeller().unwrap();
+    let tol = 0.02;
+    let mesh = tessellate(imp.hub().surface(), tol, "hub").unwrap();
+    let m = imp.hub().meridional();
+    let mut worst: f64 = 0.0;
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+        for q in [
+            (a + b + c) / 3.0,
+            (a + b) / 2.0,
+            (b + c) / 2.0,
+            (a + c) / 2.0,
+        ] {
+            worst = worst.max(m.closest(MeridionalCurve::zr_of(&q)).1.abs());
+        }
+    }
+    for v in &mesh.vertices {
+        assert!(m.closest(MeridionalCurve::zr_of(v)).1.abs() < 1e-9);
+    }
+    assert!(
+        worst <= tol,
+        "largest chord deviation {worst} mm > {tol} mm"
+    );
+    // Not needlessly fine either: the deviation uses a good part of the tolerance.
+    assert!(worst > 0.2 * tol, "{worst}");
+}
+
+#[test]
+fn binary_stl_layout() {
+    let imp = default_impeller().unwrap();
+    let mesh = mesh_parts(&imp, &[Part::MainBlades], 0.05).unwrap();
+    let bytes = stl_bytes(&mesh, "test");
+    let n = mesh.triangles.len();
+    assert!(n > 0);
+    assert_eq!(bytes.len(), 84 + 50 * n);
+    assert_eq!(
+        u32::from_le_bytes(bytes[80..84].try_into().unwrap()) as usize,
+        n
+    );
+    // First triangle's first vertex round-trips through f32.
+    let f = |o: usize| f32::from_le_bytes(bytes[o..o + 4].try_into().unwrap()) as f64;
+    let v0 = mesh.vertices[mesh.triangles[0][0] as usize];
+    let read = Vector3::new(f(84 + 12), f(84 + 16), f(84 + 20));
+    assert!((read - v0).norm() < 1e-4 * (1.0 + v0.norm()));
+    // Normal is unit length.
+    let nrm = Vector3::new(f(84), f(88), f(92));
+    assert!((nrm.norm() - 1.0).abs() < 1e-5);
+    // Every main blade copy is there: count × (pressure + suction) meshes of equal size.
+    let one = mesh_parts(&imp, &[Part::MainBlades], 0.05)
+        .unwrap()
+        .triangles
+        .len();
+    assert_eq!(one % (2 * imp.main().count()), 0);
+}
+
+#[test]
+fn whole_impeller_written_atomically() {
+    let imp = default_impeller().unwrap();
+    let dir = std::env::temp_dir().join(format!("impeller-stl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("impeller.stl");
+    let stats = write_stl(&imp, &[Part::Impeller], 0.05, &path).unwrap();
+    let len = std::fs::metadata(&path).unwrap().len() as usize;
+    assert_eq!(len, 84 + 50 * stats.triangles);
+    let parts = mesh_parts(
+        &imp,
+        &[Part::Hub, Part::MainBlades, Part::SplitterBlades],
+        0.05,
+    )
+    .unwrap();
+    assert_eq!(parts.triangles.len(), stats.triangles);
+    let names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, vec!["impeller.stl".to_string()]);
+    // A folder that does not exist: an I/O error, and nothing written.
+    let bad = dir.join("missing/sub/impeller.stl");
+    assert!(matches!(
+        write_stl(&imp, &[Part::Hub], 0.05, &bad),
+        Err(ExportError::Io { .. })
+    ));
+    assert!(matches!(
+        write_stl(&imp, &[Part::Hub], 0.0, &path),
+        Err(ExportError::Invalid { .. })
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn imported_centrifugal_exports_stl() {
+    let imp = impeller_model::load(import_common::centrifugal_geomturbo()).unwrap();
+    let mesh = mesh_parts(&imp, &[Part::Impeller], 0.05).unwrap();
+    let r_max = mesh
+        .vertices
+        .iter()
+        .map(|v| v.xy().norm())
+        .fold(0.0, f64::max);
+    // Hub trimmed 10 % beyond the 0.20 m trailing edge.
+    assert!(r_max > 200.0 && r_max < 240.0, "{r_max}");
+}
