@@ -22,16 +22,20 @@ pub fn run(args: Args) -> Result<bool, String> {
     let root = workspace_root();
     let target = target_dir();
     if !args.collect_only {
-        let mut cmd = Command::new(env_cargo());
-        cmd.current_dir(&root)
-            .args(["bench", "--workspace", "--benches", "--"]);
-        if args.quick {
-            cmd.arg("--quick");
+        // One `cargo bench` per criterion target: `--benches` alone would also hand
+        // criterion's flags to the libtest harness of every library.
+        for (package, bench) in bench_targets(&root)? {
+            let mut cmd = Command::new(env_cargo());
+            cmd.current_dir(&root)
+                .args(["bench", "-p", &package, "--bench", &bench, "--"]);
+            if args.quick {
+                cmd.arg("--quick");
+            }
+            if let Some(f) = &args.filter {
+                cmd.arg(f);
+            }
+            run_cmd(&mut cmd)?;
         }
-        if let Some(f) = &args.filter {
-            cmd.arg(f);
-        }
-        run_cmd(&mut cmd)?;
         // The closest-point query set, so other libraries can run exactly the same points.
         let csv = target.join("bench").join("closest_point_queries.csv");
         let mut ex = Command::new(env_cargo());
@@ -66,6 +70,29 @@ pub fn run(args: Args) -> Result<bool, String> {
     write_atomic(&out, text.as_bytes())?;
     println!("wrote {}", out.display());
     Ok(true)
+}
+
+/// (package, bench) for every `crates/<package>/benches/<bench>.rs`.
+fn bench_targets(root: &Path) -> Result<Vec<(String, String)>, String> {
+    let crates = root.join("crates");
+    let mut out = Vec::new();
+    let entries = std::fs::read_dir(&crates).map_err(|e| format!("{}: {e}", crates.display()))?;
+    for e in entries.flatten() {
+        let package = e.file_name().to_string_lossy().into_owned();
+        let Ok(benches) = std::fs::read_dir(e.path().join("benches")) else {
+            continue;
+        };
+        for b in benches.flatten() {
+            let p = b.path();
+            if p.extension().is_some_and(|x| x == "rs") {
+                if let Some(stem) = p.file_stem() {
+                    out.push((package.clone(), stem.to_string_lossy().into_owned()));
+                }
+            }
+        }
+    }
+    out.sort();
+    Ok(out)
 }
 
 fn env_cargo() -> String {
