@@ -26,6 +26,7 @@ const NB: usize = MAX_GUIDE_DEGREE + 1;
 pub struct GuideCurve {
     degree: usize,
     knots: Vec<f64>,
+    kv: nurbs::KnotVector,
     ctrl: Vec<Vector3>,
     weights: Option<Vec<f64>>,
 }
@@ -85,9 +86,14 @@ impl GuideCurve {
                 return bad("weights must be finite and > 0");
             }
         }
+        let kv =
+            nurbs::KnotVector::new(degree, knots.clone()).map_err(|_| CamError::InvalidGuide {
+                reason: "knot vector rejected by the nurbs crate (multiplicity too high)",
+            })?;
         Ok(Self {
             degree,
             knots,
+            kv,
             ctrl,
             weights,
         })
@@ -147,96 +153,19 @@ impl GuideCurve {
         (self.knots[self.degree], self.knots[self.ctrl.len()])
     }
 
-    /// Knot span index of `u` (clamped to the domain), NURBS Book A2.1 by binary search.
+    /// Knot span index of `u` (clamped to the domain), NURBS Book A2.1 (the `nurbs` kernel).
     pub fn find_span(&self, u: f64) -> usize {
-        let n = self.ctrl.len() - 1;
-        let p = self.degree;
-        if u >= self.knots[n + 1] {
-            return n;
-        }
-        if u <= self.knots[p] {
-            return p;
-        }
-        let (mut lo, mut hi) = (p, n + 1);
-        let mut mid = (lo + hi) / 2;
-        while u < self.knots[mid] || u >= self.knots[mid + 1] {
-            if u < self.knots[mid] {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-            mid = (lo + hi) / 2;
-        }
-        mid
+        self.kv.find_span(u)
     }
 
     /// Basis functions and their first two derivatives at `u` in span `span`
-    /// (NURBS Book A2.3 with n = 2, fixed arrays). `ders[k][j]` = k-th derivative of
-    /// `N_{span−p+j}`.
+    /// (NURBS Book A2.3 with n = 2, the `nurbs` crate's stack-array kernel). `ders[k][j]` =
+    /// k-th derivative of `N_{span−p+j}`.
     fn ders_basis(&self, span: usize, u: f64, ders: &mut [[f64; NB]; 3]) {
-        let p = self.degree;
-        let k = &self.knots;
-        let mut ndu = [[0.0; NB]; NB];
-        let mut left = [0.0; NB];
-        let mut right = [0.0; NB];
-        ndu[0][0] = 1.0;
-        for j in 1..=p {
-            left[j] = u - k[span + 1 - j];
-            right[j] = k[span + j] - u;
-            let mut saved = 0.0;
-            for r in 0..j {
-                ndu[j][r] = right[r + 1] + left[j - r];
-                let temp = ndu[r][j - 1] / ndu[j][r];
-                ndu[r][j] = saved + right[r + 1] * temp;
-                saved = left[j - r] * temp;
-            }
-            ndu[j][j] = saved;
-        }
-        for j in 0..=p {
-            ders[0][j] = ndu[j][p];
-        }
-        let nd = 2.min(p);
-        let mut a = [[0.0; NB]; 2];
-        for r in 0..=p {
-            let (mut s1, mut s2) = (0usize, 1usize);
-            a[0][0] = 1.0;
-            for kk in 1..=nd {
-                let mut d = 0.0;
-                let rk = r as isize - kk as isize;
-                let pk = p - kk;
-                if r >= kk {
-                    let rk = rk as usize;
-                    a[s2][0] = a[s1][0] / ndu[pk + 1][rk];
-                    d = a[s2][0] * ndu[rk][pk];
-                }
-                let j1: usize = if rk >= -1 { 1 } else { (-rk) as usize };
-                let j2: usize = if r as isize - 1 <= pk as isize {
-                    kk - 1
-                } else {
-                    p - r
-                };
-                for j in j1..=j2 {
-                    let idx = (rk + j as isize) as usize;
-                    a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
-                    d += a[s2][j] * ndu[idx][pk];
-                }
-                if r <= pk {
-                    a[s2][kk] = -a[s1][kk - 1] / ndu[pk + 1][r];
-                    d += a[s2][kk] * ndu[r][pk];
-                }
-                ders[kk][r] = d;
-                std::mem::swap(&mut s1, &mut s2);
-            }
-        }
-        let mut fac = p as f64;
-        for (kk, row) in ders.iter_mut().enumerate().take(nd + 1).skip(1) {
-            for v in row.iter_mut().take(p + 1) {
-                *v *= fac;
-            }
-            fac *= (p - kk) as f64;
-        }
-        for row in ders.iter_mut().skip(nd + 1) {
-            row.iter_mut().for_each(|v| *v = 0.0);
+        let mut full = [[0.0; nurbs::MAX_ORDER]; 3];
+        self.kv.ders_basis_funs_into(span, u, 2, &mut full);
+        for (row, src) in ders.iter_mut().zip(&full) {
+            row.copy_from_slice(&src[..NB]);
         }
     }
 

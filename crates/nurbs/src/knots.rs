@@ -244,6 +244,27 @@ impl KnotVector {
         out[..=self.degree].copy_from_slice(&n[..=self.degree]);
     }
 
+    /// Non-allocating form of [`KnotVector::ders_basis_funs`] for hot loops: writes the
+    /// derivatives of orders `0..=n` into `ders[0..=n][0..=p]` (rows above the degree are
+    /// zero). NURBS Book A2.3, O(p² + n p).
+    ///
+    /// `span` must come from [`KnotVector::find_span`] and `ders.len() > n` (otherwise this
+    /// panics: a caller bug, not an input error).
+    #[inline]
+    pub fn ders_basis_funs_into(
+        &self,
+        span: usize,
+        u: f64,
+        n: usize,
+        ders: &mut [[f64; MAX_ORDER]],
+    ) {
+        let du = n.min(self.degree);
+        ders_basis_fixed(&self.knots, self.degree, span, u, du, ders);
+        for row in ders.iter_mut().take(n + 1).skip(du + 1) {
+            row.iter_mut().for_each(|v| *v = 0.0);
+        }
+    }
+
     /// Basis functions and their derivatives up to order `n` (NURBS Book A2.3, O(p² + n p)):
     /// `ders[k][j]` is the `k`-th derivative of `N_{span-p+j,p}` at `u`. Orders above the
     /// degree are identically zero and returned as zero rows.
