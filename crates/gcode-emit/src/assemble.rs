@@ -14,8 +14,13 @@
 //!    inverse-time feeds), and each posted block becomes an [`NcMove`]: joint values in
 //!    [`OutputMode::Joint`] (all cutting blocks in inverse time), tool tip + axis angles in
 //!    [`OutputMode::TcpAngles`], tool tip + tool vector in [`OutputMode::TcpVector`].
+//!    With [`PostOptions::reverse_motion`] set, reverse motions of the rotary axes are removed
+//!    ([`postproc_kinematics::reverse_motion`]) and every changed posture is re-checked with
+//!    the operation's [`AccessibilityChecker`] ([`assemble_program_checked`],
+//!    [`assemble_program_with_access`]); each simultaneous operation's axis displacement
+//!    curves before and after removal come back in [`AssembledProgram::operations`].
 //!
-//! Cost: that of [`post_path`], O(n) otherwise.
+//! Cost: that of [`post_path_checked`], O(n) otherwise.
 
 use crate::dialect::Dialect;
 use crate::program::{
@@ -24,7 +29,8 @@ use crate::program::{
 use crate::{ClOperation, GcodeError};
 use cam_core::{CutterLocation, Move, MoveKind};
 use postproc_kinematics::{
-    post_path, AxisId, Joints, Machine, PostMetrics, PostOptions, PostedBlock,
+    post_path, post_path_checked, AccessibilityChecker, AxisId, DisplacementCurves, Joints,
+    Machine, PostMetrics, PostOptions, PostedBlock, ReverseMotionReport,
 };
 
 /// Options of [`assemble_program`].
@@ -66,6 +72,55 @@ pub struct AssembledProgram {
     pub program: NcProgram,
     /// (operation name, metrics) of every operation that went through kinematics.
     pub metrics: Vec<(String, PostMetrics)>,
+    /// The posted blocks and axis displacement curves of every operation that went through
+    /// kinematics (same order as `metrics`).
+    pub operations: Vec<PostedOperation>,
+}
+
+/// One simultaneous operation after post-processing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PostedOperation {
+    /// Operation name.
+    pub name: String,
+    /// Index of the operation in the input slice.
+    pub index: usize,
+    /// Post-processing metrics (same as in [`AssembledProgram::metrics`]).
+    pub metrics: PostMetrics,
+    /// Whether reverse-motion removal ran on this operation.
+    pub reverse_motion_removal: bool,
+    /// Details of reverse-motion removal when it ran.
+    pub reverse_motion: Option<ReverseMotionReport>,
+    /// Axis displacement curves (mm, deg against tool-tip path length) of the blocks before
+    /// reverse-motion removal and before linearisation control (equal to `after` when no
+    /// removal ran).
+    pub before: DisplacementCurves,
+    /// The curves after removal (before linearisation control).
+    pub after: DisplacementCurves,
+    /// The output blocks (approach and retract included, linearisation blocks inserted).
+    pub blocks: Vec<PostedBlock>,
+}
+
+/// How reverse-motion removal treats one operation in [`assemble_program_with_access`].
+#[derive(Clone, Copy)]
+pub enum OperationAccess<'a> {
+    /// Removal as [`PostOptions::reverse_motion`] says, changed postures not re-checked.
+    Unchecked,
+    /// Removal as [`PostOptions::reverse_motion`] says, every changed posture re-checked by
+    /// the checker (gouge and collision); a run that cannot be made accessible keeps its
+    /// original postures.
+    Checked(&'a dyn AccessibilityChecker),
+    /// No removal for this operation (reverse motions are only counted).
+    CountOnly,
+}
+
+impl std::fmt::Debug for OperationAccess<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Unchecked => "Unchecked",
+            Self::Checked(_) => "Checked(..)",
+            Self::CountOnly => "CountOnly",
+        })
+    }
 }
 
 /// Builds the program of `operations` on `machine` for `dialect` (see the module docs).
@@ -79,6 +134,49 @@ pub fn assemble_program(
     dialect: &dyn Dialect,
     options: &AssembleOptions,
 ) -> Result<AssembledProgram, GcodeError> {
+    assemble_program_checked(name, operations, machine, dialect, options, None)
+}
+
+/// [`assemble_program`] whose reverse-motion removal (when [`PostOptions::reverse_motion`]
+/// is set) re-checks every changed posture of every operation with `checker`
+/// ([`post_path_checked`]); `None` = no re-check.
+pub fn assemble_program_checked(
+    name: &str,
+    operations: &[ClOperation],
+    machine: &Machine,
+    dialect: &dyn Dialect,
+    options: &AssembleOptions,
+    checker: Option<&dyn AccessibilityChecker>,
+) -> Result<AssembledProgram, GcodeError> {
+    let access = match checker {
+        Some(c) => OperationAccess::Checked(c),
+        None => OperationAccess::Unchecked,
+    };
+    let access = vec![access; operations.len()];
+    assemble_program_with_access(name, operations, machine, dialect, options, &access)
+}
+
+/// [`assemble_program`] with one [`OperationAccess`] per operation (`access.len()` must equal
+/// `operations.len()`): operations machined with different cutters need different
+/// accessibility checkers, and an operation whose cutter is unknown cannot be checked.
+pub fn assemble_program_with_access(
+    name: &str,
+    operations: &[ClOperation],
+    machine: &Machine,
+    dialect: &dyn Dialect,
+    options: &AssembleOptions,
+    access: &[OperationAccess<'_>],
+) -> Result<AssembledProgram, GcodeError> {
+    if access.len() != operations.len() {
+        return Err(GcodeError::InvalidOption {
+            field: "access",
+            reason: format!(
+                "{} entries for {} operations",
+                access.len(),
+                operations.len()
+            ),
+        });
+    }
     if !(options.retract_mm.is_finite() && options.retract_mm >= 0.0) {
         return Err(GcodeError::InvalidOption {
             field: "retract_mm",
@@ -94,8 +192,9 @@ pub fn assemble_program(
     }
     let mut ops = Vec::with_capacity(operations.len());
     let mut metrics = Vec::new();
+    let mut posted_ops = Vec::new();
     let mut posture: Option<Joints> = options.post.initial;
-    for op in operations {
+    for (op_index, (op, op_access)) in operations.iter().zip(access).enumerate() {
         let path = &op.path;
         let (Some(first), Some(last)) = (path.moves.first(), path.moves.last()) else {
             return Err(GcodeError::Kinematics {
@@ -134,6 +233,7 @@ pub fn assemble_program(
             // the machine angles of the plane.
             let mut check = post.clone();
             check.linearisation_tol = None;
+            check.reverse_motion = None;
             let posted = post_path(machine, &moves, &check).map_err(|e| match e {
                 postproc_kinematics::PostError::Block { index, source } => {
                     kin_err(index, source.to_string())
@@ -172,7 +272,15 @@ pub fn assemble_program(
         if options.mode != OutputMode::Joint {
             post.linearisation_tol = None;
         }
-        let posted = post_path(machine, &moves, &post).map_err(|e| match e {
+        let checker = match op_access {
+            OperationAccess::Checked(c) => Some(*c),
+            OperationAccess::Unchecked => None,
+            OperationAccess::CountOnly => {
+                post.reverse_motion = None;
+                None
+            }
+        };
+        let posted = post_path_checked(machine, &moves, &post, checker).map_err(|e| match e {
             postproc_kinematics::PostError::Block { index, source } => {
                 kin_err(index, source.to_string())
             }
@@ -185,6 +293,31 @@ pub fn assemble_program(
             .map(|b| nc_move(machine, b, options.mode))
             .collect();
         metrics.push((path.name.clone(), posted.metrics));
+        let (before, after) = match &posted.reverse_motion {
+            Some(r) => (r.before.clone(), r.after.clone()),
+            None => {
+                // Without removal the curves are those of the source blocks (linearisation
+                // blocks left out, as in the removal report).
+                let source: Vec<PostedBlock> = posted
+                    .blocks
+                    .iter()
+                    .filter(|b| !b.inserted)
+                    .cloned()
+                    .collect();
+                let c = DisplacementCurves::of_blocks(machine, &source);
+                (c.clone(), c)
+            }
+        };
+        posted_ops.push(PostedOperation {
+            name: path.name.clone(),
+            index: op_index,
+            metrics: posted.metrics,
+            reverse_motion_removal: posted.reverse_motion.is_some(),
+            reverse_motion: posted.reverse_motion,
+            before,
+            after,
+            blocks: posted.blocks,
+        });
         ops.push(NcOperation {
             name: path.name.clone(),
             tool,
@@ -200,6 +333,7 @@ pub fn assemble_program(
             operations: ops,
         },
         metrics,
+        operations: posted_ops,
     })
 }
 
@@ -248,5 +382,147 @@ pub fn nc_move(machine: &Machine, b: &PostedBlock, mode: OutputMode) -> NcMove {
         rotary: rotary_words(machine, &b.joints),
         tool_vector: Some([b.cl.axis.x, b.cl.axis.y, b.cl.axis.z]),
         feed,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::LinuxCnc;
+    use cam_core::{Point3, ToolPath, Vector3};
+    use postproc_kinematics::ReverseMotionOptions;
+    use std::cell::Cell;
+
+    fn machine() -> Machine {
+        let text = include_str!("../../../fixtures/machines/xyzac-trt.toml");
+        Machine::from_toml_str(text, "xyzac-trt.toml").unwrap()
+    }
+
+    /// A ring pass (r = 30 mm, z = 20 mm) whose tool axis, tilted 10° from +Z, turns with the
+    /// tip's azimuth φ plus a local swing −A·u·exp(−u²), u = (φ − 60°)/5°, A = 10°: the
+    /// azimuth runs backwards near φ = 60°, so C reverses twice.
+    fn swing_op() -> ClOperation {
+        let mut path = ToolPath::new("swing", "T1");
+        let tilt = 10f64.to_radians();
+        for k in 0..=60 {
+            let phi = (2.0 * k as f64).to_radians();
+            let u = (2.0 * k as f64 - 60.0) / 5.0;
+            let az = phi - (10.0 * u * (-u * u).exp()).to_radians();
+            let tip = Point3::new(30.0 * phi.cos(), 30.0 * phi.sin(), 20.0);
+            let axis = Vector3::new(tilt.sin() * az.cos(), tilt.sin() * az.sin(), tilt.cos());
+            let cl = CutterLocation::new(tip, axis).unwrap();
+            path.moves.push(if k == 0 {
+                Move::rapid(cl)
+            } else {
+                Move::feed(cl)
+            });
+        }
+        ClOperation::new(path)
+    }
+
+    fn options() -> AssembleOptions {
+        AssembleOptions {
+            post: PostOptions {
+                reverse_motion: Some(ReverseMotionOptions::default()),
+                ..PostOptions::default()
+            },
+            ..AssembleOptions::default()
+        }
+    }
+
+    #[test]
+    fn checked_removal_leaves_no_reverse_motion_and_checks_changed_postures() {
+        let ops = [swing_op()];
+        let calls = Cell::new(0usize);
+        let accept = |_: &CutterLocation| {
+            calls.set(calls.get() + 1);
+            true
+        };
+        let a = assemble_program_checked(
+            "rm",
+            &ops,
+            &machine(),
+            &LinuxCnc::default(),
+            &options(),
+            Some(&accept),
+        )
+        .unwrap();
+        let m = a.metrics[0].1;
+        assert!(m.reverse_motions_before >= 2, "{m:?}");
+        assert_eq!(m.reverse_motions_after, 0, "{m:?}");
+        assert!(calls.get() > 0, "the checker saw the changed postures");
+        let p = &a.operations[0];
+        assert!(p.reverse_motion_removal && p.reverse_motion.is_some());
+        assert_eq!(p.before.values.len(), p.after.values.len());
+        assert_ne!(p.before.values, p.after.values);
+        // The smoothed C column (index 4) moves one way along the cutting run (between the
+        // approach and the retract rapids).
+        let n = p.after.values.len();
+        let c: Vec<f64> = p.after.values[1..n - 1].iter().map(|v| v[4]).collect();
+        let steps: Vec<f64> = c.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(
+            steps.iter().all(|d| *d >= -1e-6) || steps.iter().all(|d| *d <= 1e-6),
+            "{c:?}"
+        );
+        // Tips are kept by the smoothing: every source tip is still reached.
+        for (mv, b) in ops[0]
+            .path
+            .moves
+            .iter()
+            .zip(p.blocks.iter().filter(|b| !b.inserted).skip(1))
+        {
+            assert!((mv.cl.tip - b.cl.tip).norm() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn rejecting_checker_keeps_the_original_postures() {
+        let ops = [swing_op()];
+        let reject = |_: &CutterLocation| false;
+        let a = assemble_program_checked(
+            "rm",
+            &ops,
+            &machine(),
+            &LinuxCnc::default(),
+            &options(),
+            Some(&reject),
+        )
+        .unwrap();
+        let m = a.metrics[0].1;
+        assert!(m.reverse_motions_before >= 2);
+        assert_eq!(m.reverse_motions_after, m.reverse_motions_before);
+        let r = a.operations[0].reverse_motion.as_ref().unwrap();
+        assert!(
+            r.runs_kept >= 1 && !r.inaccessible_blocks.is_empty(),
+            "{r:?}"
+        );
+        // CountOnly: no removal at all, curves before = after.
+        let a = assemble_program_with_access(
+            "rm",
+            &ops,
+            &machine(),
+            &LinuxCnc::default(),
+            &options(),
+            &[OperationAccess::CountOnly],
+        )
+        .unwrap();
+        let p = &a.operations[0];
+        assert!(!p.reverse_motion_removal);
+        assert_eq!(p.metrics.reverse_motions_after, m.reverse_motions_before);
+        assert_eq!(p.before, p.after);
+        assert!(matches!(
+            assemble_program_with_access(
+                "rm",
+                &ops,
+                &machine(),
+                &LinuxCnc::default(),
+                &options(),
+                &[],
+            ),
+            Err(GcodeError::InvalidOption {
+                field: "access",
+                ..
+            })
+        ));
     }
 }

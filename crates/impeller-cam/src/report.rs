@@ -50,6 +50,68 @@ pub struct PostReport {
     pub max_linearisation_error_mm: f64,
     /// Blocks outside the machine limits.
     pub limit_violations: usize,
+    /// The same figures per simultaneous operation, with the reverse-motion removal details.
+    pub operations: Vec<PostOperationReport>,
+}
+
+/// Post-processing figures of one simultaneous operation.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct PostOperationReport {
+    /// Operation name.
+    pub name: String,
+    /// NC blocks.
+    pub blocks: usize,
+    /// Rotary direction reversals before smoothing.
+    pub reverse_motions_before: usize,
+    /// Rotary direction reversals after smoothing.
+    pub reverse_motions_after: usize,
+    /// Largest tool-tip deviation from the straight line between blocks (mm).
+    pub max_linearisation_error_mm: f64,
+    /// Blocks outside the machine limits.
+    pub limit_violations: usize,
+    /// Whether reverse-motion removal ran (it does not without a cutter to check against).
+    pub reverse_motion_removal: bool,
+    /// Cutting runs whose rotary angles were smoothed.
+    pub smoothed_runs: usize,
+    /// Cutting runs kept as they were (change too large, outside the limits, or a changed
+    /// posture failed the gouge check).
+    pub kept_runs: usize,
+    /// Runs made accessible by turning C by a constant offset.
+    pub c_repaired_runs: usize,
+    /// Source move indices of the first inaccessible posture of each kept run.
+    pub inaccessible_blocks: Vec<usize>,
+    /// Largest change of a rotary angle by the smoothing (deg).
+    pub max_angle_change_deg: f64,
+}
+
+impl PostOperationReport {
+    /// The figures of one posted operation.
+    pub fn of(p: &gcode_emit::assemble::PostedOperation) -> Self {
+        let m = &p.metrics;
+        let mut r = Self {
+            name: p.name.clone(),
+            blocks: m.blocks,
+            reverse_motions_before: m.reverse_motions_before,
+            reverse_motions_after: m.reverse_motions_after,
+            max_linearisation_error_mm: m.max_linearisation_error_mm,
+            limit_violations: m.limit_violations,
+            reverse_motion_removal: p.reverse_motion_removal,
+            ..Self::default()
+        };
+        if let Some(rm) = &p.reverse_motion {
+            r.smoothed_runs = rm.runs_changed;
+            r.kept_runs = rm.runs_kept;
+            r.c_repaired_runs = rm.c_repaired_runs;
+            // Block source indices count the approach move first; report CL move indices.
+            r.inaccessible_blocks = rm
+                .inaccessible_blocks
+                .iter()
+                .map(|i| i.saturating_sub(1))
+                .collect();
+            r.max_angle_change_deg = rm.max_angle_change_deg;
+        }
+        r
+    }
 }
 
 /// Verification figures.
@@ -88,6 +150,8 @@ pub struct Report {
     pub notes: Vec<String>,
     #[serde(skip)]
     plots: Vec<String>,
+    #[serde(skip)]
+    post_plots: Vec<String>,
 }
 
 impl Report {
@@ -103,6 +167,7 @@ impl Report {
             timings_ms: BTreeMap::new(),
             notes: Vec::new(),
             plots: Vec::new(),
+            post_plots: Vec::new(),
         }
     }
 
@@ -176,6 +241,34 @@ impl Report {
         ));
         self.plots
             .push(line_chart("Top view", "x (mm)", "y (mm)", &top, true));
+    }
+
+    /// Axis displacement curves of one posted operation against the tool-tip path length
+    /// (paper 004's figures): the rotary axes alone, then all five axes; dashed = before
+    /// reverse-motion removal, solid = after.
+    pub fn add_displacement_plots(&mut self, p: &gcode_emit::assemble::PostedOperation) {
+        let before = p.reverse_motion_removal.then_some(&p.before);
+        let caption = if p.reverse_motion_removal {
+            format!(
+                "{}: axis displacements before (dashed) and after (solid) reverse-motion \
+                 removal — reverse motions {} → {}",
+                p.name, p.metrics.reverse_motions_before, p.metrics.reverse_motions_after
+            )
+        } else {
+            format!(
+                "{}: axis displacements (no reverse-motion removal) — reverse motions {}",
+                p.name, p.metrics.reverse_motions_before
+            )
+        };
+        let mut h = format!("<h3>{}</h3><p>Rotary axes (deg)</p>", esc(&caption));
+        h.push_str(&postproc_kinematics::plot::displacement_svg(
+            &p.after, before, true, 900, 300,
+        ));
+        h.push_str("<p>All axes (mm; deg)</p>");
+        h.push_str(&postproc_kinematics::plot::displacement_svg(
+            &p.after, before, false, 900, 300,
+        ));
+        self.post_plots.push(h);
     }
 
     /// Heat maps of overcut and residual on the surfaces where each is largest (at most
@@ -266,10 +359,34 @@ impl Report {
             h.push_str("</table>");
         }
         h.push_str("<h2>Post-processing</h2>");
-        table_of_object(
-            &mut h,
-            &serde_json::to_value(&self.post).unwrap_or_default(),
-        );
+        let mut post = serde_json::to_value(&self.post).unwrap_or_default();
+        if let Some(m) = post.as_object_mut() {
+            m.remove("operations");
+        }
+        table_of_object(&mut h, &post);
+        if !self.post.operations.is_empty() {
+            h.push_str("<table><tr><th>operation</th><th>blocks</th><th>reverse motions before</th><th>after</th><th>removal</th><th>smoothed runs</th><th>kept runs</th><th>max angle change (deg)</th><th>max linearisation error (mm)</th><th>limit violations</th></tr>");
+            for o in &self.post.operations {
+                let _ = write!(
+                    h,
+                    "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.3}</td><td>{:.5}</td><td>{}</td></tr>",
+                    esc(&o.name),
+                    o.blocks,
+                    o.reverse_motions_before,
+                    o.reverse_motions_after,
+                    if o.reverse_motion_removal { "checked" } else { "off" },
+                    o.smoothed_runs,
+                    o.kept_runs,
+                    o.max_angle_change_deg,
+                    o.max_linearisation_error_mm,
+                    o.limit_violations
+                );
+            }
+            h.push_str("</table>");
+        }
+        for svg in &self.post_plots {
+            h.push_str(svg);
+        }
         h.push_str("<h2>Verification</h2>");
         match &self.verification {
             Some(v) => {

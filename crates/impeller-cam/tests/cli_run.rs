@@ -1,6 +1,7 @@
 //! `impeller-cam run` end to end: default job, a job with CL data from another CAM system
-//! (posted, accepted by LinuxCNC's rs274, verified by simulation), and user errors.
-#![allow(clippy::unwrap_used)] // test helpers
+//! (posted, accepted by LinuxCNC's rs274, verified by simulation), a C-axis swing removed by
+//! checked reverse-motion smoothing, and user errors.
+#![allow(clippy::unwrap_used, clippy::panic)] // test helpers
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -51,21 +52,38 @@ fn default_job_reports_the_impeller_and_says_nothing_was_machined() {
 /// 0.5 mm of the 44 mm blank, axis tilted 10° outward): it removes stock but must not touch
 /// the design.
 fn ring_cl() -> String {
+    swing_ring_cl(0.0, 43.5, true)
+}
+
+/// [`ring_cl`] at height `z` whose tool-axis azimuth is the tip's azimuth φ plus a local
+/// swing `−A·u·exp(−u²)`, `u = (φ − 90°)/5°` (A in degrees): for `A > 5°` the azimuth, and
+/// with it the C axis, runs backwards around φ = 90° (two reverse motions). With `plunge`
+/// the pass starts with a rapid to z = 60 and plunges, otherwise with a rapid to its first
+/// point.
+fn swing_ring_cl(amplitude_deg: f64, z: f64, plunge: bool) -> String {
     let mut s = String::from(
         "PARTNO RING TEST\nUNITS/MM\nMULTAX/ON\nLOADTL/1\nCUTTER/6.0,0.0,0.0,0.0,0.0,0.0,40.0\n\
-         SPINDL/RPM,10000,CLW\nRAPID\nGOTO/30.0,0.0,60.0,0.1736482,0.0,0.9848078\nFEDRAT/MMPM,800\n",
+         SPINDL/RPM,10000,CLW\nRAPID\n",
     );
+    if plunge {
+        s.push_str("GOTO/30.0,0.0,60.0,0.1736482,0.0,0.9848078\n");
+    }
     let tilt = 10f64.to_radians();
     for k in 0..=72 {
-        let phi = (k as f64 * 2.5).to_radians();
-        let (c, sn) = (phi.cos(), phi.sin());
+        if k == usize::from(!plunge) {
+            s.push_str("FEDRAT/MMPM,800\n");
+        }
+        let phi_deg = k as f64 * 2.5;
+        let phi = phi_deg.to_radians();
+        let u = (phi_deg - 90.0) / 5.0;
+        let az = (phi_deg - amplitude_deg * u * (-u * u).exp()).to_radians();
         s.push_str(&format!(
             "GOTO/{:.6},{:.6},{:.6},{:.7},{:.7},{:.7}\n",
-            30.0 * c,
-            30.0 * sn,
-            43.5,
-            tilt.sin() * c,
-            tilt.sin() * sn,
+            30.0 * phi.cos(),
+            30.0 * phi.sin(),
+            z,
+            tilt.sin() * az.cos(),
+            tilt.sin() * az.sin(),
             tilt.cos()
         ));
     }
@@ -75,8 +93,50 @@ fn ring_cl() -> String {
 
 #[test]
 fn job_with_cl_data_is_posted_accepted_by_rs274_and_verified() {
-    let dir = scratch("cljob");
-    std::fs::write(dir.join("ring.cls"), ring_cl()).unwrap();
+    let (r, _) = run_ring_job("cljob", &ring_cl(), 73);
+    let op = &r["operations"][0];
+    assert_eq!(op["moves"], 74);
+    // 72 chords of a 2.5° step on r = 30 mm plus the 16.5 mm plunge from the rapid point.
+    let chord = 2.0 * 30.0 * (1.25f64.to_radians()).sin();
+    let expected = 72.0 * chord + 16.5;
+    let len = op["path_length_mm"].as_f64().unwrap();
+    assert!((len - expected).abs() < 1e-3, "{len} vs {expected}");
+    assert_eq!(r["post"]["reverse_motions_before"], 0);
+    assert_eq!(r["post"]["reverse_motions_after"], 0);
+}
+
+#[test]
+fn c_axis_swing_is_removed_checked_posted_and_verified() {
+    // 2 mm above the 44 mm blank: well clear of the part, so every smoothed posture passes
+    // the gouge check.
+    let (r, out) = run_ring_job("swing", &swing_ring_cl(10.0, 46.0, false), 72);
+    let post = &r["post"];
+    let before = post["reverse_motions_before"].as_u64().unwrap();
+    assert!(before >= 2, "{post}");
+    assert_eq!(post["reverse_motions_after"], 0, "{post}");
+    let op = &post["operations"][0];
+    assert_eq!(op["reverse_motion_removal"], true, "{op}");
+    assert_eq!(op["smoothed_runs"], 1, "{op}");
+    assert_eq!(op["kept_runs"], 0, "{op}");
+    // The swing is ±4.3° about the ring's steady turn; the smoothing changes C by about that.
+    let change = op["max_angle_change_deg"].as_f64().unwrap();
+    assert!(change > 1.0 && change <= 10.0, "{op}");
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains(&format!("reverse motions {before} → 0")));
+    assert!(
+        html.matches("dashed: before").count() >= 2,
+        "before/after plots"
+    );
+}
+
+/// Runs a job with `cl` as its CL file on the fixture impeller and machine (LinuxCNC) and
+/// checks what every such job must satisfy: exit 0, no limit violation, linearisation within
+/// 0.005 mm, at least `min_feeds` feed moves in rs274's output, no overcut beyond the 0.5 mm dexel resolution, no collision, every move in the
+/// CL file written back, and rs274 accepting the program. Returns the report and the output
+/// folder.
+fn run_ring_job(name: &str, cl: &str, min_feeds: usize) -> (serde_json::Value, PathBuf) {
+    let dir = scratch(name);
+    std::fs::write(dir.join("ring.cls"), cl).unwrap();
     let imp = repo().join("fixtures/impeller-8+8/impeller.toml");
     let machine = repo().join("fixtures/machines/xyzac-trt.toml");
     std::fs::write(
@@ -103,13 +163,6 @@ fn job_with_cl_data_is_posted_accepted_by_rs274_and_verified() {
         String::from_utf8_lossy(&st.stderr)
     );
     let r = report(&out);
-    let op = &r["operations"][0];
-    assert_eq!(op["moves"], 74);
-    // 72 chords of a 2.5° step on r = 30 mm plus the 16.5 mm plunge from the rapid point.
-    let chord = 2.0 * 30.0 * (1.25f64.to_radians()).sin();
-    let expected = 72.0 * chord + 16.5;
-    let len = op["path_length_mm"].as_f64().unwrap();
-    assert!((len - expected).abs() < 1e-3, "{len} vs {expected}");
     assert_eq!(r["post"]["limit_violations"], 0);
     assert!(r["post"]["max_linearisation_error_mm"].as_f64().unwrap() <= 0.005 + 1e-9);
     let v = &r["verification"];
@@ -118,7 +171,7 @@ fn job_with_cl_data_is_posted_accepted_by_rs274_and_verified() {
     assert_eq!(v["collisions"], 0, "{v}");
     // The CL file written back contains every move.
     let cls = std::fs::read_to_string(out.join("toolpath.cls")).unwrap();
-    assert_eq!(cls.matches("GOTO/").count(), 74);
+    assert_eq!(cls.matches("GOTO/").count(), cl.matches("GOTO/").count());
     // LinuxCNC's own interpreter accepts the program.
     let program = out.join("program.ngc");
     assert!(program.is_file());
@@ -146,11 +199,12 @@ fn job_with_cl_data_is_posted_accepted_by_rs274_and_verified() {
             let feeds = String::from_utf8_lossy(&res.stdout)
                 .matches("STRAIGHT_FEED")
                 .count();
-            assert!(feeds >= 73, "{feeds} feed moves");
+            assert!(feeds >= min_feeds, "{feeds} feed moves");
         }
         None if std::env::var("IMPELLER_SKIP_RS274").as_deref() == Ok("1") => {}
         None => panic!("rs274 not on PATH (apt-get install linuxcnc-uspace, as .ci/run does)"),
     }
+    (r, out)
 }
 
 fn which(name: &str) -> Option<PathBuf> {
