@@ -21,6 +21,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<bool, String> {
     let root = workspace_root();
     let target = target_dir();
+    let mut export_ok = true;
     if !args.collect_only {
         // One `cargo bench` per criterion target: `--benches` alone would also hand
         // criterion's flags to the libtest harness of every library.
@@ -38,6 +39,8 @@ pub fn run(args: Args) -> Result<bool, String> {
         }
         // The closest-point query set, so other libraries can run exactly the same points.
         let csv = target.join("bench").join("closest_point_queries.csv");
+        std::fs::create_dir_all(target.join("bench"))
+            .map_err(|e| format!("{}: {e}", target.join("bench").display()))?;
         let mut ex = Command::new(env_cargo());
         ex.current_dir(&root).args([
             "run",
@@ -52,7 +55,7 @@ pub fn run(args: Args) -> Result<bool, String> {
         ex.arg(&csv);
         if let Err(e) = run_cmd(&mut ex) {
             eprintln!("xtask bench: closest-point query export failed: {e}");
-            return Ok(false);
+            export_ok = false;
         }
     }
     let results = collect(&target.join("criterion"))?;
@@ -69,7 +72,7 @@ pub fn run(args: Args) -> Result<bool, String> {
     let text = serde_json::to_string_pretty(&Value::Object(bmf)).map_err(|e| e.to_string())?;
     write_atomic(&out, text.as_bytes())?;
     println!("wrote {}", out.display());
-    Ok(true)
+    Ok(export_ok)
 }
 
 /// (package, bench) for every `crates/<package>/benches/<bench>.rs`.
