@@ -56,6 +56,12 @@ impl Default for ImpellerSampling {
     }
 }
 
+/// Width of the band beyond `far_mm` in which blade distances are still computed exactly
+/// (mm). Farther out the mesh gives only a lower bound `dm − far_mm`, which is then at least
+/// this band: larger than half of any dexel cell, so the overcut/residual probes (which stop
+/// where the design is closer than half a cell) never mistake the bound for a nearby wall.
+const EXACT_BAND_MM: f64 = 2.0;
+
 /// The impeller design model.
 #[derive(Debug, Clone)]
 pub struct ImpellerDesign {
@@ -206,7 +212,7 @@ impl ImpellerDesign {
             return f64::INFINITY;
         };
         let dm = (proj.point - q).length();
-        if dm > self.far_mm {
+        if dm > self.far_mm + EXACT_BAND_MM {
             // Farther than half the thickest blade from every side: outside all blades, and
             // the distance to the blade solids is at least dm − chord − t_max/2.
             let ds = self.shroud_sd.signed_distance(p);

@@ -135,3 +135,39 @@ fn gouge_into_a_blade_of_the_fixture_is_located() {
     let frac = (sp.u - u0) / (u1 - u0);
     assert!((0.45..=0.75).contains(&frac), "{frac} {e:?}");
 }
+
+/// Nothing machined: along each blade side's outward normal the channel is full of stock, so
+/// the residual probe must run to its depth (the channels are ≥ 4.28 mm wide at the hub, more
+/// above). A design distance that is only a lower bound away from the blades once made the
+/// probe stop after one cell (residual ≈ 0.25 mm at 0.5 mm cells).
+#[test]
+fn untouched_channels_read_full_residual_on_blade_sides() {
+    let imp = default_impeller().unwrap();
+    let d = ImpellerDesign::new(&imp, coarse()).unwrap();
+    let mut stock = TriDexel::from_shape(&d.blank().unwrap(), 0.5).unwrap();
+    let opts = SimOptions {
+        probe_depth_mm: 2.0,
+        ..SimOptions::default()
+    };
+    let rep = simulate(&mut stock, &d, &[], &opts).unwrap();
+    let (mut full, mut total) = (0usize, 0usize);
+    for m in rep
+        .maps
+        .iter()
+        .filter(|m| m.name != "hub" && !m.name.contains("tip"))
+    {
+        for r in m.residual_mm.iter().flatten() {
+            total += 1;
+            if *r >= 2.0 - 1e-9 {
+                full += 1;
+            }
+        }
+    }
+    assert!(total > 100, "{total} blade samples");
+    // Samples near the leading/trailing edges and the hub fillet corner may stop early
+    // (another design face within a cell); the bulk of every side must read the full depth.
+    assert!(
+        full as f64 >= 0.8 * total as f64,
+        "{full} of {total} blade samples read the full residual depth"
+    );
+}
