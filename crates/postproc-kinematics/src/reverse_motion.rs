@@ -200,8 +200,17 @@ pub struct ReverseMotionReport {
     pub runs_kept: usize,
     /// Shift-and-smooth iterations (summed over runs and axes).
     pub iterations: usize,
-    /// Runs × axes that needed the monotone projection of the control values.
+    /// Fits (over runs × axes and control-value counts) that needed the monotone projection
+    /// of the control values.
     pub projections: usize,
+    /// Control values of the accepted B-spline fit of each smoothed run × axis, in run order
+    /// (tilt before C); larger than `ReverseMotionOptions::control_points` where the adaptive
+    /// refit of [`smooth_monotone_adaptive`] was needed.
+    #[serde(default)]
+    pub control_points_used: Vec<usize>,
+    /// Refits with more control values (fits beyond the first, over runs × axes).
+    #[serde(default)]
+    pub refits: usize,
     /// Runs whose C was turned by a multiple of `c_step` to restore accessibility.
     pub c_repaired_runs: usize,
     /// The C offsets applied to those runs (deg).
@@ -243,38 +252,60 @@ fn run_parameters(blocks: &[PostedBlock]) -> Vec<f64> {
     t
 }
 
-/// Shift-and-smooth of one angle sequence (paper 004): angles lying behind the running extreme
-/// in the direction of motion are shifted by at most `φ_L` toward it, the sequence is smoothed
-/// by the least-squares cubic B-spline, and this repeats until no reverse motion is left; after
-/// `max_iterations` the control values are projected onto a monotone sequence, which makes the
-/// spline monotone. Returns the new angles, the iterations and whether the projection ran.
+/// Largest control-value count the adaptive refit of [`smooth_monotone_adaptive`] tries
+/// (an absolute bound on top of half the run's block count, so that a long run costs at most
+/// `O(max_iterations · m · 128²)`).
+pub const MAX_ADAPTIVE_CONTROL_POINTS: usize = 128;
+
+/// Shift-and-smooth of one angle sequence (paper 004) with the fixed control-value count
+/// `opts.control_points`: angles lying behind the running extreme in the direction of motion
+/// are shifted by at most `φ_L` toward it, the sequence is smoothed by the least-squares cubic
+/// B-spline, and this repeats until no reverse motion is left; after `max_iterations` the
+/// control values are projected onto a monotone sequence, which makes the spline monotone.
+/// Returns the new angles, the iterations and whether the projection ran; `None` for fewer
+/// than 3 angles or a rank-deficient fit. Cost O(max_iterations · m · n²).
 pub fn smooth_monotone(
     t: &[f64],
     angles: &[f64],
     opts: &ReverseMotionOptions,
 ) -> Option<(Vec<f64>, usize, bool)> {
+    smooth_monotone_n(t, angles, opts, opts.control_points)
+}
+
+/// Direction (±1) in which a run of angles should move: the sign of the net change, or of the
+/// larger of the summed rises and falls when the run ends where it started.
+fn run_direction(angles: &[f64]) -> f64 {
     let m = angles.len();
-    if m < 3 {
+    let net = angles[m - 1] - angles[0];
+    if net.abs() > REVERSE_DEAD_BAND_RAD {
+        return net.signum();
+    }
+    let up: f64 = angles.windows(2).map(|w| (w[1] - w[0]).max(0.0)).sum();
+    let down: f64 = angles.windows(2).map(|w| (w[0] - w[1]).max(0.0)).sum();
+    if up >= down {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// [`smooth_monotone`] with `n_ctrl` control values. The fit uses the given parameters `t`
+/// (normalised path length) when they determine the `n_ctrl` coefficients, otherwise the
+/// normalised block index (a knot span without samples, e.g. across a long plunge).
+fn smooth_monotone_n(
+    t: &[f64],
+    angles: &[f64],
+    opts: &ReverseMotionOptions,
+    n_ctrl: usize,
+) -> Option<(Vec<f64>, usize, bool)> {
+    let m = angles.len();
+    if m < 3 || t.len() != m {
         return None;
     }
-    let net = angles[m - 1] - angles[0];
-    let dir = if net.abs() > REVERSE_DEAD_BAND_RAD {
-        net.signum()
-    } else {
-        let up: f64 = angles.windows(2).map(|w| (w[1] - w[0]).max(0.0)).sum();
-        let down: f64 = angles.windows(2).map(|w| (w[0] - w[1]).max(0.0)).sum();
-        if up >= down {
-            1.0
-        } else {
-            -1.0
-        }
-    };
+    let dir = run_direction(angles);
     let uniform: Vec<f64> = (0..m).map(|i| i as f64 / (m - 1) as f64).collect();
-    let fit = |y: &[f64]| {
-        fit_least_squares(t, y, opts.control_points)
-            .or_else(|| fit_least_squares(&uniform, y, opts.control_points))
-    };
-    let params = if fit_least_squares(t, angles, opts.control_points).is_some() {
+    // The rank of the collocation matrix depends on the parameters only.
+    let params = if fit_least_squares(t, angles, n_ctrl).is_some() {
         t
     } else {
         &uniform[..]
@@ -290,7 +321,7 @@ pub fn smooth_monotone(
             }
             ext = if dir > 0.0 { ext.max(*v) } else { ext.min(*v) };
         }
-        let spline = fit(&cur)?;
+        let spline = fit_least_squares(params, &cur, n_ctrl)?;
         cur = params.iter().map(|&ti| spline.eval(ti)).collect();
         if count_reverse_motions(&cur, REVERSE_DEAD_BAND_RAD) == 0 {
             return Some((cur, iter, false));
@@ -302,17 +333,117 @@ pub fn smooth_monotone(
     Some((out, opts.max_iterations, true))
 }
 
+/// Result of [`smooth_monotone_adaptive`] for one axis of one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SmoothedAngles {
+    /// The smoothed angles (rad), one per block; of the accepted fit, or of the fit with the
+    /// smallest change when none was accepted.
+    pub angles: Vec<f64>,
+    /// Control values of that fit.
+    pub control_points: usize,
+    /// Shift-and-smooth iterations summed over every fit tried.
+    pub iterations: usize,
+    /// Fits that ended with the monotone projection of the control values.
+    pub projections: usize,
+    /// Fits tried (1 when the fit with `opts.control_points` was accepted).
+    pub fits: usize,
+    /// Largest change of any angle (rad).
+    pub max_change: f64,
+    /// `true` when the angles are free of reverse motions and `max_change ≤ max_angle_change`.
+    pub accepted: bool,
+}
+
+/// Upper bound of the control-value count tried for a run of `m` blocks starting from `n0`:
+/// `max(n0, min(m / 2, MAX_ADAPTIVE_CONTROL_POINTS))`.
+pub fn adaptive_control_cap(m: usize, n0: usize) -> usize {
+    n0.max((m / 2).min(MAX_ADAPTIVE_CONTROL_POINTS))
+}
+
+/// Shift-and-smooth (paper 004, "Modification of reverse movements", procedure steps 3–5)
+/// with an adaptive number of cubic B-spline control values.
+///
+/// The paper smooths each tool path with four cubic B-splines. A run whose angles change
+/// character sharply — a plunge with constant posture followed by a five-axis sweep — cannot
+/// be followed by one cubic piece: the four-value fit either keeps reversing or moves some
+/// angle by more than `opts.max_angle_change` away from the CAM posture, and the run would be
+/// kept with its reverse motions. Rule: start with `n = opts.control_points`; when the result
+/// still reverses (after the shift iterations and the monotone projection) or changes an angle
+/// by more than `max_angle_change`, refit the original angles with `n ← min(2n, cap)`,
+/// `cap =` [`adaptive_control_cap`]`(m, n0)` (half the blocks, at most
+/// [`MAX_ADAPTIVE_CONTROL_POINTS`]: at least two samples per control value, so the fit stays
+/// a least-squares smoothing and never interpolates the reversal back in); keep the first fit
+/// that is free of reverse motions (dead band [`REVERSE_DEAD_BAND_RAD`]) and within
+/// `max_angle_change`, i.e. the fit with the fewest control values (the smoothest) among
+/// those tried that meets the tolerance.
+///
+/// `None` for fewer than 3 angles or when no control-value count gives a full-rank fit.
+/// Cost: at most `log₂(cap / n0) + 1` fits, each O(max_iterations · m · n²).
+pub fn smooth_monotone_adaptive(
+    t: &[f64],
+    angles: &[f64],
+    opts: &ReverseMotionOptions,
+) -> Option<SmoothedAngles> {
+    let m = angles.len();
+    let n0 = opts.control_points;
+    let cap = adaptive_control_cap(m, n0);
+    let mut n = n0;
+    let (mut iterations, mut projections, mut fits) = (0, 0, 0);
+    let mut best: Option<SmoothedAngles> = None;
+    loop {
+        if let Some((new, iters, projected)) = smooth_monotone_n(t, angles, opts, n) {
+            iterations += iters;
+            projections += usize::from(projected);
+            fits += 1;
+            let max_change = angles
+                .iter()
+                .zip(&new)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            let accepted = count_reverse_motions(&new, REVERSE_DEAD_BAND_RAD) == 0
+                && max_change <= opts.max_angle_change;
+            let better = best.as_ref().is_none_or(|b| max_change < b.max_change);
+            if accepted || better {
+                best = Some(SmoothedAngles {
+                    angles: new,
+                    control_points: n,
+                    iterations: 0,
+                    projections: 0,
+                    fits: 0,
+                    max_change,
+                    accepted,
+                });
+            }
+            if accepted {
+                break;
+            }
+        }
+        if n >= cap {
+            break;
+        }
+        n = (2 * n).min(cap);
+    }
+    best.map(|b| SmoothedAngles {
+        iterations,
+        projections,
+        fits,
+        ..b
+    })
+}
+
 /// Removes reverse motions of the rotary axes run by run (paper 004 procedure steps 2–7):
-/// shift-and-smooth each reversing axis ([`smooth_monotone`]); recompute the linear axes for
-/// the changed postures keeping the tool tips ([`Machine::joints_for_angles`]); check limits
-/// and re-check every changed posture with `checker`; where one fails, turn C of the whole run
-/// by `±k·c_step` (smallest first, up to `c_max`; a constant offset keeps the run monotone)
-/// and re-check. A run that cannot be repaired, or whose smoothing changes an angle by more
-/// than `max_angle_change`, keeps its original angles.
+/// shift-and-smooth each reversing axis with the adaptive control-value count of
+/// [`smooth_monotone_adaptive`] (the paper's four cubic B-splines first, refitted with more
+/// control values when a run — e.g. a plunge followed by a sweep — needs it); recompute the
+/// linear axes for the changed postures keeping the tool tips ([`Machine::joints_for_angles`]);
+/// check limits and re-check every changed posture with `checker`; where one fails, turn C of
+/// the whole run by `±k·c_step` (smallest first, up to `c_max`; a constant offset keeps the
+/// run monotone) and re-check. A run that cannot be repaired, or for which no tried fit is
+/// free of reverse motions within `max_angle_change`, keeps its original angles.
 /// Blocks' `cl.axis` becomes the smoothed tool axis.
 ///
-/// Cost: O(m·n²) per run for the fit (n control points), plus `c_max / c_step` checker calls
-/// per run whose smoothed postures fail.
+/// Cost: per run and reversing axis at most `log₂(cap / n0) + 1` fits of
+/// O(max_iterations · m · n²) each (see [`smooth_monotone_adaptive`]), plus `c_max / c_step`
+/// checker passes per run whose smoothed postures fail.
 pub fn remove_reverse_motions(
     machine: &Machine,
     blocks: &mut [PostedBlock],
@@ -335,28 +466,26 @@ pub fn remove_reverse_motions(
         let mut changed = false;
         let mut ok = true;
         let mut run_max_change: f64 = 0.0;
+        let mut run_control_points = Vec::new();
         for axis in [AxisId::Tilt, AxisId::Rotate] {
             let angles: Vec<f64> = run.iter().map(|b| b.joints.get(axis)).collect();
             if count_reverse_motions(&angles, REVERSE_DEAD_BAND_RAD) == 0 {
                 continue;
             }
-            let Some((new, iters, projected)) = smooth_monotone(&t, &angles, opts) else {
+            let Some(fit) = smooth_monotone_adaptive(&t, &angles, opts) else {
                 ok = false;
                 break;
             };
-            rep.iterations += iters;
-            rep.projections += usize::from(projected);
-            let change = angles
-                .iter()
-                .zip(&new)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
-            if change > opts.max_angle_change {
+            rep.iterations += fit.iterations;
+            rep.projections += fit.projections;
+            rep.refits += fit.fits.saturating_sub(1);
+            if !fit.accepted {
                 ok = false;
                 break;
             }
-            run_max_change = run_max_change.max(change);
-            for (b, v) in run.iter_mut().zip(new) {
+            run_control_points.push(fit.control_points);
+            run_max_change = run_max_change.max(fit.max_change);
+            for (b, v) in run.iter_mut().zip(fit.angles) {
                 b.joints.set(axis, v);
             }
             changed = true;
@@ -409,6 +538,7 @@ pub fn remove_reverse_motions(
                         b.cl = cl;
                     }
                     rep.runs_changed += 1;
+                    rep.control_points_used.append(&mut run_control_points);
                     if off != 0.0 {
                         rep.c_repaired_runs += 1;
                         rep.c_offsets_deg.push(off.to_degrees());

@@ -1,0 +1,188 @@
+//! Reverse-motion removal on a realistic cutting run: a plunge with a constant posture
+//! followed by a five-axis sweep whose C angle swings back and forth. The paper's four cubic
+//! B-splines cannot follow the plunge-to-sweep change within the 10° angle limit; the adaptive
+//! control-value count must.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use cam_core::{CutterLocation, Move, Point3};
+use postproc_kinematics::reverse_motion::{
+    adaptive_control_cap, count_reverse_motions, smooth_monotone, smooth_monotone_adaptive,
+    REVERSE_DEAD_BAND_RAD,
+};
+use postproc_kinematics::{
+    post_path, post_path_checked, AccessibilityChecker, AxisId, Machine, PostOptions,
+    ReverseMotionOptions,
+};
+
+fn fixture(name: &str) -> Machine {
+    let path = format!(
+        "{}/../../fixtures/machines/{name}.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    Machine::from_file(&path).unwrap()
+}
+
+const PLUNGE_BLOCKS: usize = 8;
+const SWEEP_BLOCKS: usize = 90;
+
+/// C (deg) of the sweep at `s ∈ [0, 1]`: a steady 50° turn with a local swing of amplitude
+/// 12° about s = 0.6 that runs C backwards (two reverse motions).
+fn sweep_c_deg(s: f64) -> f64 {
+    let u = (s - 0.6) / 0.05;
+    50.0 * s - 12.0 * u * (-u * u).exp()
+}
+
+/// A rapid above the part, a plunge of `PLUNGE_BLOCKS` feed blocks from z = 60 to z = 5 with
+/// A = −20°, C = 0 held, then a sweep of `SWEEP_BLOCKS` blocks along a 60 mm curve with A
+/// tilting from −20° to −30° and C following [`sweep_c_deg`].
+fn plunge_and_swing(m: &Machine) -> Vec<Move> {
+    let axis = |a: f64, c: f64| m.tool_axis(a.to_radians(), c.to_radians()).into_inner();
+    let cl = |tip: Point3, a: f64, c: f64| CutterLocation::new(tip, axis(a, c)).unwrap();
+    let mut moves = vec![Move::rapid(cl(Point3::new(-30.0, 0.0, 70.0), -20.0, 0.0))];
+    for i in 0..PLUNGE_BLOCKS {
+        let z = 60.0 - 55.0 * i as f64 / (PLUNGE_BLOCKS - 1) as f64;
+        let mut mv = Move::feed(cl(Point3::new(-30.0, 0.0, z), -20.0, 0.0));
+        mv.feed_mm_per_min = Some(300.0);
+        moves.push(mv);
+    }
+    for i in 1..=SWEEP_BLOCKS {
+        let s = i as f64 / SWEEP_BLOCKS as f64;
+        let tip = Point3::new(-30.0 + 60.0 * s, 10.0 * (3.0 * s).sin(), 5.0 + 3.0 * s);
+        let mut mv = Move::feed(cl(tip, -20.0 - 10.0 * s, sweep_c_deg(s)));
+        mv.feed_mm_per_min = Some(800.0);
+        moves.push(mv);
+    }
+    moves
+}
+
+/// Normalised cumulative tip path length of a run of tips.
+fn path_parameters(tips: &[Point3]) -> Vec<f64> {
+    let mut t = vec![0.0];
+    for w in tips.windows(2) {
+        t.push(t.last().unwrap() + (w[1] - w[0]).norm());
+    }
+    let total = *t.last().unwrap();
+    t.iter().map(|v| v / total).collect()
+}
+
+#[test]
+fn plunge_then_swing_needs_more_than_four_control_points_and_leaves_no_reversal() {
+    let m = fixture("xyzac-trt");
+    let moves = plunge_and_swing(&m);
+    let plain = post_path(&m, &moves, &PostOptions::default()).unwrap();
+    let opts = ReverseMotionOptions::default();
+
+    // The run as the removal sees it: the rapid's end point and every feed block.
+    let run: Vec<_> = plain.blocks.iter().filter(|b| !b.inserted).collect();
+    assert_eq!(run.len(), 1 + PLUNGE_BLOCKS + SWEEP_BLOCKS);
+    let c: Vec<f64> = run.iter().map(|b| b.joints.get(AxisId::Rotate)).collect();
+    let tips: Vec<Point3> = run.iter().map(|b| b.cl.tip).collect();
+    let t = path_parameters(&tips);
+    assert_eq!(count_reverse_motions(&c, REVERSE_DEAD_BAND_RAD), 2);
+
+    // The paper's fixed four control values: no monotone result within the 10° limit.
+    let (fixed, _, _) = smooth_monotone(&t, &c, &opts).unwrap();
+    let fixed_change = c
+        .iter()
+        .zip(&fixed)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        count_reverse_motions(&fixed, REVERSE_DEAD_BAND_RAD) > 0
+            || fixed_change > opts.max_angle_change,
+        "four control values already suffice ({:.2}°): the test lost its point",
+        fixed_change.to_degrees()
+    );
+
+    // The adaptive rule refits with more control values and accepts a monotone fit.
+    let fit = smooth_monotone_adaptive(&t, &c, &opts).unwrap();
+    assert!(fit.accepted, "{fit:?}");
+    assert!(fit.control_points > opts.control_points);
+    assert!(fit.control_points <= adaptive_control_cap(c.len(), opts.control_points));
+    assert!(fit.fits >= 2);
+    assert_eq!(count_reverse_motions(&fit.angles, REVERSE_DEAD_BAND_RAD), 0);
+    assert!(fit.max_change <= opts.max_angle_change);
+
+    // End to end through post-processing with a checker that accepts every posture.
+    let all_ok = |_: &CutterLocation| true;
+    let checker: &dyn AccessibilityChecker = &all_ok;
+    let post_opts = PostOptions {
+        reverse_motion: Some(opts),
+        ..Default::default()
+    };
+    let posted = post_path_checked(&m, &moves, &post_opts, Some(checker)).unwrap();
+    let rep = posted.reverse_motion.as_ref().unwrap();
+    assert_eq!(rep.rotate_before, 2, "{rep:?}");
+    assert_eq!((rep.rotate_after, rep.tilt_after), (0, 0), "{rep:?}");
+    assert_eq!((rep.runs_changed, rep.runs_kept), (1, 0), "{rep:?}");
+    assert!(rep.refits >= 1);
+    assert_eq!(rep.control_points_used, vec![fit.control_points]);
+    assert!(rep.max_angle_change_deg > 1.0 && rep.max_angle_change_deg <= 10.0 + 1e-9);
+    assert_eq!(posted.metrics.reverse_motions_after, 0);
+    // every angle moved by at most the limit, tips kept, joints reach the smoothed CLs
+    for b in posted.blocks.iter().filter(|b| !b.inserted) {
+        let src = &plain
+            .blocks
+            .iter()
+            .find(|p| !p.inserted && p.source_index == b.source_index)
+            .unwrap();
+        for axis in [AxisId::Tilt, AxisId::Rotate] {
+            let d = (b.joints.get(axis) - src.joints.get(axis)).abs();
+            assert!(
+                d <= opts.max_angle_change + 1e-12,
+                "block {}",
+                b.source_index
+            );
+        }
+        assert!((b.cl.tip - moves[b.source_index].cl.tip).norm() < 1e-12);
+        let f = m.forward(&b.joints, 0.0);
+        assert!((f.tip - b.cl.tip).norm() < 1e-9);
+        assert!((f.axis.into_inner() - b.cl.axis.into_inner()).norm() < 1e-9);
+    }
+    // C along the posted run (inserted linearisation blocks included) never turns back.
+    let cs: Vec<f64> = posted
+        .blocks
+        .iter()
+        .skip(1)
+        .map(|b| b.joints.get(AxisId::Rotate))
+        .collect();
+    assert!(cs.windows(2).all(|w| w[1] >= w[0] - 1e-6), "C not monotone");
+}
+
+#[test]
+fn adaptive_fit_keeps_the_papers_four_control_points_when_they_suffice() {
+    // A gentle swing on a steady turn (paper 004 fig. 12): four control values are enough,
+    // so no refit happens and the result equals the fixed-count smoothing.
+    let t: Vec<f64> = (0..100).map(|i| i as f64 / 99.0).collect();
+    let a: Vec<f64> = t
+        .iter()
+        .map(|&x| x - 0.15 * (-((x - 0.5) / 0.05f64).powi(2)).exp() * (x - 0.5) / 0.05)
+        .collect();
+    let opts = ReverseMotionOptions::default();
+    let fit = smooth_monotone_adaptive(&t, &a, &opts).unwrap();
+    assert!(fit.accepted);
+    assert_eq!((fit.control_points, fit.fits), (4, 1));
+    let (fixed, _, _) = smooth_monotone(&t, &a, &opts).unwrap();
+    assert_eq!(fit.angles, fixed);
+}
+
+#[test]
+fn adaptive_fit_gives_up_at_the_cap_when_the_limit_is_too_tight() {
+    // A 0.01° limit cannot absorb a swing of several degrees at any control-value count:
+    // the rule tries n0, 2n0, … up to the cap and reports the fit as not accepted.
+    let t: Vec<f64> = (0..60).map(|i| i as f64 / 59.0).collect();
+    let a: Vec<f64> = t
+        .iter()
+        .map(|&x| x - 0.15 * (-((x - 0.5) / 0.05f64).powi(2)).exp() * (x - 0.5) / 0.05)
+        .collect();
+    let opts = ReverseMotionOptions {
+        max_angle_change: 0.01f64.to_radians(),
+        ..Default::default()
+    };
+    let fit = smooth_monotone_adaptive(&t, &a, &opts).unwrap();
+    assert!(!fit.accepted);
+    assert!(fit.max_change > opts.max_angle_change);
+    // 4, 8, 16, 30 (= 60 / 2)
+    assert_eq!(adaptive_control_cap(60, 4), 30);
+    assert_eq!(fit.fits, 4);
+}
