@@ -2,13 +2,14 @@
 //! displacement of an axis changes direction (paper 004: such reversals leave tool marks,
 //! because the feed drive stops and backlash acts).
 
-use crate::bspline_fit::fit_least_squares;
+use crate::bspline_fit::{fit_least_squares, ScalarBSpline};
 use crate::error::PostError;
 use crate::joints::{AxisId, Joints};
 use crate::kinematics::LIMIT_SLACK;
 use crate::machine::Machine;
 use crate::post::PostedBlock;
 use cam_core::{CutterLocation, MoveKind};
+use nalgebra::{DMatrix, DVector, Dyn, SVD};
 use serde::{Deserialize, Serialize};
 
 /// Angular steps smaller than this (rad) count as standing still when looking for direction
@@ -253,8 +254,8 @@ fn run_parameters(blocks: &[PostedBlock]) -> Vec<f64> {
 }
 
 /// Largest control-value count the adaptive refit of [`smooth_monotone_adaptive`] tries
-/// (an absolute bound on top of half the run's block count, so that a long run costs at most
-/// `O(max_iterations · m · 128²)`).
+/// (an absolute bound on top of half the run's block count, so that a refit of a long run
+/// costs at most O(m · 128²) for the factorisation plus O(m · 128) per iteration).
 pub const MAX_ADAPTIVE_CONTROL_POINTS: usize = 128;
 
 /// Shift-and-smooth of one angle sequence (paper 004) with the fixed control-value count
@@ -263,7 +264,7 @@ pub const MAX_ADAPTIVE_CONTROL_POINTS: usize = 128;
 /// B-spline, and this repeats until no reverse motion is left; after `max_iterations` the
 /// control values are projected onto a monotone sequence, which makes the spline monotone.
 /// Returns the new angles, the iterations and whether the projection ran; `None` for fewer
-/// than 3 angles or a rank-deficient fit. Cost O(max_iterations · m · n²).
+/// than 3 angles or a rank-deficient fit. Cost O(m·n²) plus O(m·n) per iteration.
 pub fn smooth_monotone(
     t: &[f64],
     angles: &[f64],
@@ -289,9 +290,63 @@ fn run_direction(angles: &[f64]) -> f64 {
     }
 }
 
+/// Least-squares projection onto the cubic B-splines of one parameter set and control-value
+/// count: the collocation matrix `A` (`m × n`, `A[i][j] = N_j(t_i)`) and its SVD, factored
+/// once (O(m·n²)) and reused by every shift-and-smooth iteration (O(m·n) each). The solve is
+/// the one of [`fit_least_squares`] (same basis, same rank test and singular-value cut-off).
+struct SplineProjector {
+    template: ScalarBSpline,
+    a: DMatrix<f64>,
+    svd: SVD<f64, Dyn, Dyn>,
+    eps: f64,
+}
+
+impl SplineProjector {
+    /// `None` when the fit with these parameters is rank deficient.
+    fn new(t: &[f64], n_ctrl: usize) -> Option<Self> {
+        let m = t.len();
+        let template = fit_least_squares(t, &vec![0.0; m], n_ctrl)?;
+        let k = template.control_points().len();
+        let mut a = DMatrix::<f64>::zeros(m, k);
+        let mut unit = vec![0.0; k];
+        for j in 0..k {
+            unit[j] = 1.0;
+            let basis_j = template.with_control_points(unit.clone())?;
+            for (i, &ti) in t.iter().enumerate() {
+                a[(i, j)] = basis_j.eval(ti);
+            }
+            unit[j] = 0.0;
+        }
+        let svd = a.clone().svd(true, true);
+        let eps = 1e-12 * svd.singular_values.max();
+        Some(Self {
+            template,
+            a,
+            svd,
+            eps,
+        })
+    }
+
+    /// Least-squares control values of `y` and the fitted values `A·x`.
+    fn fit(&self, y: &[f64]) -> Option<(DVector<f64>, Vec<f64>)> {
+        let x = self
+            .svd
+            .solve(&DVector::from_column_slice(y), self.eps)
+            .ok()?;
+        let values = (&self.a * &x).iter().copied().collect();
+        Some((x, values))
+    }
+
+    fn spline(&self, x: &DVector<f64>) -> Option<ScalarBSpline> {
+        self.template
+            .with_control_points(x.iter().copied().collect())
+    }
+}
+
 /// [`smooth_monotone`] with `n_ctrl` control values. The fit uses the given parameters `t`
 /// (normalised path length) when they determine the `n_ctrl` coefficients, otherwise the
 /// normalised block index (a knot span without samples, e.g. across a long plunge).
+/// Cost O(m·n²) for the factorisation plus O(m·n) per iteration.
 fn smooth_monotone_n(
     t: &[f64],
     angles: &[f64],
@@ -303,12 +358,14 @@ fn smooth_monotone_n(
         return None;
     }
     let dir = run_direction(angles);
-    let uniform: Vec<f64> = (0..m).map(|i| i as f64 / (m - 1) as f64).collect();
     // The rank of the collocation matrix depends on the parameters only.
-    let params = if fit_least_squares(t, angles, n_ctrl).is_some() {
-        t
-    } else {
-        &uniform[..]
+    let (params, proj) = match SplineProjector::new(t, n_ctrl) {
+        Some(p) => (t.to_vec(), p),
+        None => {
+            let uniform: Vec<f64> = (0..m).map(|i| i as f64 / (m - 1) as f64).collect();
+            let p = SplineProjector::new(&uniform, n_ctrl)?;
+            (uniform, p)
+        }
     };
     let mut cur = angles.to_vec();
     let mut last = None;
@@ -321,14 +378,14 @@ fn smooth_monotone_n(
             }
             ext = if dir > 0.0 { ext.max(*v) } else { ext.min(*v) };
         }
-        let spline = fit_least_squares(params, &cur, n_ctrl)?;
-        cur = params.iter().map(|&ti| spline.eval(ti)).collect();
+        let (x, values) = proj.fit(&cur)?;
+        cur = values;
         if count_reverse_motions(&cur, REVERSE_DEAD_BAND_RAD) == 0 {
             return Some((cur, iter, false));
         }
-        last = Some(spline);
+        last = Some(x);
     }
-    let spline = last?.monotone(dir);
+    let spline = proj.spline(&last?)?.monotone(dir);
     let out: Vec<f64> = params.iter().map(|&ti| spline.eval(ti)).collect();
     Some((out, opts.max_iterations, true))
 }
@@ -377,7 +434,8 @@ pub fn adaptive_control_cap(m: usize, n0: usize) -> usize {
 /// those tried that meets the tolerance.
 ///
 /// `None` for fewer than 3 angles or when no control-value count gives a full-rank fit.
-/// Cost: at most `log₂(cap / n0) + 1` fits, each O(max_iterations · m · n²).
+/// Cost: at most `⌈log₂(cap / n0)⌉ + 1` fits, each O(m·n²) (one SVD of the collocation
+/// matrix) plus O(m·n) per shift-and-smooth iteration.
 pub fn smooth_monotone_adaptive(
     t: &[f64],
     angles: &[f64],
@@ -441,9 +499,9 @@ pub fn smooth_monotone_adaptive(
 /// free of reverse motions within `max_angle_change`, keeps its original angles.
 /// Blocks' `cl.axis` becomes the smoothed tool axis.
 ///
-/// Cost: per run and reversing axis at most `log₂(cap / n0) + 1` fits of
-/// O(max_iterations · m · n²) each (see [`smooth_monotone_adaptive`]), plus `c_max / c_step`
-/// checker passes per run whose smoothed postures fail.
+/// Cost: per run and reversing axis at most `⌈log₂(cap / n0)⌉ + 1` fits of
+/// O(m·n² + max_iterations·m·n) each (see [`smooth_monotone_adaptive`]), plus
+/// `c_max / c_step` checker passes per run whose smoothed postures fail.
 pub fn remove_reverse_motions(
     machine: &Machine,
     blocks: &mut [PostedBlock],
