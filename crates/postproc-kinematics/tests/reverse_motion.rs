@@ -6,8 +6,8 @@
 
 use cam_core::{CutterLocation, Move, Point3};
 use postproc_kinematics::reverse_motion::{
-    adaptive_control_cap, count_reverse_motions, smooth_monotone, smooth_monotone_adaptive,
-    REVERSE_DEAD_BAND_RAD,
+    adaptive_control_cap, count_reverse_motions, reversal_windows, smooth_monotone,
+    smooth_monotone_adaptive, smooth_monotone_windowed, REVERSE_DEAD_BAND_RAD,
 };
 use postproc_kinematics::{
     post_path, post_path_checked, AccessibilityChecker, AxisId, Machine, PostOptions,
@@ -103,6 +103,21 @@ fn plunge_then_swing_needs_more_than_four_control_points_and_leaves_no_reversal(
     assert_eq!(count_reverse_motions(&fit.angles, REVERSE_DEAD_BAND_RAD), 0);
     assert!(fit.max_change <= opts.max_angle_change);
 
+    // Smoothing only a window around the reversals: the plunge and the blocks far from the
+    // swing keep their exact angles, the window joins them without a reversal.
+    let win = smooth_monotone_windowed(&t, &c, &opts).unwrap();
+    assert!(win.accepted, "{win:?}");
+    assert_eq!(win.windows.len(), 1, "{:?}", win.windows);
+    let (wa, wb) = win.windows[0];
+    assert!(wa > PLUNGE_BLOCKS && wb < c.len() - 10, "{:?}", win.windows);
+    assert_eq!(count_reverse_motions(&win.angles, REVERSE_DEAD_BAND_RAD), 0);
+    assert!(win.max_change <= opts.max_angle_change && win.max_change > 1f64.to_radians());
+    for (i, (a, b)) in c.iter().zip(&win.angles).enumerate() {
+        if i < wa || i > wb {
+            assert_eq!(a, b, "block {i} outside the window changed");
+        }
+    }
+
     // End to end through post-processing with a checker that accepts every posture.
     let all_ok = |_: &CutterLocation| true;
     let checker: &dyn AccessibilityChecker = &all_ok;
@@ -115,8 +130,17 @@ fn plunge_then_swing_needs_more_than_four_control_points_and_leaves_no_reversal(
     assert_eq!(rep.rotate_before, 2, "{rep:?}");
     assert_eq!((rep.rotate_after, rep.tilt_after), (0, 0), "{rep:?}");
     assert_eq!((rep.runs_changed, rep.runs_kept), (1, 0), "{rep:?}");
-    assert!(rep.refits >= 1);
-    assert_eq!(rep.control_points_used, vec![fit.control_points]);
+    assert_eq!(rep.windowed, 1, "{rep:?}");
+    assert_eq!(rep.control_points_used, vec![win.control_points]);
+    assert!((rep.max_angle_change_deg - win.max_change.to_degrees()).abs() < 1e-9);
+    // the run's blocks outside the window keep their exact joints (X Y Z included)
+    let kept: Vec<_> = posted.blocks.iter().filter(|b| !b.inserted).collect();
+    assert_eq!(kept.len(), run.len());
+    for (i, (p, o)) in kept.iter().zip(&run).enumerate() {
+        if i < wa || i > wb {
+            assert_eq!(p.joints, o.joints, "block {i}");
+        }
+    }
     assert!(rep.max_angle_change_deg > 1.0 && rep.max_angle_change_deg <= 10.0 + 1e-9);
     assert_eq!(posted.metrics.reverse_motions_after, 0);
     // every angle moved by at most the limit, tips kept, joints reach the smoothed CLs
@@ -185,4 +209,21 @@ fn adaptive_fit_gives_up_at_the_cap_when_the_limit_is_too_tight() {
     // 4, 8, 16, 30 (= 60 / 2)
     assert_eq!(adaptive_control_cap(60, 4), 30);
     assert_eq!(fit.fits, 4);
+}
+
+#[test]
+fn reversal_windows_cover_the_range_that_must_change() {
+    // rises to 5, falls back to 3, rises again past 5 at index 7
+    let a = [
+        0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 3.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0,
+    ];
+    // 4 lies above the later 3 and 3 behind the earlier 5; 5 lies above the later 3
+    assert_eq!(reversal_windows(&a, 1.0, 0), vec![(4, 6)]);
+    assert_eq!(reversal_windows(&a, 1.0, 2), vec![(2, 8)]);
+    // padding clamps at the ends and merges neighbouring ranges
+    let b = [0.0, 2.0, 1.0, 3.0, 4.0, 6.0, 5.0, 7.0];
+    assert_eq!(reversal_windows(&b, 1.0, 0), vec![(1, 2), (5, 6)]);
+    assert_eq!(reversal_windows(&b, 1.0, 1), vec![(0, 7)]);
+    // a monotone sequence (standing still included) has no window
+    assert!(reversal_windows(&[3.0, 2.0, 2.0, 1.0], -1.0, 3).is_empty());
 }
