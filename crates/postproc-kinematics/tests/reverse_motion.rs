@@ -227,3 +227,57 @@ fn reversal_windows_cover_the_range_that_must_change() {
     // a monotone sequence (standing still included) has no window
     assert!(reversal_windows(&[3.0, 2.0, 2.0, 1.0], -1.0, 3).is_empty());
 }
+
+mod props {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// A steadily turning axis (random positive steps) with one dip back of 0.5°–4° over a
+        /// few blocks: the windowed smoothing leaves no reverse motion, changes no angle by
+        /// more than the dip, and keeps every block outside its windows exactly.
+        #[test]
+        fn windowed_smoothing_removes_a_dip_and_keeps_the_rest(
+            steps in proptest::collection::vec(0.05f64..0.6, 40..120),
+            at in 0.15f64..0.85,
+            width in 2usize..6,
+            depth_deg in 0.5f64..4.0,
+            down in any::<bool>(),
+        ) {
+            let sign = if down { -1.0 } else { 1.0 };
+            let mut a = vec![0.0];
+            for s in &steps {
+                a.push(a.last().unwrap() + sign * s.to_radians());
+            }
+            let m = a.len();
+            let c = ((at * m as f64) as usize).clamp(1, m - width - 1);
+            let depth = depth_deg.to_radians();
+            let peak = a[c];
+            for (k, v) in a[c + 1..=c + width].iter_mut().enumerate() {
+                // fall back to `peak - depth` and climb back over `width` blocks
+                let f = 1.0 - (k as f64 + 1.0) / (width as f64 + 1.0);
+                *v = peak - sign * depth * f;
+            }
+            prop_assume!(count_reverse_motions(&a, REVERSE_DEAD_BAND_RAD) >= 1);
+            let t: Vec<f64> = (0..m).map(|i| i as f64 / (m - 1) as f64).collect();
+            let opts = ReverseMotionOptions::default();
+            let win = smooth_monotone_windowed(&t, &a, &opts).unwrap();
+            prop_assert!(win.accepted, "{:?}", win.windows);
+            prop_assert_eq!(count_reverse_motions(&win.angles, REVERSE_DEAD_BAND_RAD), 0);
+            // the contract; and, since a window's ends are kept and its smoothed angles move
+            // one way between them, no change exceeds the window's own net turn
+            prop_assert!(win.max_change <= opts.max_angle_change);
+            let turn = win
+                .windows
+                .iter()
+                .map(|&(s, e)| (a[e] - a[s]).abs())
+                .fold(0.0, f64::max);
+            prop_assert!(win.max_change <= turn + 1e-12, "{} > {}", win.max_change, turn);
+            for (i, (x, y)) in a.iter().zip(&win.angles).enumerate() {
+                if win.windows.iter().all(|&(s, e)| i < s || i > e) {
+                    prop_assert_eq!(x, y, "block {}", i);
+                }
+            }
+        }
+    }
+}
