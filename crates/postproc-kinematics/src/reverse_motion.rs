@@ -698,6 +698,9 @@ pub fn smooth_monotone_windowed(
     })
 }
 
+/// A shift-and-smooth of one angle sequence (parameters, angles, options).
+type SmoothingStrategy = fn(&[f64], &[f64], &ReverseMotionOptions) -> Option<SmoothedAngles>;
+
 /// Removes reverse motions of the rotary axes run by run (paper 004 procedure steps 2–7):
 /// shift-and-smooth each reversing axis within windows around its reversals
 /// ([`smooth_monotone_windowed`]; the other blocks keep their exact angles), or, when the
@@ -746,26 +749,23 @@ pub fn remove_reverse_motions(
             }
             // Windows around the reversals first; the whole run when they cannot be made
             // monotone within the limit.
-            let mut tried = Vec::with_capacity(2);
+            let strategies: [SmoothingStrategy; 2] =
+                [smooth_monotone_windowed, smooth_monotone_adaptive];
             let mut accepted = None;
-            for fit in [
-                smooth_monotone_windowed(&t, &angles, opts),
-                smooth_monotone_adaptive(&t, &angles, opts),
-            ]
-            .into_iter()
-            .flatten()
-            {
-                tried.push((fit.fits, fit.iterations, fit.projections));
+            let mut fits_tried = 0;
+            for smooth in strategies {
+                let Some(fit) = smooth(&t, &angles, opts) else {
+                    continue;
+                };
+                rep.iterations += fit.iterations;
+                rep.projections += fit.projections;
+                fits_tried += fit.fits;
                 if fit.accepted {
                     accepted = Some(fit);
                     break;
                 }
             }
-            for (fits, iters, projections) in tried {
-                rep.iterations += iters;
-                rep.projections += projections;
-                rep.refits += fits.saturating_sub(1);
-            }
+            rep.refits += fits_tried.saturating_sub(1);
             let Some(fit) = accepted else {
                 ok = false;
                 break;
