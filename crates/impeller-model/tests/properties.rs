@@ -162,11 +162,20 @@ proptest! {
         let c = impeller_model::MeridionalCurve::quarter_ellipse([zi, ri], [zo, ro]).unwrap();
         let q = nalgebra::Vector2::new(qz, qr);
         let (t, d) = c.closest(q);
-        let best = (0..=2000)
-            .map(|k| (c.point(k as f64 / 2000.0) - q).norm())
+        let samples: Vec<_> = (0..=2000).map(|k| c.point(k as f64 / 2000.0)).collect();
+        let best = samples
+            .iter()
+            .map(|p| (p - q).norm())
             .fold(f64::INFINITY, f64::min);
+        // The nearest sample lies within half the largest sample spacing of the true closest
+        // point (the curve is smooth), so the dense distance can exceed the global minimum by
+        // at most that much.
+        let spacing = samples
+            .windows(2)
+            .map(|w| (w[1] - w[0]).norm())
+            .fold(0.0, f64::max);
         prop_assert!(d.abs() <= best + 1e-9, "{} > {best}", d.abs());
-        prop_assert!(best - d.abs() < 1e-2);
+        prop_assert!(best - d.abs() <= 0.5 * spacing + 1e-9, "{best} vs {}", d.abs());
         let n = c.normal(t);
         if d.abs() > 1e-6 && t > 1e-9 && t < 1.0 - 1e-9 {
             prop_assert!(((q - c.point(t)).dot(&n) > 0.0) == (d > 0.0));
