@@ -150,3 +150,52 @@ impl ToolPath {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{CutterLocation, Point3};
+
+    fn at(x: f64, y: f64, z: f64) -> CutterLocation {
+        CutterLocation::vertical(Point3::new(x, y, z))
+    }
+
+    #[test]
+    fn length_and_time_follow_each_moves_kind_and_feed() {
+        let mut p = ToolPath::new("op", "t1");
+        p.moves.push(Move::rapid(at(0.0, 0.0, 50.0)));
+        p.moves.push(Move::rapid(at(0.0, 0.0, 10.0))); // 40 mm rapid
+        p.moves.push(Move {
+            kind: MoveKind::Plunge,
+            cl: at(0.0, 0.0, 0.0),
+            feed_mm_per_min: None,
+        }); // 10 mm at the plunge rate
+        p.moves.push(Move::feed(at(30.0, 40.0, 0.0))); // 50 mm at the default feed
+        p.moves.push(Move {
+            kind: MoveKind::Feed,
+            cl: at(30.0, 40.0, 20.0),
+            feed_mm_per_min: Some(200.0),
+        }); // 20 mm at its own feed
+        let rates = Rates {
+            feed_mm_per_min: 1000.0,
+            plunge_mm_per_min: 100.0,
+            rapid_mm_per_min: 12000.0,
+        };
+        assert!((p.path_length_mm() - 120.0).abs() < 1e-12);
+        assert!((p.cutting_length_mm() - 80.0).abs() < 1e-12);
+        let expected = 60.0 * (40.0 / 12000.0 + 10.0 / 100.0 + 50.0 / 1000.0 + 20.0 / 200.0);
+        assert!((p.cutting_time_s(&rates) - expected).abs() < 1e-12);
+        assert!(rates.validate().is_ok());
+        let bad = Rates {
+            rapid_mm_per_min: 0.0,
+            ..rates
+        };
+        assert!(matches!(
+            bad.validate(),
+            Err(CamError::NonPositive {
+                field: "rapid_mm_per_min",
+                ..
+            })
+        ));
+    }
+}

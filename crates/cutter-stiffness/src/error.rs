@@ -23,6 +23,16 @@ pub enum StiffnessError {
         /// Terms per section used.
         terms: usize,
     },
+    /// The adaptive Ritz expansion did not converge within its largest term count.
+    #[error("Rayleigh-Ritz indicator did not converge to {rel_tol:e} within {terms} terms (last relative change {change:e})")]
+    NotConverged {
+        /// Terms reached.
+        terms: usize,
+        /// Requested relative tolerance.
+        rel_tol: f64,
+        /// Last relative change of the indicator.
+        change: f64,
+    },
     /// The cutter shape has no conical-beam model (only ball-ended and flat cutters do).
     #[error("cutter `{0}`: shape not supported by the stiffness model")]
     UnsupportedCutter(String),

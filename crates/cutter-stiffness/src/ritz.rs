@@ -23,8 +23,8 @@ impl Default for RitzOptions {
     fn default() -> Self {
         Self {
             terms: None,
-            rel_tol: 1e-12,
-            max_terms: 40,
+            rel_tol: 1e-10,
+            max_terms: 80,
         }
     }
 }
@@ -120,7 +120,8 @@ impl RitzSolution {
     ///
     /// With `options.terms = Some(n)` it uses `n ≥ 2` terms per section; otherwise it adds
     /// terms until two successive indicators differ by less than `rel_tol` relative (the
-    /// convergence is geometric, typically 6–15 terms for taper ratios up to 12).
+    /// convergence is geometric, typically 6–15 terms for taper ratios up to 12), and
+    /// returns [`StiffnessError::NotConverged`] if `max_terms` is reached first.
     pub fn solve(beam: &Beam, options: &RitzOptions) -> Result<Self, StiffnessError> {
         if let Some(n) = options.terms {
             if !(2..=200).contains(&n) {
@@ -133,15 +134,20 @@ impl RitzSolution {
             return solve_fixed(beam, n);
         }
         let mut prev = solve_fixed(beam, 2)?;
+        let mut change = f64::INFINITY;
         for n in 3..=options.max_terms.max(3) {
             let next = solve_fixed(beam, n)?;
-            let change = (next.stiffness - prev.stiffness).abs() / next.stiffness;
+            change = (next.stiffness - prev.stiffness).abs() / next.stiffness;
             prev = next;
             if change < options.rel_tol {
-                break;
+                return Ok(prev);
             }
         }
-        Ok(prev)
+        Err(StiffnessError::NotConverged {
+            terms: prev.terms,
+            rel_tol: options.rel_tol,
+            change,
+        })
     }
 
     /// Derivative of the indicator with respect to a shape parameter `p`, given
@@ -227,6 +233,28 @@ mod tests {
             .unwrap()
             .stiffness;
         assert!((k / exact - 1.0).abs() < 1e-9, "{k} vs {exact}");
+    }
+
+    #[test]
+    fn non_convergence_is_an_error_not_a_silent_value() {
+        let beam = Beam::new(
+            vec![Section {
+                length: 40.0,
+                radius_clamp_side: 8.0,
+                radius_load_side: 1.0,
+            }],
+            600e3,
+        )
+        .unwrap();
+        let opts = RitzOptions {
+            rel_tol: 1e-15,
+            max_terms: 4,
+            ..Default::default()
+        };
+        assert!(matches!(
+            RitzSolution::solve(&beam, &opts),
+            Err(StiffnessError::NotConverged { terms: 4, .. })
+        ));
     }
 
     #[test]

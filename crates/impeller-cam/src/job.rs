@@ -12,7 +12,7 @@
 //!
 //! [verification]                             # optional
 //! enabled = true
-//! resolution_mm = 0.25
+//! resolution_mm = 0.1                      # dexel spacing (mm)
 //!
 //! [[cl_files]]                               # CL data from any CAM system: posted + verified
 //! path = "rough.cls"
@@ -61,7 +61,7 @@ impl Default for VerificationSpec {
     fn default() -> Self {
         Self {
             enabled: true,
-            resolution_mm: 0.25,
+            resolution_mm: 0.1,
         }
     }
 }

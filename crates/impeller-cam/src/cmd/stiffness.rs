@@ -19,7 +19,7 @@ pub struct Args {
     /// Young's modulus (GPa); 600 GPa is typical of cemented carbide.
     #[arg(long, value_name = "GPA", default_value_t = 600.0)]
     pub youngs: f64,
-    /// Ritz terms (default: grow until converged to 1e-12 relative).
+    /// Ritz terms (default: grow until converged to 1e-10 relative, at most 80).
     #[arg(long)]
     pub terms: Option<usize>,
     /// Print JSON instead of text.
