@@ -21,36 +21,14 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
 use nurbs::closest::SurfaceProjector;
-use nurbs::NurbsSurface;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// Seed shared with `examples/closest_point_queries.rs`.
-const SEED: u64 = 20_240_601;
-const COUNT: usize = 20_000;
+#[path = "common/reference.rs"]
+mod reference;
+use reference::{reference_surface, SEED};
 
-fn reference_surface() -> NurbsSurface {
-    let ctrl: Vec<Vec<Vector3<f64>>> = (0..12)
-        .map(|i| {
-            (0..12)
-                .map(|j| {
-                    let x = 100.0 * i as f64 / 11.0;
-                    let y = 100.0 * j as f64 / 11.0;
-                    Vector3::new(
-                        x,
-                        y,
-                        8.0 * (x / 17.0).sin() * (y / 23.0).cos() + 0.002 * x * y,
-                    )
-                })
-                .collect()
-        })
-        .collect();
-    let knots = nurbs::KnotVector::clamped_uniform(3, 12)
-        .unwrap()
-        .knots()
-        .to_vec();
-    NurbsSurface::new(3, 3, knots.clone(), knots, ctrl, None).unwrap()
-}
+const COUNT: usize = 20_000;
 
 fn bench(c: &mut Criterion) {
     let surface = reference_surface();

@@ -25,31 +25,9 @@ use nurbs::NurbsSurface;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// Seed of the query generator (shared with `benches/nurbs.rs`).
-const SEED: u64 = 20_240_601;
-
-fn reference_surface() -> NurbsSurface {
-    let ctrl: Vec<Vec<Vector3<f64>>> = (0..12)
-        .map(|i| {
-            (0..12)
-                .map(|j| {
-                    let x = 100.0 * i as f64 / 11.0;
-                    let y = 100.0 * j as f64 / 11.0;
-                    Vector3::new(
-                        x,
-                        y,
-                        8.0 * (x / 17.0).sin() * (y / 23.0).cos() + 0.002 * x * y,
-                    )
-                })
-                .collect()
-        })
-        .collect();
-    let knots = nurbs::KnotVector::clamped_uniform(3, 12)
-        .unwrap()
-        .knots()
-        .to_vec();
-    NurbsSurface::new(3, 3, knots.clone(), knots, ctrl, None).unwrap()
-}
+#[path = "../benches/common/reference.rs"]
+mod reference;
+use reference::{reference_surface, SEED};
 
 /// Bound-constrained Newton on [0,1]² (independent of the library's engine).
 fn polish(s: &NurbsSurface, q: &Vector3<f64>, mut u: f64, mut v: f64) -> (f64, f64, f64) {
