@@ -87,20 +87,11 @@ pub fn xy_approach(
     Ok(())
 }
 
-/// [`write_moves`], then the block leaving inverse-time mode if the moves entered it.
-pub fn write_moves_and_leave_inverse_time(
-    w: &mut BlockWriter,
-    mw: &mut MotionWriter,
-    op_name: &str,
-    mode: OutputMode,
-    moves: &[NcMove],
-    prefix: &str,
-) -> Result<(), GcodeError> {
-    write_moves(w, mw, op_name, mode, moves, prefix)?;
+/// The block leaving inverse-time mode (`G94`), if the moves written so far entered it.
+pub fn leave_inverse_time(w: &mut BlockWriter, mw: &mut MotionWriter) {
     if let Some(feed_mode) = mw.leave_inverse_time() {
         w.block(feed_mode);
     }
-    Ok(())
 }
 
 /// The tips of a 3+2 operation once the control's tilted plane is active: each tip mapped

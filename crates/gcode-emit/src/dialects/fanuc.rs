@@ -19,8 +19,8 @@
 //!   retracts in machine coordinates before any tool change or reorientation.
 
 use super::common::{
-    iso_style, op_comment, preposition_rotary, retract_block, spindle_and_coolant,
-    write_moves_and_leave_inverse_time, write_tilted_tips, xy_approach,
+    iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block,
+    spindle_and_coolant, write_moves, write_tilted_tips, xy_approach,
 };
 use crate::dialect::{num, program_name, sanitize, At, BlockWriter, Dialect, MotionWriter};
 use crate::program::{Motion, NcProgram, OutputMode, ProgramOptions};
@@ -101,9 +101,8 @@ impl Dialect for Fanuc {
                         OutputMode::TcpAngles => format!("G43.4 H{h}"),
                         OutputMode::TcpVector => format!("G43.5 H{h}"),
                     };
-                    write_moves_and_leave_inverse_time(
-                        &mut w, &mut mw, &op.name, mode, moves, &prefix,
-                    )?;
+                    write_moves(&mut w, &mut mw, &op.name, mode, moves, &prefix)?;
+                    leave_inverse_time(&mut w, &mut mw);
                     w.block("G49");
                 }
                 Motion::Indexed {

@@ -14,8 +14,8 @@
 //! - Checked by running LinuxCNC's own interpreter `rs274` on our output (tests/rs274.rs).
 
 use super::common::{
-    iso_style, op_comment, preposition_rotary, retract_block, simultaneous, spindle_and_coolant,
-    write_moves_and_leave_inverse_time, xy_approach,
+    iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block, simultaneous,
+    spindle_and_coolant, write_moves, xy_approach,
 };
 use crate::dialect::{program_name, sanitize, At, BlockWriter, Dialect, MotionWriter};
 use crate::program::{NcProgram, OutputMode, ProgramOptions};
@@ -91,7 +91,8 @@ impl Dialect for LinuxCnc {
             } else {
                 xy_approach(&mut w, style, first, at)?;
             }
-            write_moves_and_leave_inverse_time(&mut w, &mut mw, &op.name, mode, moves, "")?;
+            write_moves(&mut w, &mut mw, &op.name, mode, moves, "")?;
+            leave_inverse_time(&mut w, &mut mw);
             if mode == OutputMode::TcpAngles {
                 w.block(&self.tcp_off);
             }

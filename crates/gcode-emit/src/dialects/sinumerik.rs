@@ -18,8 +18,8 @@
 //!   plane at the operation's end.
 
 use super::common::{
-    iso_style, op_comment, preposition_rotary, retract_block, spindle_and_coolant,
-    write_moves_and_leave_inverse_time, write_tilted_tips, xy_approach,
+    iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block,
+    spindle_and_coolant, write_moves, write_tilted_tips, xy_approach,
 };
 use crate::dialect::{
     num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
@@ -95,9 +95,8 @@ impl Dialect for Sinumerik {
                             w.block("ORIWKS");
                         }
                     }
-                    write_moves_and_leave_inverse_time(
-                        &mut w, &mut mw, &op.name, *mode, moves, "",
-                    )?;
+                    write_moves(&mut w, &mut mw, &op.name, *mode, moves, "")?;
+                    leave_inverse_time(&mut w, &mut mw);
                     if *mode != OutputMode::Joint {
                         w.block("TRAFOOF");
                     }
