@@ -107,6 +107,21 @@ pub struct At<'a> {
     pub block: usize,
 }
 
+impl<'a> At<'a> {
+    /// The program-level blocks (header, retract, end).
+    pub const fn program() -> At<'static> {
+        At {
+            op: "program",
+            block: 0,
+        }
+    }
+
+    /// The blocks that set up operation `op` before its first move.
+    pub const fn start(op: &'a str) -> Self {
+        Self { op, block: 0 }
+    }
+}
+
 /// Formats `v` with `fmt` or returns [`GcodeError::NonFinite`] naming the word and block.
 pub fn num(fmt: NumberFormat, v: f64, word: &str, at: At<'_>) -> Result<String, GcodeError> {
     fmt.format(v).ok_or_else(|| GcodeError::NonFinite {
@@ -223,6 +238,11 @@ impl MotionWriter {
         for l in &mut self.last {
             *l = None;
         }
+    }
+
+    /// The words and number formats this writer uses.
+    pub fn style(&self) -> MotionStyle {
+        self.style
     }
 
     /// `true` while inverse-time mode is active.

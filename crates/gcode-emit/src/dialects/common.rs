@@ -1,8 +1,122 @@
 //! Pieces of program structure several dialects share.
 
-use crate::dialect::{num, At, BlockWriter, MotionWriter};
-use crate::program::{Feed, Motion, NcMove, NcOperation, OutputMode};
+use crate::dialect::{num, At, BlockWriter, MotionStyle, MotionWriter};
+use crate::program::{Feed, Motion, NcMove, NcOperation, OutputMode, ProgramOptions, ToolCall};
+use crate::tilted_plane::TiltedPlane;
 use crate::{Coolant, GcodeError, NumberFormat, Spindle};
+use cam_core::Point3;
+
+/// `G0`/`G1`, `G93`/`G94`, tool vector as `I J K`; lengths and angles formatted by
+/// `positions`, feeds by `feeds`, each with the decimals the options ask for. Dialects
+/// override the words their controller spells differently.
+pub fn iso_style(
+    o: &ProgramOptions,
+    positions: fn(usize) -> NumberFormat,
+    feeds: fn(usize) -> NumberFormat,
+) -> MotionStyle {
+    MotionStyle {
+        rapid: "G0",
+        linear: "G1",
+        feed_modes: ("G93", "G94"),
+        vector_words: ["I", "J", "K"],
+        linear_fmt: positions(o.linear_decimals),
+        angular_fmt: positions(o.angular_decimals),
+        feed_fmt: feeds(o.feed_decimals),
+        inverse_fmt: feeds(o.inverse_time_decimals),
+    }
+}
+
+/// The retract block to the safe height in machine coordinates: `before Z<safe>after`
+/// (each controller names machine coordinates its own way: `G53 G0`, `G00 .. M91`,
+/// `G0 SUPA .. D0`).
+pub fn retract_block(
+    before: &str,
+    after: &str,
+    o: &ProgramOptions,
+    fmt: NumberFormat,
+) -> Result<String, GcodeError> {
+    let z = num(fmt, o.safe_z_machine, "Z", At::program())?;
+    Ok(format!("{before} Z{z}{after}"))
+}
+
+/// The spindle block (`S.. M3`/`M4`, integer speed, or `M5`) and the coolant block.
+pub fn spindle_and_coolant(
+    w: &mut BlockWriter,
+    tool: &ToolCall,
+    at: At<'_>,
+) -> Result<(), GcodeError> {
+    w.block(&spindle_words(tool.spindle, NumberFormat::trimmed(0), at)?);
+    w.block(coolant_word(tool.coolant));
+    Ok(())
+}
+
+/// Rapid of the rotary axes alone to the first move's angles, before the linear approach;
+/// nothing when the move has no rotary words or in tool-vector mode (there the control
+/// chooses the angles).
+pub fn preposition_rotary(
+    w: &mut BlockWriter,
+    style: MotionStyle,
+    mode: OutputMode,
+    first: &NcMove,
+    at: At<'_>,
+) -> Result<(), GcodeError> {
+    if mode != OutputMode::TcpVector && !first.rotary.is_empty() {
+        w.block(&format!(
+            "{} {}",
+            style.rapid,
+            rotary_words(first, style.angular_fmt, at)?
+        ));
+    }
+    Ok(())
+}
+
+/// Rapid in X Y alone to the first move, so the approach that follows runs along Z.
+pub fn xy_approach(
+    w: &mut BlockWriter,
+    style: MotionStyle,
+    first: &NcMove,
+    at: At<'_>,
+) -> Result<(), GcodeError> {
+    let fmt = style.linear_fmt;
+    w.block(&format!(
+        "{} X{} Y{}",
+        style.rapid,
+        num(fmt, first.xyz[0], "X", at)?,
+        num(fmt, first.xyz[1], "Y", at)?
+    ));
+    Ok(())
+}
+
+/// The block leaving inverse-time mode (`G94`), if the moves written so far entered it.
+pub fn leave_inverse_time(w: &mut BlockWriter, mw: &mut MotionWriter) {
+    if let Some(feed_mode) = mw.leave_inverse_time() {
+        w.block(feed_mode);
+    }
+}
+
+/// The tips of a 3+2 operation once the control's tilted plane is active: each tip mapped
+/// into the plane's frame, an X Y rapid to the first, then three-axis moves, the first
+/// written block carrying `prefix`.
+pub fn write_tilted_tips(
+    w: &mut BlockWriter,
+    mw: &mut MotionWriter,
+    op_name: &str,
+    plane: &TiltedPlane,
+    tips: &[(Point3, Feed)],
+    prefix: &str,
+) -> Result<(), GcodeError> {
+    let moves: Vec<_> = tips
+        .iter()
+        .map(|(p, f)| {
+            let q = plane.to_plane(p);
+            tip_move([q.x, q.y, q.z], *f)
+        })
+        .collect();
+    if let Some(first) = moves.first() {
+        xy_approach(w, mw.style(), first, At::start(op_name))?;
+    }
+    write_moves(w, mw, op_name, OutputMode::TcpAngles, &moves, prefix)
+}
 
 /// `M3`/`M4` with `S`, or `M5`.
 pub fn spindle_words(

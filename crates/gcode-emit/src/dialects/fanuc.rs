@@ -18,10 +18,11 @@
 //! - `G49` cancels compensation / TCP at the end of each operation, then `G53 G0 Z<safe>`
 //!   retracts in machine coordinates before any tool change or reorientation.
 
-use super::common::{coolant_word, op_comment, rotary_words, spindle_words, tip_move, write_moves};
-use crate::dialect::{
-    num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
+use super::common::{
+    iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block,
+    spindle_and_coolant, write_moves, write_tilted_tips, xy_approach,
 };
+use crate::dialect::{num, program_name, sanitize, At, BlockWriter, Dialect, MotionWriter};
 use crate::program::{Motion, NcProgram, OutputMode, ProgramOptions};
 use crate::tilted_plane::TiltedPlane;
 use crate::{GcodeError, NumberFormat};
@@ -59,17 +60,7 @@ impl Dialect for Fanuc {
                 reason: format!("{} does not fit Fanuc's O0001..O9999", o.program_number),
             });
         }
-        let style = MotionStyle {
-            rapid: "G0",
-            linear: "G1",
-            feed_modes: ("G93", "G94"),
-            vector_words: ["I", "J", "K"],
-            linear_fmt: pointed(o.linear_decimals),
-            angular_fmt: pointed(o.angular_decimals),
-            feed_fmt: pointed(o.feed_decimals),
-            inverse_fmt: pointed(o.inverse_time_decimals),
-        };
-        let lin = style.linear_fmt;
+        let style = iso_style(o, pointed, pointed);
         let mut w = BlockWriter::new(o.line_numbers, "");
         let mut mw = MotionWriter::new(style);
         w.raw("%");
@@ -82,17 +73,10 @@ impl Dialect for Fanuc {
             "G21 G17 G90 G94 G40 G49 G80 G{}",
             53 + o.work_offset
         ));
-        let at0 = At {
-            op: "program",
-            block: 0,
-        };
-        let safe = format!("G53 G0 Z{}", num(lin, o.safe_z_machine, "Z", at0)?);
+        let safe = retract_block("G53 G0", "", o, style.linear_fmt)?;
         let mut tool: Option<u32> = None;
         for op in &program.operations {
-            let at = At {
-                op: &op.name,
-                block: 0,
-            };
+            let at = At::start(&op.name);
             if o.comments {
                 w.raw(&format!("({})", sanitize(&op_comment(op), true)));
             }
@@ -101,40 +85,25 @@ impl Dialect for Fanuc {
                 w.block(&format!("T{} M6", op.tool.number));
                 tool = Some(op.tool.number);
             }
-            w.block(&spindle_words(
-                op.tool.spindle,
-                NumberFormat::trimmed(0),
-                at,
-            )?);
-            w.block(coolant_word(op.tool.coolant));
+            spindle_and_coolant(&mut w, &op.tool, at)?;
             mw.forget_positions();
+            let h = op.tool.number;
             match &op.motion {
                 Motion::Simultaneous { mode, moves } => {
                     let mode = *mode;
                     let Some(first) = moves.first() else { continue };
-                    if mode != OutputMode::TcpVector && !first.rotary.is_empty() {
-                        w.block(&format!(
-                            "G0 {}",
-                            rotary_words(first, style.angular_fmt, at)?
-                        ));
-                    }
-                    let h = op.tool.number;
+                    preposition_rotary(&mut w, style, mode, first, at)?;
                     let prefix = match mode {
                         OutputMode::Joint => {
-                            w.block(&format!(
-                                "G0 X{} Y{}",
-                                num(lin, first.xyz[0], "X", at)?,
-                                num(lin, first.xyz[1], "Y", at)?
-                            ));
+                            xy_approach(&mut w, style, first, at)?;
                             format!("G43 H{h}")
                         }
                         OutputMode::TcpAngles => format!("G43.4 H{h}"),
                         OutputMode::TcpVector => format!("G43.5 H{h}"),
                     };
                     write_moves(&mut w, &mut mw, &op.name, mode, moves, &prefix)?;
-                    if let Some(g94) = mw.leave_inverse_time() {
-                        w.block(g94);
-                    }
+                    leave_inverse_time(&mut w, &mut mw);
+                    w.block("G49");
                 }
                 Motion::Indexed {
                     tool_axis, tips, ..
@@ -146,42 +115,17 @@ impl Dialect for Fanuc {
                         num(style.angular_fmt, plane.b.to_degrees(), "J", at)?
                     ));
                     w.block("G53.1");
-                    let moves: Vec<_> = tips
-                        .iter()
-                        .map(|(p, f)| {
-                            let q = plane.to_plane(p);
-                            tip_move([q.x, q.y, q.z], *f)
-                        })
-                        .collect();
-                    if let Some(first) = moves.first() {
-                        w.block(&format!(
-                            "G0 X{} Y{}",
-                            num(lin, first.xyz[0], "X", at)?,
-                            num(lin, first.xyz[1], "Y", at)?
-                        ));
-                    }
-                    let prefix = format!("G43 H{}", op.tool.number);
-                    write_moves(
-                        &mut w,
-                        &mut mw,
-                        &op.name,
-                        OutputMode::TcpAngles,
-                        &moves,
-                        &prefix,
-                    )?;
+                    let prefix = format!("G43 H{h}");
+                    write_tilted_tips(&mut w, &mut mw, &op.name, &plane, tips, &prefix)?;
                     w.block("G49");
                     w.block("G69");
-                    mw.forget_positions();
-                    continue;
                 }
             }
-            w.block("G49");
             mw.forget_positions();
         }
-        w.block(&safe);
-        w.block("M5");
-        w.block("M9");
-        w.block("M30");
+        for end in [safe.as_str(), "M5", "M9", "M30"] {
+            w.block(end);
+        }
         w.raw("%");
         Ok(w.finish())
     }

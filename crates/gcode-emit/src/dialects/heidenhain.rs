@@ -17,7 +17,10 @@
 //! - Joint (inverse-time) output is not offered: TNC feeds rotary moves in deg/min or
 //!   through M116/M128, not `G93`.
 
-use super::common::{coolant_word, op_comment, rotary_words, tip_move, write_moves};
+use super::common::{
+    coolant_word, iso_style, op_comment, preposition_rotary, retract_block, write_moves,
+    write_tilted_tips,
+};
 use crate::dialect::{
     num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
 };
@@ -55,14 +58,8 @@ impl Dialect for HeidenhainIso {
         let style = MotionStyle {
             rapid: "G00",
             linear: "G01",
-            feed_modes: ("G93", "G94"),
-            vector_words: ["I", "J", "K"],
-            linear_fmt: signed(o.linear_decimals),
-            angular_fmt: signed(o.angular_decimals),
-            feed_fmt: NumberFormat::trimmed(o.feed_decimals),
-            inverse_fmt: NumberFormat::trimmed(o.inverse_time_decimals),
+            ..iso_style(o, signed, NumberFormat::trimmed)
         };
-        let lin = style.linear_fmt;
         let ang = style.angular_fmt;
         let name = program_name(&program.name);
         let numbers = o.line_numbers.unwrap_or(LineNumbers {
@@ -73,17 +70,10 @@ impl Dialect for HeidenhainIso {
         let mut mw = MotionWriter::new(style);
         w.raw(&format!("%{name} G71 *"));
         w.block("G17 G90 G40");
-        let at0 = At {
-            op: "program",
-            block: 0,
-        };
-        let safe = format!("G00 Z{} M91", num(lin, o.safe_z_machine, "Z", at0)?);
+        let safe = retract_block("G00", " M91", o, style.linear_fmt)?;
         let mut tool: Option<u32> = None;
         for op in &program.operations {
-            let at = At {
-                op: &op.name,
-                block: 0,
-            };
+            let at = At::start(&op.name);
             if o.comments {
                 w.block(&format!(";{}", sanitize(&op_comment(op), true)));
             }
@@ -120,9 +110,7 @@ impl Dialect for HeidenhainIso {
                         });
                     }
                     let Some(first) = moves.first() else { continue };
-                    if !first.rotary.is_empty() {
-                        w.block(&format!("G00 {}", rotary_words(first, ang, at)?));
-                    }
+                    preposition_rotary(&mut w, style, *mode, first, at)?;
                     w.block("M128");
                     write_moves(&mut w, &mut mw, &op.name, *mode, moves, "")?;
                     w.block("M129");
@@ -136,30 +124,15 @@ impl Dialect for HeidenhainIso {
                         num(ang, plane.a.to_degrees(), "SPA", at)?,
                         num(ang, plane.b.to_degrees(), "SPB", at)?
                     ));
-                    let moves: Vec<_> = tips
-                        .iter()
-                        .map(|(p, f)| {
-                            let q = plane.to_plane(p);
-                            tip_move([q.x, q.y, q.z], *f)
-                        })
-                        .collect();
-                    if let Some(first) = moves.first() {
-                        w.block(&format!(
-                            "G00 X{} Y{}",
-                            num(lin, first.xyz[0], "X", at)?,
-                            num(lin, first.xyz[1], "Y", at)?
-                        ));
-                    }
-                    write_moves(&mut w, &mut mw, &op.name, OutputMode::TcpAngles, &moves, "")?;
+                    write_tilted_tips(&mut w, &mut mw, &op.name, &plane, tips, "")?;
                     w.block("PLANE RESET STAY");
                 }
             }
             mw.forget_positions();
         }
-        w.block(&safe);
-        w.block("M5");
-        w.block("M9");
-        w.block("M30");
+        for end in [safe.as_str(), "M5", "M9", "M30"] {
+            w.block(end);
+        }
         w.raw(&format!("N99999999 %{name} G71 *"));
         Ok(w.finish())
     }

@@ -14,11 +14,10 @@
 //! - Checked by running LinuxCNC's own interpreter `rs274` on our output (tests/rs274.rs).
 
 use super::common::{
-    coolant_word, op_comment, rotary_words, simultaneous, spindle_words, write_moves,
+    iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block, simultaneous,
+    spindle_and_coolant, write_moves, xy_approach,
 };
-use crate::dialect::{
-    num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
-};
+use crate::dialect::{program_name, sanitize, At, BlockWriter, Dialect, MotionWriter};
 use crate::program::{NcProgram, OutputMode, ProgramOptions};
 use crate::{GcodeError, NumberFormat};
 
@@ -44,21 +43,6 @@ impl Default for LinuxCnc {
     }
 }
 
-impl LinuxCnc {
-    fn style(o: &ProgramOptions) -> MotionStyle {
-        MotionStyle {
-            rapid: "G0",
-            linear: "G1",
-            feed_modes: ("G93", "G94"),
-            vector_words: ["I", "J", "K"],
-            linear_fmt: NumberFormat::trimmed(o.linear_decimals),
-            angular_fmt: NumberFormat::trimmed(o.angular_decimals),
-            feed_fmt: NumberFormat::trimmed(o.feed_decimals),
-            inverse_fmt: NumberFormat::trimmed(o.inverse_time_decimals),
-        }
-    }
-}
-
 impl Dialect for LinuxCnc {
     fn name(&self) -> &'static str {
         "linuxcnc"
@@ -75,8 +59,7 @@ impl Dialect for LinuxCnc {
 
     fn write(&self, program: &NcProgram, o: &ProgramOptions) -> Result<String, GcodeError> {
         o.validate()?;
-        let style = Self::style(o);
-        let lin = style.linear_fmt;
+        let style = iso_style(o, NumberFormat::trimmed, NumberFormat::trimmed);
         let mut w = BlockWriter::new(o.line_numbers, "");
         let mut mw = MotionWriter::new(style);
         w.raw("%");
@@ -84,20 +67,13 @@ impl Dialect for LinuxCnc {
             w.raw(&format!("({})", program_name(&program.name)));
         }
         w.block(&format!("G21 G17 G90 G94 G40 G49 G{}", 53 + o.work_offset));
-        let at0 = At {
-            op: "program",
-            block: 0,
-        };
-        let safe = format!("G53 G0 Z{}", num(lin, o.safe_z_machine, "Z", at0)?);
+        let safe = retract_block("G53 G0", "", o, style.linear_fmt)?;
         let mut tool: Option<u32> = None;
         for op in &program.operations {
             let (mode, moves) =
                 simultaneous(op, self.name(), &[OutputMode::Joint, OutputMode::TcpAngles])?;
             let Some(first) = moves.first() else { continue };
-            let at = At {
-                op: &op.name,
-                block: 0,
-            };
+            let at = At::start(&op.name);
             if o.comments {
                 w.raw(&format!("({})", sanitize(&op_comment(op), false)));
             }
@@ -107,32 +83,16 @@ impl Dialect for LinuxCnc {
                 w.block(&format!("G43 H{}", op.tool.number));
                 tool = Some(op.tool.number);
             }
-            w.block(&spindle_words(
-                op.tool.spindle,
-                NumberFormat::trimmed(0),
-                at,
-            )?);
-            w.block(coolant_word(op.tool.coolant));
+            spindle_and_coolant(&mut w, &op.tool, at)?;
             mw.forget_positions();
-            if !first.rotary.is_empty() {
-                w.block(&format!(
-                    "G0 {}",
-                    rotary_words(first, style.angular_fmt, at)?
-                ));
-            }
+            preposition_rotary(&mut w, style, mode, first, at)?;
             if mode == OutputMode::TcpAngles {
                 w.block(&self.tcp_on);
             } else {
-                w.block(&format!(
-                    "G0 X{} Y{}",
-                    num(lin, first.xyz[0], "X", at)?,
-                    num(lin, first.xyz[1], "Y", at)?
-                ));
+                xy_approach(&mut w, style, first, at)?;
             }
             write_moves(&mut w, &mut mw, &op.name, mode, moves, "")?;
-            if let Some(g94) = mw.leave_inverse_time() {
-                w.block(g94);
-            }
+            leave_inverse_time(&mut w, &mut mw);
             if mode == OutputMode::TcpAngles {
                 w.block(&self.tcp_off);
             }

@@ -17,7 +17,10 @@
 //!   first rotary angle; tips are written in the tilted frame; `CYCLE800()` resets the
 //!   plane at the operation's end.
 
-use super::common::{coolant_word, op_comment, rotary_words, spindle_words, tip_move, write_moves};
+use super::common::{
+    iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block,
+    spindle_and_coolant, write_moves, write_tilted_tips, xy_approach,
+};
 use crate::dialect::{
     num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
 };
@@ -57,16 +60,9 @@ impl Dialect for Sinumerik {
     fn write(&self, program: &NcProgram, o: &ProgramOptions) -> Result<String, GcodeError> {
         o.validate()?;
         let style = MotionStyle {
-            rapid: "G0",
-            linear: "G1",
-            feed_modes: ("G93", "G94"),
             vector_words: ["A3=", "B3=", "C3="],
-            linear_fmt: NumberFormat::trimmed(o.linear_decimals),
-            angular_fmt: NumberFormat::trimmed(o.angular_decimals),
-            feed_fmt: NumberFormat::trimmed(o.feed_decimals),
-            inverse_fmt: NumberFormat::trimmed(o.inverse_time_decimals),
+            ..iso_style(o, NumberFormat::trimmed, NumberFormat::trimmed)
         };
-        let lin = style.linear_fmt;
         let ang = style.angular_fmt;
         let mut w = BlockWriter::new(o.line_numbers, "");
         let mut mw = MotionWriter::new(style);
@@ -74,16 +70,9 @@ impl Dialect for Sinumerik {
             w.raw(&format!("; {}", program_name(&program.name)));
         }
         w.block(&format!("G17 G71 G90 G94 G40 G{}", 53 + o.work_offset));
-        let at0 = At {
-            op: "program",
-            block: 0,
-        };
-        let safe = format!("G0 SUPA Z{} D0", num(lin, o.safe_z_machine, "Z", at0)?);
+        let safe = retract_block("G0 SUPA", " D0", o, style.linear_fmt)?;
         for op in &program.operations {
-            let at = At {
-                op: &op.name,
-                block: 0,
-            };
+            let at = At::start(&op.name);
             if o.comments {
                 w.raw(&format!("; {}", sanitize(&op_comment(op), false)));
             }
@@ -92,25 +81,14 @@ impl Dialect for Sinumerik {
             w.block(&format!("T{}", op.tool.number));
             w.block("M6");
             w.block("D1");
-            w.block(&spindle_words(
-                op.tool.spindle,
-                NumberFormat::trimmed(0),
-                at,
-            )?);
-            w.block(coolant_word(op.tool.coolant));
+            spindle_and_coolant(&mut w, &op.tool, at)?;
             mw.forget_positions();
             match &op.motion {
                 Motion::Simultaneous { mode, moves } => {
                     let Some(first) = moves.first() else { continue };
-                    if *mode != OutputMode::TcpVector && !first.rotary.is_empty() {
-                        w.block(&format!("G0 {}", rotary_words(first, ang, at)?));
-                    }
+                    preposition_rotary(&mut w, style, *mode, first, at)?;
                     match mode {
-                        OutputMode::Joint => w.block(&format!(
-                            "G0 X{} Y{}",
-                            num(lin, first.xyz[0], "X", at)?,
-                            num(lin, first.xyz[1], "Y", at)?
-                        )),
+                        OutputMode::Joint => xy_approach(&mut w, style, first, at)?,
                         OutputMode::TcpAngles => w.block("TRAORI"),
                         OutputMode::TcpVector => {
                             w.block("TRAORI");
@@ -118,9 +96,7 @@ impl Dialect for Sinumerik {
                         }
                     }
                     write_moves(&mut w, &mut mw, &op.name, *mode, moves, "")?;
-                    if let Some(g94) = mw.leave_inverse_time() {
-                        w.block(g94);
-                    }
+                    leave_inverse_time(&mut w, &mut mw);
                     if *mode != OutputMode::Joint {
                         w.block("TRAFOOF");
                     }
@@ -143,30 +119,15 @@ impl Dialect for Sinumerik {
                         num(ang, plane.b.to_degrees(), "_B", at)?,
                         dir
                     ));
-                    let moves: Vec<_> = tips
-                        .iter()
-                        .map(|(p, f)| {
-                            let q = plane.to_plane(p);
-                            tip_move([q.x, q.y, q.z], *f)
-                        })
-                        .collect();
-                    if let Some(first) = moves.first() {
-                        w.block(&format!(
-                            "G0 X{} Y{}",
-                            num(lin, first.xyz[0], "X", at)?,
-                            num(lin, first.xyz[1], "Y", at)?
-                        ));
-                    }
-                    write_moves(&mut w, &mut mw, &op.name, OutputMode::TcpAngles, &moves, "")?;
+                    write_tilted_tips(&mut w, &mut mw, &op.name, &plane, tips, "")?;
                     w.block("CYCLE800()");
                 }
             }
             mw.forget_positions();
         }
-        w.block(&safe);
-        w.block("M5");
-        w.block("M9");
-        w.block("M30");
+        for end in [safe.as_str(), "M5", "M9", "M30"] {
+            w.block(end);
+        }
         Ok(w.finish())
     }
 }
