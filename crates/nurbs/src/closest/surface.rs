@@ -529,6 +529,9 @@ pub struct SurfaceProjector {
 /// (never reached on sane geometry; protects against pathological input).
 const MAX_LEAF_SOLVES: usize = 4096;
 
+/// Entries of the query walk's stack (see `closest_point_with_hint`).
+const WALK_STACK: usize = 64;
+
 /// Leaves whose normals turn by more than this (cosine) are split.
 const LEAF_NORMAL_COS: f64 = 0.82;
 
@@ -688,13 +691,18 @@ impl SurfaceProjector {
         }
         // Depth-first walk over the 4-wide hierarchy, nearer children first; each stack entry
         // keeps its box distance so it is re-tested against the (possibly improved) bound
-        // when popped. Entries with `LEAF_BIT` set are leaves.
-        let mut stack = [(0u32, 0.0f64); 128];
+        // when popped. Entries with `LEAF_BIT` set are leaves. Indices and distances are kept
+        // in two short arrays: the stack is initialised on every query, and the walks on
+        // reference surfaces hold at most a few dozen entries. Should it ever fill up, the
+        // children that do not fit are not dropped: every leaf is then scanned after the walk.
+        let mut stack_i = [0u32; WALK_STACK];
+        let mut stack_d = [0.0f64; WALK_STACK];
         let mut sp = 1usize;
         let mut solves = 0usize;
+        let mut overflow = false;
         while sp > 0 {
             sp -= 1;
-            let (index, d2) = stack[sp];
+            let (index, d2) = (stack_i[sp], stack_d[sp]);
             let bound = best.map_or(f64::INFINITY, |b| b.0.d2);
             if d2 >= bound {
                 continue;
@@ -703,7 +711,7 @@ impl SurfaceProjector {
                 if solves >= MAX_LEAF_SOLVES {
                     continue;
                 }
-                if let Some(l) = self.solve_leaf((index & !LEAF_BIT) as usize, q, best, bound) {
+                if let Some(l) = self.solve_leaf((index & !LEAF_BIT) as usize, q, best) {
                     solves += 1;
                     if l.0.d2 < bound {
                         best = Some(l);
@@ -735,9 +743,26 @@ impl SurfaceProjector {
                 nk += 1;
             }
             for k in (0..nk).rev() {
-                if sp < stack.len() {
-                    stack[sp] = (kids[k].2, kids[k].0);
+                if sp < WALK_STACK {
+                    stack_i[sp] = kids[k].2;
+                    stack_d[sp] = kids[k].0;
                     sp += 1;
+                } else {
+                    overflow = true;
+                }
+            }
+        }
+        if overflow {
+            for index in 0..self.leaves.len() {
+                let bound = best.map_or(f64::INFINITY, |b| b.0.d2);
+                if solves >= MAX_LEAF_SOLVES || self.leaves[index].obb.dist2(q) >= bound {
+                    continue;
+                }
+                if let Some(l) = self.solve_leaf(index, q, best) {
+                    solves += 1;
+                    if l.0.d2 < bound {
+                        best = Some(l);
+                    }
                 }
             }
         }
@@ -779,21 +804,18 @@ impl SurfaceProjector {
         }
     }
 
-    /// Minimises over one leaf unless it is certified not to hold a point closer than
-    /// `bound` (squared). Returns the leaf minimum and whether it is a KKT point of the
-    /// whole domain.
+    /// Minimises over one leaf unless it is certified not to hold a point closer than the
+    /// current best. The caller has already checked that the leaf's oriented box is nearer
+    /// than the best (the walk's stack entry of a leaf holds that box distance). Returns the
+    /// leaf minimum and whether it is a KKT point of the whole domain.
     #[inline]
     fn solve_leaf(
         &self,
         index: usize,
         q: &Vector3<f64>,
         best: Option<(Local, bool)>,
-        bound: f64,
     ) -> Option<(Local, bool)> {
         let leaf = &self.leaves[index];
-        if leaf.obb.dist2(q) >= bound {
-            return None;
-        }
         // The convexity certificate is computed only when it is needed (skip test below or
         // before solving), after the cheaper cone tests.
         let mut certified: Option<bool> = None;
