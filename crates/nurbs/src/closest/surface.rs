@@ -689,14 +689,62 @@ impl SurfaceProjector {
                 best = Some((l, l.converged));
             }
         }
+        let mut best = self.walk::<WALK_STACK>(q, best);
+        // A best point held on an interior leaf edge is not yet stationary for the whole
+        // surface (its true minimum lies within round-off across the edge): polish it on
+        // the whole domain.
+        if let Some((b, false)) = best {
+            let l = minimise(
+                |u, v| self.derivs2(u, v),
+                q,
+                (ua, va),
+                (ub, vb),
+                (b.u, b.v),
+                self.step_tol,
+            );
+            if l.d2 <= b.d2 * (1.0 + 8.0 * f64::EPSILON) {
+                best = Some((l, true));
+            }
+        }
+        let l = match best {
+            Some(b) => b.0,
+            // Unreachable for a non-empty structure; answer the domain corner.
+            None => minimise(
+                |u, v| self.derivs2(u, v),
+                q,
+                (ua, va),
+                (ub, vb),
+                (ua, va),
+                self.step_tol,
+            ),
+        };
+        let on_boundary = (l.active[0] != 0) || (l.active[1] != 0);
+        SurfacePoint {
+            u: l.u,
+            v: l.v,
+            point: l.point,
+            distance: l.d2.sqrt(),
+            on_boundary,
+        }
+    }
+
+    /// Walk of the hierarchy that certifies (or improves) `best`: every leaf whose boxes are
+    /// nearer than the best is either excluded by a certificate or minimised over. `N` is the
+    /// capacity of the walk's stack.
+    #[inline]
+    fn walk<const N: usize>(
+        &self,
+        q: &Vector3<f64>,
+        mut best: Option<(Local, bool)>,
+    ) -> Option<(Local, bool)> {
         // Depth-first walk over the 4-wide hierarchy, nearer children first; each stack entry
         // keeps its box distance so it is re-tested against the (possibly improved) bound
         // when popped. Entries with `LEAF_BIT` set are leaves. Indices and distances are kept
         // in two short arrays: the stack is initialised on every query, and the walks on
         // reference surfaces hold at most a few dozen entries. Should it ever fill up, the
         // children that do not fit are not dropped: every leaf is then scanned after the walk.
-        let mut stack_i = [0u32; WALK_STACK];
-        let mut stack_d = [0.0f64; WALK_STACK];
+        let mut stack_i = [0u32; N];
+        let mut stack_d = [0.0f64; N];
         let mut sp = 1usize;
         let mut solves = 0usize;
         let mut overflow = false;
@@ -743,7 +791,7 @@ impl SurfaceProjector {
                 nk += 1;
             }
             for k in (0..nk).rev() {
-                if sp < WALK_STACK {
+                if sp < N {
                     stack_i[sp] = kids[k].2;
                     stack_d[sp] = kids[k].0;
                     sp += 1;
@@ -766,42 +814,7 @@ impl SurfaceProjector {
                 }
             }
         }
-        // A best point held on an interior leaf edge is not yet stationary for the whole
-        // surface (its true minimum lies within round-off across the edge): polish it on
-        // the whole domain.
-        if let Some((b, false)) = best {
-            let l = minimise(
-                |u, v| self.derivs2(u, v),
-                q,
-                (ua, va),
-                (ub, vb),
-                (b.u, b.v),
-                self.step_tol,
-            );
-            if l.d2 <= b.d2 * (1.0 + 8.0 * f64::EPSILON) {
-                best = Some((l, true));
-            }
-        }
-        let l = match best {
-            Some(b) => b.0,
-            // Unreachable for a non-empty structure; answer the domain corner.
-            None => minimise(
-                |u, v| self.derivs2(u, v),
-                q,
-                (ua, va),
-                (ub, vb),
-                (ua, va),
-                self.step_tol,
-            ),
-        };
-        let on_boundary = (l.active[0] != 0) || (l.active[1] != 0);
-        SurfacePoint {
-            u: l.u,
-            v: l.v,
-            point: l.point,
-            distance: l.d2.sqrt(),
-            on_boundary,
-        }
+        best
     }
 
     /// Minimises over one leaf unless it is certified not to hold a point closer than the
@@ -1314,4 +1327,47 @@ fn group_obb(leaves: &[Leaf], idx: &[usize]) -> Obb {
         }
     }
     Obb::from_points(&corners, axes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::KnotVector;
+
+    /// A walk whose stack overflows (capacity 2 < the root's children) scans every leaf and
+    /// finds the same minimum as the full walk, to Newton's tolerance.
+    #[test]
+    fn overflowing_walk_scans_all_leaves() {
+        let ctrl: Vec<Vec<Vector3<f64>>> = (0..8)
+            .map(|i| {
+                (0..8)
+                    .map(|j| {
+                        let (x, y) = (10.0 * i as f64, 10.0 * j as f64);
+                        Vector3::new(x, y, 6.0 * (x / 13.0).sin() * (y / 17.0).cos())
+                    })
+                    .collect()
+            })
+            .collect();
+        let knots = KnotVector::clamped_uniform(3, 8).unwrap().knots().to_vec();
+        let s = NurbsSurface::new(3, 3, knots.clone(), knots, ctrl, None).unwrap();
+        let p = SurfaceProjector::new(&s);
+        assert!(
+            p.wide[0].n > 2,
+            "the root must have more children than the stack holds"
+        );
+        for i in 0..=6 {
+            for j in 0..=6 {
+                let (u, v) = (i as f64 / 6.0, j as f64 / 6.0);
+                let q = s.point(u, v) + Vector3::new(1.5 * i as f64 - 4.0, 0.5, 3.0 - j as f64);
+                let full = p.walk::<WALK_STACK>(&q, None).unwrap().0;
+                let scanned = p.walk::<2>(&q, None).unwrap().0;
+                assert!(
+                    (full.d2.sqrt() - scanned.d2.sqrt()).abs() <= 1e-9,
+                    "q = {q:?}: walk {} vs scan {}",
+                    full.d2.sqrt(),
+                    scanned.d2.sqrt()
+                );
+            }
+        }
+    }
 }
