@@ -529,6 +529,9 @@ pub struct SurfaceProjector {
 /// (never reached on sane geometry; protects against pathological input).
 const MAX_LEAF_SOLVES: usize = 4096;
 
+/// Entries of the query walk's stack (see `closest_point_with_hint`).
+const WALK_STACK: usize = 64;
+
 /// Leaves whose normals turn by more than this (cosine) are split.
 const LEAF_NORMAL_COS: f64 = 0.82;
 
@@ -686,61 +689,7 @@ impl SurfaceProjector {
                 best = Some((l, l.converged));
             }
         }
-        // Depth-first walk over the 4-wide hierarchy, nearer children first; each stack entry
-        // keeps its box distance so it is re-tested against the (possibly improved) bound
-        // when popped. Entries with `LEAF_BIT` set are leaves.
-        let mut stack = [(0u32, 0.0f64); 128];
-        let mut sp = 1usize;
-        let mut solves = 0usize;
-        while sp > 0 {
-            sp -= 1;
-            let (index, d2) = stack[sp];
-            let bound = best.map_or(f64::INFINITY, |b| b.0.d2);
-            if d2 >= bound {
-                continue;
-            }
-            if index & LEAF_BIT != 0 {
-                if solves >= MAX_LEAF_SOLVES {
-                    continue;
-                }
-                if let Some(l) = self.solve_leaf((index & !LEAF_BIT) as usize, q, best, bound) {
-                    solves += 1;
-                    if l.0.d2 < bound {
-                        best = Some(l);
-                    }
-                }
-                continue;
-            }
-            let node = &self.wide[index as usize];
-            // (lower bound, centre distance, child) of the children closer than the bound.
-            let mut kids = [(0.0f64, 0.0f64, 0u32); 4];
-            let mut nk = 0;
-            for c in 0..node.n as usize {
-                let a = node.aabb[c].dist2(q);
-                if a >= bound {
-                    continue;
-                }
-                let lb = a.max(node.obb[c].dist2(q));
-                if lb >= bound {
-                    continue;
-                }
-                let key2 = (node.obb[c].c - q).norm_squared();
-                // Insertion sort, nearest first (ties: nearer box centre).
-                let mut at = nk;
-                while at > 0 && (kids[at - 1].0, kids[at - 1].1) > (lb, key2) {
-                    kids[at] = kids[at - 1];
-                    at -= 1;
-                }
-                kids[at] = (lb, key2, node.child[c]);
-                nk += 1;
-            }
-            for k in (0..nk).rev() {
-                if sp < stack.len() {
-                    stack[sp] = (kids[k].2, kids[k].0);
-                    sp += 1;
-                }
-            }
-        }
+        let mut best = self.walk::<WALK_STACK>(q, best);
         // A best point held on an interior leaf edge is not yet stationary for the whole
         // surface (its true minimum lies within round-off across the edge): polish it on
         // the whole domain.
@@ -779,21 +728,107 @@ impl SurfaceProjector {
         }
     }
 
-    /// Minimises over one leaf unless it is certified not to hold a point closer than
-    /// `bound` (squared). Returns the leaf minimum and whether it is a KKT point of the
-    /// whole domain.
+    /// Walk of the hierarchy that certifies (or improves) `best`: every leaf whose boxes are
+    /// nearer than the best is either excluded by a certificate or minimised over. `N` is the
+    /// capacity of the walk's stack.
+    #[inline]
+    fn walk<const N: usize>(
+        &self,
+        q: &Vector3<f64>,
+        mut best: Option<(Local, bool)>,
+    ) -> Option<(Local, bool)> {
+        // Depth-first walk over the 4-wide hierarchy, nearer children first; each stack entry
+        // keeps its box distance so it is re-tested against the (possibly improved) bound
+        // when popped. Entries with `LEAF_BIT` set are leaves. Indices and distances are kept
+        // in two short arrays: the stack is initialised on every query, and the walks on
+        // reference surfaces hold at most a few dozen entries. Should it ever fill up, the
+        // children that do not fit are not dropped: every leaf is then scanned after the walk.
+        let mut stack_i = [0u32; N];
+        let mut stack_d = [0.0f64; N];
+        let mut sp = 1usize;
+        let mut solves = 0usize;
+        let mut overflow = false;
+        while sp > 0 {
+            sp -= 1;
+            let (index, d2) = (stack_i[sp], stack_d[sp]);
+            let bound = best.map_or(f64::INFINITY, |b| b.0.d2);
+            if d2 >= bound {
+                continue;
+            }
+            if index & LEAF_BIT != 0 {
+                if solves >= MAX_LEAF_SOLVES {
+                    continue;
+                }
+                if let Some(l) = self.solve_leaf((index & !LEAF_BIT) as usize, q, best) {
+                    solves += 1;
+                    if l.0.d2 < bound {
+                        best = Some(l);
+                    }
+                }
+                continue;
+            }
+            let node = &self.wide[index as usize];
+            // (lower bound, centre distance, child) of the children closer than the bound.
+            let mut kids = [(0.0f64, 0.0f64, 0u32); 4];
+            let mut nk = 0;
+            for c in 0..node.n as usize {
+                let a = node.aabb[c].dist2(q);
+                if a >= bound {
+                    continue;
+                }
+                let lb = a.max(node.obb[c].dist2(q));
+                if lb >= bound {
+                    continue;
+                }
+                let key2 = (node.obb[c].c - q).norm_squared();
+                // Insertion sort, nearest first (ties: nearer box centre).
+                let mut at = nk;
+                while at > 0 && (kids[at - 1].0, kids[at - 1].1) > (lb, key2) {
+                    kids[at] = kids[at - 1];
+                    at -= 1;
+                }
+                kids[at] = (lb, key2, node.child[c]);
+                nk += 1;
+            }
+            for k in (0..nk).rev() {
+                if sp < N {
+                    stack_i[sp] = kids[k].2;
+                    stack_d[sp] = kids[k].0;
+                    sp += 1;
+                } else {
+                    overflow = true;
+                }
+            }
+        }
+        if overflow {
+            for index in 0..self.leaves.len() {
+                let bound = best.map_or(f64::INFINITY, |b| b.0.d2);
+                if solves >= MAX_LEAF_SOLVES || self.leaves[index].obb.dist2(q) >= bound {
+                    continue;
+                }
+                if let Some(l) = self.solve_leaf(index, q, best) {
+                    solves += 1;
+                    if l.0.d2 < bound {
+                        best = Some(l);
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Minimises over one leaf unless it is certified not to hold a point closer than the
+    /// current best. The caller has already checked that the leaf's oriented box is nearer
+    /// than the best (the walk's stack entry of a leaf holds that box distance). Returns the
+    /// leaf minimum and whether it is a KKT point of the whole domain.
     #[inline]
     fn solve_leaf(
         &self,
         index: usize,
         q: &Vector3<f64>,
         best: Option<(Local, bool)>,
-        bound: f64,
     ) -> Option<(Local, bool)> {
         let leaf = &self.leaves[index];
-        if leaf.obb.dist2(q) >= bound {
-            return None;
-        }
         // The convexity certificate is computed only when it is needed (skip test below or
         // before solving), after the cheaper cone tests.
         let mut certified: Option<bool> = None;
@@ -1292,4 +1327,47 @@ fn group_obb(leaves: &[Leaf], idx: &[usize]) -> Obb {
         }
     }
     Obb::from_points(&corners, axes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::KnotVector;
+
+    /// A walk whose stack overflows (capacity 2 < the root's children) scans every leaf and
+    /// finds the same minimum as the full walk, to Newton's tolerance.
+    #[test]
+    fn overflowing_walk_scans_all_leaves() {
+        let ctrl: Vec<Vec<Vector3<f64>>> = (0..8)
+            .map(|i| {
+                (0..8)
+                    .map(|j| {
+                        let (x, y) = (10.0 * i as f64, 10.0 * j as f64);
+                        Vector3::new(x, y, 6.0 * (x / 13.0).sin() * (y / 17.0).cos())
+                    })
+                    .collect()
+            })
+            .collect();
+        let knots = KnotVector::clamped_uniform(3, 8).unwrap().knots().to_vec();
+        let s = NurbsSurface::new(3, 3, knots.clone(), knots, ctrl, None).unwrap();
+        let p = SurfaceProjector::new(&s);
+        assert!(
+            p.wide[0].n > 2,
+            "the root must have more children than the stack holds"
+        );
+        for i in 0..=6 {
+            for j in 0..=6 {
+                let (u, v) = (i as f64 / 6.0, j as f64 / 6.0);
+                let q = s.point(u, v) + Vector3::new(1.5 * i as f64 - 4.0, 0.5, 3.0 - j as f64);
+                let full = p.walk::<WALK_STACK>(&q, None).unwrap().0;
+                let scanned = p.walk::<2>(&q, None).unwrap().0;
+                assert!(
+                    (full.d2.sqrt() - scanned.d2.sqrt()).abs() <= 1e-9,
+                    "q = {q:?}: walk {} vs scan {}",
+                    full.d2.sqrt(),
+                    scanned.d2.sqrt()
+                );
+            }
+        }
+    }
 }
