@@ -52,8 +52,9 @@
 //! Tolerances: Newton stops when its predicted 3D step is below `1e-13 × (1 + surface size)`
 //! mm and the angle between `S − q` and each free tangent is within `1e-11` of 90°; steps
 //! are accepted up to the round-off of `|S − q|²`. Cost on the 12×12 bicubic reference surface
-//! (225 leaves), CPU time per query on a busy 2-core machine: ≈ 1.0 µs cold, ≈ 0.6 µs warm,
-//! i.e. about 25 and 15 surface evaluations (see `benches/nurbs.rs`). Queries take
+//! (225 leaves), criterion medians per query on an idle 2-core machine: ≈ 0.83 µs cold,
+//! ≈ 0.47 µs warm (a warm query averages 1.02 Newton runs, ~4 surface evaluations and
+//! 1.5 leaf visits; see `benches/nurbs.rs`). Queries take
 //! `&self` and, outside the branch-and-bound fallback, do not allocate; the projector is
 //! `Send + Sync`.
 
