@@ -6,9 +6,8 @@
 //! times, so this module keeps a private, validated copy of each curve (degree, knots, control
 //! points, optional weights) and evaluates it with fixed-size stack arrays:
 //!
-//! - knot span: binary search (The NURBS Book, A2.1), O(log n);
-//! - basis functions and their derivatives up to order 2: NURBS Book A2.3 with `[f64; 8]`
-//!   arrays, O(p²);
+//! - knot span and basis functions with derivatives up to order 2: the `nurbs` crate's
+//!   stack-array kernels (The NURBS Book A2.1–A2.3), O(log n + p²);
 //! - rational curves: homogeneous evaluation then the quotient rule (NURBS Book eq. 4.8),
 //!   `P = A/W`, `P' = (A' − W'P)/W`, `P'' = (A'' − 2W'P' − W''P)/W`.
 //!
@@ -25,7 +24,6 @@ const NB: usize = MAX_GUIDE_DEGREE + 1;
 #[derive(Debug, Clone, PartialEq)]
 pub struct GuideCurve {
     degree: usize,
-    knots: Vec<f64>,
     kv: nurbs::KnotVector,
     ctrl: Vec<Vector3>,
     weights: Option<Vec<f64>>,
@@ -86,13 +84,11 @@ impl GuideCurve {
                 return bad("weights must be finite and > 0");
             }
         }
-        let kv =
-            nurbs::KnotVector::new(degree, knots.clone()).map_err(|_| CamError::InvalidGuide {
-                reason: "knot vector rejected by the nurbs crate (multiplicity too high)",
-            })?;
+        let kv = nurbs::KnotVector::new(degree, knots).map_err(|_| CamError::InvalidGuide {
+            reason: "knot vector rejected by the nurbs crate (multiplicity too high)",
+        })?;
         Ok(Self {
             degree,
-            knots,
             kv,
             ctrl,
             weights,
@@ -118,7 +114,7 @@ impl GuideCurve {
     pub fn to_curve(&self) -> Result<nurbs::Curve3, CamError> {
         nurbs::Curve3::new(
             self.degree,
-            self.knots.clone(),
+            self.kv.knots().to_vec(),
             self.ctrl.clone(),
             self.weights.clone(),
         )
@@ -133,7 +129,7 @@ impl GuideCurve {
     }
     /// Full knot vector.
     pub fn knots(&self) -> &[f64] {
-        &self.knots
+        self.kv.knots()
     }
     /// Control points.
     pub fn control_points(&self) -> &[Vector3] {
@@ -150,7 +146,7 @@ impl GuideCurve {
 
     /// Parameter domain `[u_p, u_n]`.
     pub fn domain(&self) -> (f64, f64) {
-        (self.knots[self.degree], self.knots[self.ctrl.len()])
+        self.kv.domain()
     }
 
     /// Knot span index of `u` (clamped to the domain), NURBS Book A2.1 (the `nurbs` kernel).
@@ -179,7 +175,7 @@ impl GuideCurve {
     /// True when `other` has the same degree and knots, so one basis evaluation serves both
     /// (the envelope then evaluates the basis once per frame; weights may differ).
     pub fn shares_basis_with(&self, other: &GuideCurve) -> bool {
-        self.degree == other.degree && self.knots == other.knots
+        self.degree == other.degree && self.kv.knots() == other.kv.knots()
     }
 
     /// Knot span and non-rational basis functions with two derivatives at `u` (clamped).
@@ -241,22 +237,8 @@ impl GuideCurve {
         let span = self.find_span(u);
         let (lo, hi) = self.domain();
         let u = u.clamp(lo, hi);
-        let k = &self.knots;
         let mut nb = [0.0; NB];
-        let mut left = [0.0; NB];
-        let mut right = [0.0; NB];
-        nb[0] = 1.0;
-        for j in 1..=p {
-            left[j] = u - k[span + 1 - j];
-            right[j] = k[span + j] - u;
-            let mut saved = 0.0;
-            for r in 0..j {
-                let temp = nb[r] / (right[r + 1] + left[j - r]);
-                nb[r] = saved + right[r + 1] * temp;
-                saved = left[j - r] * temp;
-            }
-            nb[j] = saved;
-        }
+        self.kv.basis_funs(span, u, &mut nb);
         let first = span - p;
         match &self.weights {
             None => (0..=p).fold(Vector3::zeros(), |acc, j| {
@@ -279,7 +261,7 @@ impl GuideCurve {
     pub fn breakpoints(&self) -> Vec<f64> {
         let (lo, hi) = self.domain();
         let mut out: Vec<f64> = Vec::new();
-        for &k in &self.knots[self.degree..=self.ctrl.len()] {
+        for &k in &self.kv.knots()[self.degree..=self.ctrl.len()] {
             if (lo..=hi).contains(&k) && out.last().is_none_or(|&l| k > l) {
                 out.push(k);
             }

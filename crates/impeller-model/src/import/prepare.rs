@@ -23,8 +23,8 @@
 
 use super::error::ImportError;
 use super::raw::{
-    meridional, offset_camber, positive, split_loop, BladeRole, Polyline3, RawImpeller,
-    SectionShape,
+    blade_count, meridional, offset_camber, positive, split_loop, BladeRole, Polyline3,
+    RawImpeller, SectionShape,
 };
 use nalgebra::{Vector2, Vector3};
 use std::path::PathBuf;
@@ -77,20 +77,18 @@ pub struct PreparedImpeller {
 impl PreparedImpeller {
     /// Number of main blades.
     pub fn main_blade_count(&self) -> usize {
-        self.blades
-            .iter()
-            .filter(|b| b.role == BladeRole::Main)
-            .map(|b| b.count)
-            .sum()
+        blade_count(
+            self.blades.iter().map(|b| (b.role, b.count)),
+            BladeRole::Main,
+        )
     }
 
     /// Number of splitter blades.
     pub fn splitter_blade_count(&self) -> usize {
-        self.blades
-            .iter()
-            .filter(|b| b.role == BladeRole::Splitter)
-            .map(|b| b.count)
-            .sum()
+        blade_count(
+            self.blades.iter().map(|b| (b.role, b.count)),
+            BladeRole::Splitter,
+        )
     }
 }
 

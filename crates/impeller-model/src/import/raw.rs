@@ -151,23 +151,29 @@ pub struct RawImpeller {
     pub blades: Vec<RawBlade>,
 }
 
+/// Total blade count of the rows with `role`, from `(role, count)` pairs.
+pub(crate) fn blade_count(
+    rows: impl Iterator<Item = (BladeRole, usize)>,
+    role: BladeRole,
+) -> usize {
+    rows.filter(|(r, _)| *r == role).map(|(_, n)| n).sum()
+}
+
 impl RawImpeller {
     /// Number of main blades.
     pub fn main_blade_count(&self) -> usize {
-        self.blades
-            .iter()
-            .filter(|b| b.role == BladeRole::Main)
-            .map(|b| b.count)
-            .sum()
+        blade_count(
+            self.blades.iter().map(|b| (b.role, b.count)),
+            BladeRole::Main,
+        )
     }
 
     /// Number of splitter blades.
     pub fn splitter_blade_count(&self) -> usize {
-        self.blades
-            .iter()
-            .filter(|b| b.role == BladeRole::Splitter)
-            .map(|b| b.count)
-            .sum()
+        blade_count(
+            self.blades.iter().map(|b| (b.role, b.count)),
+            BladeRole::Splitter,
+        )
     }
 }
 
