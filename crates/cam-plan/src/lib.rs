@@ -1,0 +1,51 @@
+//! What every impeller machining operation shares.
+//!
+//! An operation (plunge roughing, channel roughing, hub and blade-root finishing, flank
+//! semi-finishing and finishing) is a type implementing [`Operation`]: given a
+//! [`PlanContext`] (the impeller, its blank, the tool, the tolerances, the process row and the
+//! shared services) it returns a [`PlannedOperation`] — its tool paths in machining order, its
+//! own metrics under the fixed names of DESIGN §4, and the data of its plots — or a typed
+//! [`PlanError`] naming the operation, the blade or channel and the reason.
+//!
+//! The services every planner needs live here once:
+//! - [`clearance`]: signed clearance of the cutter, shank and holder against the design (hub,
+//!   shroud contour, every blade), with the part that is nearest;
+//! - [`linking`]: retract along the tool axis to a safety surface, travel on it, approach
+//!   along the tool axis;
+//! - [`pattern`]: rotational copy of one channel's or blade's paths to every channel/blade
+//!   (paper 003's "object transformation");
+//! - [`order`]: channel and blade ordering that keeps rapids short.
+//!
+//! Job-file vocabulary shared by the pipeline and the operation crates: [`Tool`] (a cutter with
+//! its number, teeth, holder and gauge length), [`Process`] (the shop-sheet row: spindle speed,
+//! feed per tooth, depth and width of cut, allowances → feed rates), [`params`] (deserialising
+//! a kind's own keys with errors that name the key).
+//!
+//! Dependency direction (DESIGN §2): `nurbs`, `cam-core`, `impeller-model` only; the verifier
+//! (`machining-sim`) never depends on this crate.
+
+pub mod clearance;
+pub mod error;
+pub mod linking;
+pub mod metrics;
+pub mod operation;
+pub mod order;
+pub mod params;
+pub mod pattern;
+pub mod process;
+pub mod tool;
+
+pub use clearance::{
+    Clearance, ClearanceOptions, DesignClearance, DesignPart, PartSet, Row, ToolPart,
+};
+pub use error::PlanError;
+pub use linking::{Linker, SafetySurface};
+pub use metrics::{MetricValue, Metrics, Plot, PlotKind, PlotSeries};
+pub use operation::{Builder, Operation, OperationSpec, PlanContext, PlannedOperation};
+pub use process::Process;
+pub use tool::Tool;
+
+/// Point in the workpiece frame (mm).
+pub type Point3 = cam_core::Point3;
+/// Vector in the workpiece frame (mm).
+pub type Vector3 = cam_core::Vector3;

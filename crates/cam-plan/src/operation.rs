@@ -1,0 +1,87 @@
+//! The [`Operation`] trait, the context an operation plans in, and what it returns.
+//!
+//! The pipeline knows an operation only through this trait and one registration of its kind:
+//! a function [`Builder`] that turns the job's `[[operations]]` table ([`OperationSpec`]) into
+//! a boxed operation. Each operation crate exports one builder per kind.
+
+use crate::{DesignClearance, Linker, Metrics, PlanError, Plot, Process, Tool};
+use cam_core::{Rates, Tolerances, ToolPath};
+use impeller_model::{Impeller, Stock};
+
+/// Everything an operation plans with. Built by the pipeline once per operation.
+#[derive(Debug, Clone, Copy)]
+pub struct PlanContext<'a> {
+    /// The impeller (design geometry).
+    pub impeller: &'a Impeller,
+    /// The blank the impeller is cut from.
+    pub stock: &'a Stock,
+    /// The operation's tool.
+    pub tool: &'a Tool,
+    /// The job's tolerances (every one accepted is used).
+    pub tolerances: &'a Tolerances,
+    /// The operation's process row (feeds, speeds, depths, allowances).
+    pub process: &'a Process,
+    /// Clearance of this tool (cutter, shank, holder) against the design.
+    pub clearance: &'a DesignClearance<'a>,
+    /// Linking moves over the job's safety surface.
+    pub linker: &'a Linker,
+}
+
+impl PlanContext<'_> {
+    /// Feed, plunge and rapid rates of this operation's tool and process row.
+    pub fn rates(&self) -> Rates {
+        self.process.rates(self.tool)
+    }
+}
+
+/// What an operation returns.
+#[derive(Debug, Clone, Default)]
+pub struct PlannedOperation {
+    /// Tool paths in machining order, one per channel or blade side. Each starts with its
+    /// approach from the safety surface and ends with its retract to it (the pipeline links
+    /// consecutive paths with [`Linker::link`]).
+    pub paths: Vec<ToolPath>,
+    /// The kind's own metrics under the fixed names of DESIGN §4 (the pipeline adds `moves`,
+    /// `path_length_mm`, `cutting_time_s` and `plan_ms`).
+    pub metrics: Metrics,
+    /// The kind's own plots.
+    pub plots: Vec<Plot>,
+    /// Remarks for the report (what was skipped and why, warnings).
+    pub notes: Vec<String>,
+}
+
+/// A machining operation that plans tool paths on an impeller.
+///
+/// Object safe: the pipeline holds `Box<dyn Operation>`. `plan` must not panic on any
+/// impeller or parameters; it returns a [`PlanError`] naming the operation, the place and the
+/// reason instead.
+pub trait Operation: std::fmt::Debug + Send + Sync {
+    /// The kind name as written in job files (`plunge_roughing`, …).
+    fn kind(&self) -> &'static str;
+    /// The operation's name in the job.
+    fn name(&self) -> &str;
+    /// Name of the tool it needs (a key into the job's tools).
+    fn tool(&self) -> &str;
+    /// Plans the operation.
+    fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError>;
+}
+
+/// One `[[operations]]` table of a job: the common keys, the process row and the kind's own
+/// keys (everything else in the table), left for the kind's builder to deserialise with
+/// [`crate::params::parse`] (which rejects unknown keys).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OperationSpec {
+    /// Operation name (unique in the job).
+    pub name: String,
+    /// Kind name.
+    pub kind: String,
+    /// Tool name.
+    pub tool: String,
+    /// The process row.
+    pub process: Process,
+    /// The kind's own keys.
+    pub params: toml::Table,
+}
+
+/// Turns an operation table into an operation of one kind.
+pub type Builder = fn(&OperationSpec) -> Result<Box<dyn Operation>, PlanError>;
