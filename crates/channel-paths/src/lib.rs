@@ -1,0 +1,4 @@
+//! Tool paths inside an impeller channel, each an [`cam_plan::Operation`]:
+//! roughing by depth levels with triangle path planning (paper 001 §3, channel areas around
+//! the splitter of paper 003), hub finishing and blade-root finishing along the intersection
+//! of the hub's and the blade's offset surfaces (paper 004 §2–3).
