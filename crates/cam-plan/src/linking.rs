@@ -6,11 +6,22 @@
 //! top plane `z = Z` (by default the blank's largest radius and top plus a clearance). A
 //! retract from a tool tip `p` with axis `a` runs along `a` to the first point where the ray
 //! `p + t·a` leaves the capped cylinder (closed form: the smallest `t > 0` where
-//! `|xy(p + t a)| = R` or `z = Z`). The travel between an exit point `A` and an entry point `B`
-//! rises vertically to the cap (a vertical line from a point outside the cylinder stays
-//! outside it), crosses the cap on the straight chord (the cap is a plane above the blank),
-//! and comes down vertically to `B`. The tool axis turns linearly (normalised) from `A`'s to
-//! `B`'s on the travel; the pipeline's verification checks the swept tool between postures.
+//! `|xy(p + t a)| = R` or `z = Z`). The travel between an exit point `A` (axis `a`) and an
+//! entry point `B` (axis `b`):
+//! 1. rises vertically from `A` to the cap with the axis `a` kept: a side exit leaves along an
+//!    axis with an outward radial component, and the rise keeps the tip's azimuth, so the whole
+//!    tool stays outside the cylinder;
+//! 2. turns the axis from `a` to +Z on the cap's rim (the interpolated axes keep `a`'s outward
+//!    or upward component, so the tool stays outside the cylinder or above the cap);
+//! 3. crosses the cap on the straight chord with the axis +Z (the chord of a disc stays in
+//!    the disc; the tool stands above the cap);
+//! 4. turns the axis from +Z to `b`, and comes down vertically to `B` — steps 2 and 1 for `B`
+//!    in reverse.
+//!
+//! So every posture of the travel, and every posture interpolated between two of its moves
+//! (tip linear, axis linear and normalised), keeps the whole tool outside the capped cylinder:
+//! at least the safety clearance from the blank, and so from the design inside it (checked in
+//! the tests with the clearance query).
 //!
 //! Cost: O(1) per retract and per travel.
 
@@ -20,6 +31,11 @@ use impeller_model::Stock;
 
 /// Default clearance of the safety surface over the blank (mm).
 pub const DEFAULT_SAFETY_CLEARANCE_MM: f64 = 10.0;
+
+/// Two tips closer than this are one position (mm): far below any machine's resolution.
+const SAME_POSTURE_MM: f64 = 1e-9;
+/// Two unit axes closer than this (chord, ≈ rad) are one orientation.
+const SAME_POSTURE_RAD: f64 = 1e-12;
 
 /// The safety surface: a capped cylinder about +Z.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -105,31 +121,37 @@ impl Linker {
     }
 
     /// Travel on the safety surface from `from` to `to` (both on or outside it), as rapid
-    /// moves excluding `from` and including `to`.
+    /// moves excluding `from` and including `to` (see the module docs for why the tool stays
+    /// outside the capped cylinder on every move).
     pub fn travel(&self, from: &CutterLocation, to: &CutterLocation) -> Vec<Move> {
         let top = self.surface.top_z_mm;
-        // Straight up (a vertical line outside the cylinder stays outside it), across the cap
-        // on its chord (the cap is a plane above the blank), straight down.
         let up = |p: &Point3| Point3::new(p.x, p.y, top.max(p.z));
-        let mut tips = vec![up(&from.tip), up(&to.tip), to.tip];
-        tips.dedup_by(|x, y| (*x - *y).norm() < 1e-12);
-        if tips.first().is_some_and(|t| (t - from.tip).norm() < 1e-12) {
-            tips.remove(0);
+        let z = nalgebra::Unit::new_unchecked(Vector3::z());
+        let cl = |tip: Point3, axis: nalgebra::Unit<Vector3>| CutterLocation { tip, axis };
+        let postures = [
+            cl(up(&from.tip), from.axis),
+            cl(up(&from.tip), z),
+            cl(up(&to.tip), z),
+            cl(up(&to.tip), to.axis),
+            *to,
+        ];
+        let mut moves: Vec<Move> = Vec::with_capacity(postures.len());
+        let mut last = *from;
+        for p in postures {
+            let same = (p.tip - last.tip).norm() < SAME_POSTURE_MM
+                && (p.axis.into_inner() - last.axis.into_inner()).norm() < SAME_POSTURE_RAD;
+            if !same {
+                moves.push(Move::rapid(p));
+                last = p;
+            }
         }
-        let n = tips.len();
-        let a0 = from.axis.into_inner();
-        let a1 = to.axis.into_inner();
-        tips.into_iter()
-            .enumerate()
-            .map(|(i, tip)| {
-                let f = (i + 1) as f64 / n as f64;
-                let axis = (a0 * (1.0 - f) + a1 * f).try_normalize(1e-12).unwrap_or(a1);
-                Move::rapid(CutterLocation {
-                    tip,
-                    axis: nalgebra::Unit::new_unchecked(axis),
-                })
-            })
-            .collect()
+        // `to` is always the last move, even when it equals `from`'s last posture.
+        if moves.last().is_none_or(|m| m.cl != *to) {
+            if let Some(m) = moves.last_mut() {
+                m.cl = *to;
+            }
+        }
+        moves
     }
 
     /// The moves from the end of one cutting move at `from` to the start of the next at
@@ -190,6 +212,120 @@ impl Linker {
             cl: end,
             feed_mm_per_min: None,
         });
+        Ok(())
+    }
+
+    /// The moves from `from` to the start `to` of the next path: retract along `from`'s axis
+    /// to the safety surface (when `from` is inside it), [`Linker::travel`] to where `to`'s
+    /// axis leaves the surface, then (when `to` is inside) a rapid to `approach_mm` above `to`
+    /// along its axis and a plunge to `to`. Ends exactly at `to`.
+    pub fn connect(
+        &self,
+        from: &CutterLocation,
+        to: &CutterLocation,
+        approach_mm: f64,
+    ) -> Result<Vec<Move>, PlanError> {
+        let out = self.retract_point(from)?;
+        let inn = self.retract_point(to)?;
+        let mut moves = Vec::new();
+        if (out.tip - from.tip).norm() >= SAME_POSTURE_MM {
+            moves.push(Move {
+                kind: MoveKind::Retract,
+                cl: out,
+                feed_mm_per_min: None,
+            });
+        }
+        moves.extend(self.travel(&out, &inn));
+        let inside = (inn.tip - to.tip).norm();
+        if inside >= SAME_POSTURE_MM {
+            let a = approach_mm.clamp(0.0, inside);
+            if a < inside {
+                moves.push(Move::rapid(CutterLocation {
+                    tip: to.tip + to.axis.into_inner() * a,
+                    axis: to.axis,
+                }));
+            }
+            moves.push(Move {
+                kind: MoveKind::Plunge,
+                cl: *to,
+                feed_mm_per_min: None,
+            });
+        }
+        Ok(moves)
+    }
+
+    /// One tool path `name` (tool `tool`) of `paths` in order: each path's moves, linked to
+    /// the next with [`Linker::connect`] (which replaces the next path's first move by the
+    /// link arriving at it); the whole starts and ends on the safety surface (an approach
+    /// along the first axis is prepended and a retract along the last appended when the path
+    /// starts or ends inside it). Empty paths are skipped.
+    ///
+    /// Errors: a path end whose axis never leaves the safety surface.
+    pub fn join(
+        &self,
+        name: &str,
+        tool: &str,
+        paths: &[ToolPath],
+        approach_mm: f64,
+    ) -> Result<ToolPath, PlanError> {
+        let mut out = ToolPath::new(name, tool);
+        for p in paths {
+            let Some(first) = p.moves.first() else {
+                continue;
+            };
+            match out.moves.last() {
+                Some(last) => {
+                    let link = self.connect(&last.cl, &first.cl, approach_mm)?;
+                    out.moves.extend(link);
+                    out.moves.extend_from_slice(&p.moves[1..]);
+                }
+                None => {
+                    let mut head = p.clone();
+                    if self.surface.contains(&first.cl.tip) {
+                        self.close_start(&mut head, approach_mm)?;
+                    }
+                    out.moves = head.moves;
+                }
+            }
+        }
+        if let Some(last) = out.moves.last().copied() {
+            if self.surface.contains(&last.cl.tip) {
+                out.moves.push(Move {
+                    kind: MoveKind::Retract,
+                    cl: self.retract_point(&last.cl)?,
+                    feed_mm_per_min: None,
+                });
+            }
+        }
+        Ok(out)
+    }
+
+    /// Prepends the approach from the safety surface along the first move's axis.
+    fn close_start(&self, path: &mut ToolPath, approach_mm: f64) -> Result<(), PlanError> {
+        let Some(first) = path.moves.first().copied() else {
+            return Ok(());
+        };
+        let start = self.retract_point(&first.cl)?;
+        let inside = (start.tip - first.cl.tip).norm();
+        let mut head = vec![Move::rapid(start)];
+        let a = approach_mm.clamp(0.0, inside);
+        if a < inside {
+            head.push(Move::rapid(CutterLocation {
+                tip: first.cl.tip + first.cl.axis.into_inner() * a,
+                axis: first.cl.axis,
+            }));
+        }
+        if first.kind == MoveKind::Feed {
+            head.push(Move {
+                kind: MoveKind::Plunge,
+                cl: first.cl,
+                feed_mm_per_min: None,
+            });
+            head.extend_from_slice(&path.moves[1..]);
+        } else {
+            head.extend_from_slice(&path.moves);
+        }
+        path.moves = head;
         Ok(())
     }
 }

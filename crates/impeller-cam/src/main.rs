@@ -1,16 +1,12 @@
-//! `impeller-cam`: the command line of the impeller five-axis CAM toolkit.
+//! `impeller-cam`: the command line of the impeller five-axis CAM toolkit, a thin layer over
+//! the `impeller_cam` library.
 //!
 //! Every subcommand exits 0 on success and 1 on a user error with one clear line on stderr
-//! (see `../shared/DESIGN.md` §4). Subcommands live in `cmd/`, one module each.
-
-mod cmd;
-mod error;
-mod job;
-mod pipeline;
-mod plot;
-mod report;
+//! (see `../shared/DESIGN.md` §4). Subcommands live in the library's `cmd` module, one module
+//! each.
 
 use clap::{Parser, Subcommand};
+use impeller_cam::cmd;
 use std::process::ExitCode;
 
 /// Turn impeller design geometry into verified five-axis NC programs.

@@ -2,7 +2,10 @@
 //! (the same figures for a person, with inline SVG plots).
 
 use crate::error::CliError;
+use crate::pipeline::JobOperation;
 use crate::plot::{heat_map, line_chart, Series};
+use cam_core::MoveKind;
+use cam_plan::{PlotKind, PlotSeries};
 use impeller_model::{Impeller, Side};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -10,7 +13,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// One operation's figures (DESIGN §4: `moves`, `path_length_mm`, `cutting_time_s`,
-/// `plan_ms`).
+/// `plan_ms`) and the kind's own metrics, flattened into the same JSON object so that
+/// `cargo xtask regress` reads `operations.<name>.<metric>`.
 #[derive(Debug, Clone, Serialize)]
 pub struct OperationReport {
     /// Operation name.
@@ -27,6 +31,9 @@ pub struct OperationReport {
     pub cutting_time_s: f64,
     /// Planning time (ms).
     pub plan_ms: f64,
+    /// The kind's own metrics (names of DESIGN §4; numbers, counts, booleans, texts).
+    #[serde(flatten)]
+    pub metrics: cam_plan::Metrics,
 }
 
 /// Post-processing figures summed over the operations.
@@ -152,6 +159,8 @@ pub struct Report {
     plots: Vec<String>,
     #[serde(skip)]
     post_plots: Vec<String>,
+    #[serde(skip)]
+    operation_plots: Vec<String>,
 }
 
 impl Report {
@@ -168,6 +177,7 @@ impl Report {
             notes: Vec::new(),
             plots: Vec::new(),
             post_plots: Vec::new(),
+            operation_plots: Vec::new(),
         }
     }
 
@@ -241,6 +251,136 @@ impl Report {
         ));
         self.plots
             .push(line_chart("Top view", "x (mm)", "y (mm)", &top, true));
+    }
+
+    /// The paths of one operation over the impeller — top view (x, y) with the blades' tip
+    /// edges, meridional view (z, r) with the hub and shroud contours; cutting moves and
+    /// rapids/links as separate series — then the operation's own plots.
+    pub fn add_operation_plots(&mut self, imp: &Impeller, op: &JobOperation) {
+        let path = &op.cl.path;
+        let mut h = format!("<h3>{} ({})</h3>", esc(&path.name), esc(&op.kind));
+        // At most this many points per series keeps a report of long paths small; the
+        // decimation keeps every k-th tip and both ends of each run.
+        const MAX_POINTS: usize = 6000;
+        let step = (path.moves.len() / MAX_POINTS).max(1);
+        let mut cut_xy = Vec::new();
+        let mut cut_zr = Vec::new();
+        let mut link_xy = Vec::new();
+        let mut link_zr = Vec::new();
+        let mut prev: Option<(bool, cam_core::Point3)> = None;
+        for (i, m) in path.moves.iter().enumerate() {
+            let cutting = !matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
+            let p = m.cl.tip;
+            let (xy, zr, other_xy, other_zr) = if cutting {
+                (&mut cut_xy, &mut cut_zr, &mut link_xy, &mut link_zr)
+            } else {
+                (&mut link_xy, &mut link_zr, &mut cut_xy, &mut cut_zr)
+            };
+            let changed = prev.is_some_and(|(c, _)| c != cutting);
+            if changed {
+                // Start the new run at the previous tip, and break the other series.
+                if let Some((_, q)) = prev {
+                    xy.push((f64::NAN, f64::NAN));
+                    zr.push((f64::NAN, f64::NAN));
+                    xy.push((q.x, q.y));
+                    zr.push((q.z, q.x.hypot(q.y)));
+                }
+                other_xy.push((f64::NAN, f64::NAN));
+                other_zr.push((f64::NAN, f64::NAN));
+            }
+            let last = i + 1 == path.moves.len();
+            let run_end = path
+                .moves
+                .get(i + 1)
+                .is_some_and(|n| matches!(n.kind, MoveKind::Rapid | MoveKind::Retract) == cutting);
+            if i % step == 0 || changed || last || run_end {
+                xy.push((p.x, p.y));
+                zr.push((p.z, p.x.hypot(p.y)));
+            }
+            prev = Some((cutting, p));
+        }
+        let (mut top, mut merid) = self.outline(imp);
+        top.push(Series {
+            label: "cutting moves".into(),
+            points: cut_xy,
+        });
+        top.push(Series {
+            label: "rapids and links".into(),
+            points: link_xy,
+        });
+        merid.push(Series {
+            label: "cutting moves".into(),
+            points: cut_zr,
+        });
+        merid.push(Series {
+            label: "rapids and links".into(),
+            points: link_zr,
+        });
+        h.push_str(&line_chart(
+            &format!("{}: top view", path.name),
+            "x (mm)",
+            "y (mm)",
+            &top,
+            true,
+        ));
+        h.push_str(&line_chart(
+            &format!("{}: meridional view", path.name),
+            "z (mm)",
+            "r (mm)",
+            &merid,
+            true,
+        ));
+        for plot in &op.plots {
+            h.push_str(&render_plot(plot));
+        }
+        self.operation_plots.push(h);
+    }
+
+    /// Outlines drawn under an operation's paths: every blade's tip edge (top view); hub and
+    /// shroud contours (meridional view).
+    fn outline(&self, imp: &Impeller) -> (Vec<Series>, Vec<Series>) {
+        const N: usize = 60;
+        let contour = |m: &impeller_model::MeridionalCurve| -> Vec<(f64, f64)> {
+            let (t0, t1) = m.domain();
+            (0..=N)
+                .map(|i| {
+                    let p = m.point(t0 + (t1 - t0) * i as f64 / N as f64);
+                    (p.x, p.y)
+                })
+                .collect()
+        };
+        let merid = vec![
+            Series {
+                label: "hub".into(),
+                points: contour(imp.hub().meridional()),
+            },
+            Series {
+                label: "shroud".into(),
+                points: contour(imp.shroud().meridional()),
+            },
+        ];
+        let mut pts = Vec::new();
+        let sets = std::iter::once(imp.main()).chain(imp.splitter());
+        for set in sets {
+            let side = set.blade().side(Side::Pressure);
+            let ((u0, u1), (_, v1)) = side.domain();
+            let edge: Vec<cam_core::Vector3> = (0..=N)
+                .map(|i| side.point(u0 + (u1 - u0) * i as f64 / N as f64, v1))
+                .collect();
+            for k in 0..set.count() {
+                let rot = set.rotation(k);
+                for p in &edge {
+                    let q = rot * p;
+                    pts.push((q.x, q.y));
+                }
+                pts.push((f64::NAN, f64::NAN));
+            }
+        }
+        let top = vec![Series {
+            label: "blades (tip edge)".into(),
+            points: pts,
+        }];
+        (top, merid)
     }
 
     /// Axis displacement curves of one posted operation against the tool-tip path length
@@ -357,6 +497,16 @@ impl Report {
                 );
             }
             h.push_str("</table>");
+            for o in self.operations.iter().filter(|o| !o.metrics.0.is_empty()) {
+                let _ = write!(h, "<h3>{}: metrics</h3>", esc(&o.name));
+                table_of_object(
+                    &mut h,
+                    &serde_json::to_value(&o.metrics).unwrap_or_default(),
+                );
+            }
+            for p in &self.operation_plots {
+                h.push_str(p);
+            }
         }
         h.push_str("<h2>Post-processing</h2>");
         let mut post = serde_json::to_value(&self.post).unwrap_or_default();
@@ -413,6 +563,35 @@ impl Report {
         }
         h.push_str("</body></html>\n");
         h
+    }
+}
+
+/// An operation's own plot as inline SVG.
+fn render_plot(plot: &cam_plan::Plot) -> String {
+    match &plot.kind {
+        PlotKind::Lines {
+            x_label,
+            y_label,
+            series,
+            equal_aspect,
+        } => {
+            let series: Vec<Series> = series
+                .iter()
+                .map(|s: &PlotSeries| Series {
+                    label: s.label.clone(),
+                    points: s.points.iter().map(|p| (p[0], p[1])).collect(),
+                })
+                .collect();
+            line_chart(&plot.title, x_label, y_label, &series, *equal_aspect)
+        }
+        PlotKind::HeatMap { values, unit } => {
+            let finite = values.iter().flatten().filter(|v| v.is_finite());
+            let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+            let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
+            heat_map(&plot.title, values, lo, hi, unit)
+        }
     }
 }
 

@@ -26,7 +26,7 @@ fn report(dir: &Path) -> serde_json::Value {
 }
 
 #[test]
-fn default_job_reports_the_impeller_and_says_nothing_was_machined() {
+fn default_job_is_the_impeller_8_8_fixture_job() {
     let out = scratch("default");
     let st = cli().args(["run", "--out"]).arg(&out).output().unwrap();
     assert!(
@@ -35,17 +35,24 @@ fn default_job_reports_the_impeller_and_says_nothing_was_machined() {
         String::from_utf8_lossy(&st.stderr)
     );
     let r = report(&out);
+    assert_eq!(r["job"], "impeller-8+8");
     assert_eq!(r["impeller"]["main_blade_count"], 8);
     assert_eq!(r["impeller"]["splitter_blade_count"], 8);
     let d = r["impeller"]["blade_tip_diameter_mm"].as_f64().unwrap();
     assert!((d - 77.0).abs() < 0.5, "{d}");
-    assert_eq!(r["operations"].as_array().unwrap().len(), 0);
-    assert!(r["notes"][0].as_str().unwrap().contains("no operation"));
+    // The fixture job's CL file (embedded), posted and verified like every operation.
+    let ops = r["operations"].as_array().unwrap();
+    assert_eq!(ops.len(), 1, "{ops:?}");
+    assert_eq!(ops[0]["name"], "TOP_RING");
+    assert_eq!(ops[0]["kind"], "cl_import");
+    assert_eq!(r["post"]["written"], true);
+    assert!(out.join("program.ngc").is_file());
     for k in ["model_ms", "plan_ms", "post_ms", "verify_ms", "total_ms"] {
         assert!(r["timings_ms"][k].as_f64().is_some(), "{k}");
     }
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains("<svg") && html.contains("Meridional view"));
+    assert!(html.contains("TOP_RING: top view") && html.contains("TOP_RING: meridional view"));
 }
 
 /// A five-axis ring cut in the stock above the impeller's shroud contour (r = 30 mm, top

@@ -19,7 +19,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<(), CliError> {
     let job = match &args.job {
         Some(p) => Job::from_file(p)?,
-        None => Job::default_job(),
+        None => Job::default_job()?,
     };
     let report = crate::pipeline::run_job(&job, &args.out)?;
     eprintln!(

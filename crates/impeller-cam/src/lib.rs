@@ -1,0 +1,25 @@
+//! `impeller-cam`: the job pipeline of the impeller five-axis CAM toolkit as a library, and
+//! the command line over it.
+//!
+//! [`run_job`] runs a [`Job`] (parsed from a job file with [`Job::from_file`], or the embedded
+//! default [`Job::default_job`]) end to end and writes the program, the CL file and the
+//! reports into a folder: impeller model → planned operations → post-processing → independent
+//! verification → reports (see [`pipeline`]). Operation kinds are found in a registry
+//! ([`registry::OPERATIONS`]); [`run_job_with`] takes another one (a library user's own
+//! operations, or test operations).
+//!
+//! The command line (`src/main.rs`) is a thin layer over [`cmd`]: every subcommand exits 0 on
+//! success and 1 on a user error with one clear line on stderr (`../shared/DESIGN.md` §4).
+
+pub mod cmd;
+pub mod error;
+pub mod job;
+pub mod pipeline;
+pub mod plot;
+pub mod registry;
+pub mod report;
+
+pub use error::CliError;
+pub use job::Job;
+pub use pipeline::{run_job, run_job_with};
+pub use report::Report;

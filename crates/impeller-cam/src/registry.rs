@@ -1,0 +1,53 @@
+//! The operation registry: which operation kinds a job may name, and the builder of each.
+//!
+//! One static table of `(kind name, builder)`; adding a kind is one line in [`OPERATIONS`]
+//! (the builder comes from the kind's crate, e.g. `plunge_opt::build`). The pipeline knows an
+//! operation only through [`cam_plan::Operation`] and this table; [`crate::run_job_with`] and
+//! [`crate::Job::from_toml_str_with`] take another table (a library user's own kinds, test
+//! operations).
+
+use cam_plan::{Builder, Operation, OperationSpec, PlanError};
+
+/// A registry: `(kind name, builder)` rows.
+pub type Registry = [(&'static str, Builder)];
+
+/// The registered operation kinds of this release.
+///
+/// Kinds whose crate has not landed yet are absent (never replaced by a stand-in):
+/// `plunge_roughing` (plunge-opt), `channel_roughing`, `hub_finishing`,
+/// `blade_root_finishing` (channel-paths), `flank_semi_finishing`, `flank_finishing`
+/// (flank-opt).
+pub static OPERATIONS: &Registry = &[];
+
+/// The builder of `kind`, if registered.
+pub fn builder(registry: &Registry, kind: &str) -> Option<Builder> {
+    registry.iter().find(|(k, _)| *k == kind).map(|(_, b)| *b)
+}
+
+/// The registered kind names, comma-separated (for error messages).
+pub fn known(registry: &Registry) -> String {
+    if registry.is_empty() {
+        "none registered in this release".into()
+    } else {
+        registry
+            .iter()
+            .map(|(k, _)| *k)
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// Builds the operation of `spec` with `registry`.
+///
+/// Errors: [`PlanError::UnknownKind`] when the kind is not registered; whatever the kind's
+/// builder returns (usually [`PlanError::Param`] naming the key).
+pub fn build(registry: &Registry, spec: &OperationSpec) -> Result<Box<dyn Operation>, PlanError> {
+    match builder(registry, &spec.kind) {
+        Some(b) => b(spec),
+        None => Err(PlanError::UnknownKind {
+            operation: spec.name.clone(),
+            kind: spec.kind.clone(),
+            known: known(registry),
+        }),
+    }
+}
