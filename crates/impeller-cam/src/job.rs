@@ -390,58 +390,47 @@ fn line_of(text: &str, path: &[Seg]) -> Option<usize> {
     best
 }
 
-/// The dotted path of the innermost key whose key or value contains byte `offset`.
+/// The dotted path of the innermost key whose key or value contains byte `offset`
+/// (`operations[0].process.spindle_rpm`): every key of the document with the spans of the
+/// key and of its value, the smallest span containing the offset wins. O(document size).
 fn path_at(text: &str, offset: usize) -> Option<String> {
     use toml::de::{DeTable, DeValue};
-    fn walk(v: &DeValue<'_>, offset: usize, out: &mut String) {
+    type Spans = Vec<(String, std::ops::Range<usize>)>;
+    fn walk_value(v: &DeValue<'_>, path: &str, out: &mut Spans) {
         match v {
-            DeValue::Table(t) => walk_table(t, offset, out),
+            DeValue::Table(t) => walk_table(t, path, out),
             DeValue::Array(a) => {
                 for (i, e) in a.iter().enumerate() {
-                    let in_table = e.get_ref().as_table().is_some_and(|t| {
-                        t.iter().any(|(k, v)| contains(k.span(), v.span(), offset))
-                    });
-                    if e.span().contains(&offset) || in_table {
-                        out.push_str(&format!("[{i}]"));
-                        walk(e.get_ref(), offset, out);
-                        return;
-                    }
+                    let p = format!("{path}[{i}]");
+                    out.push((p.clone(), e.span()));
+                    walk_value(e.get_ref(), &p, out);
                 }
             }
             _ => {}
         }
     }
-    fn contains(k: std::ops::Range<usize>, v: std::ops::Range<usize>, offset: usize) -> bool {
-        k.contains(&offset) || v.contains(&offset) || (offset >= k.start && offset < v.end)
-    }
-    fn walk_table(t: &DeTable<'_>, offset: usize, out: &mut String) {
+    fn walk_table(t: &DeTable<'_>, path: &str, out: &mut Spans) {
         for (k, v) in t.iter() {
-            let nested = v.get_ref().as_table().is_some_and(|t| {
-                t.iter()
-                    .any(|(k2, v2)| contains(k2.span(), v2.span(), offset))
-            }) || v.get_ref().as_array().is_some_and(|a| {
-                a.iter().any(|e| {
-                    e.span().contains(&offset)
-                        || e.get_ref().as_table().is_some_and(|t| {
-                            t.iter()
-                                .any(|(k2, v2)| contains(k2.span(), v2.span(), offset))
-                        })
-                })
-            });
-            if contains(k.span(), v.span(), offset) || nested {
-                if !out.is_empty() {
-                    out.push('.');
-                }
-                out.push_str(k.get_ref());
-                walk(v.get_ref(), offset, out);
-                return;
+            let p = if path.is_empty() {
+                k.get_ref().to_string()
+            } else {
+                format!("{path}.{}", k.get_ref())
+            };
+            out.push((p.clone(), k.span()));
+            if !matches!(v.get_ref(), DeValue::Table(_)) {
+                out.push((p.clone(), v.span()));
             }
+            walk_value(v.get_ref(), &p, out);
         }
     }
     let doc = DeTable::parse(text).ok()?;
-    let mut out = String::new();
-    walk_table(doc.get_ref(), offset, &mut out);
-    (!out.is_empty()).then_some(out)
+    let mut spans = Spans::new();
+    walk_table(doc.get_ref(), "", &mut spans);
+    spans
+        .into_iter()
+        .filter(|(_, r)| r.start <= offset && offset < r.end.max(r.start + 1))
+        .min_by_key(|(_, r)| r.end - r.start)
+        .map(|(p, _)| p)
 }
 
 /// `file:line: key: reason`.
@@ -463,7 +452,7 @@ fn toml_error(file: &Path, text: &str, e: &toml::de::Error) -> CliError {
     // The key: the dotted path at the error's position, completed by the key serde names
     // (an unknown or missing field) when that one is not already its last element.
     let mut key = path_at(text, span.start).unwrap_or_default();
-    if let Some(named) = cam_plan::params::offending_key(message) {
+    if let Some(named) = cam_plan::params::field_key(message) {
         if !key.ends_with(&named) {
             if !key.is_empty() {
                 key.push('.');

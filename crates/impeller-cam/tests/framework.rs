@@ -1,0 +1,265 @@
+//! The operations framework end to end with a test-only operation (never registered in the
+//! binary, never in a fixture job): a ring of arcs above the blade tips, one arc per main
+//! channel made by rotational copy, planned through the registry passed to
+//! `impeller_cam::run_job_with`, linked over the safety surface, written to the CL file and
+//! the program, verified, and reported with its kind's metrics and plots. Also: job-file
+//! errors of the kind's own keys name the file, line and key.
+#![allow(clippy::unwrap_used, clippy::panic)] // test code
+
+use cam_core::{CutterLocation, Move, Point3, ToolPath, Vector3};
+use cam_plan::{
+    order, params, pattern, Builder, Metrics, Operation, OperationSpec, PlanContext, PlanError,
+    PlannedOperation, Plot, PlotKind, PlotSeries,
+};
+use impeller_cam::{run_job_with, Job};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// The kind's own keys.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RingParams {
+    /// Ring radius (mm).
+    radius_mm: f64,
+    /// Depth below the blank's top (mm).
+    depth_mm: f64,
+    /// Chords per channel.
+    #[serde(default = "default_chords")]
+    chords: usize,
+}
+
+fn default_chords() -> usize {
+    8
+}
+
+#[derive(Debug)]
+struct Ring {
+    name: String,
+    tool: String,
+    params: RingParams,
+}
+
+impl Operation for Ring {
+    fn kind(&self) -> &'static str {
+        "test_ring"
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn tool(&self) -> &str {
+        &self.tool
+    }
+    fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
+        let p = &self.params;
+        let set = ctx.impeller.main();
+        let pitch = set.pitch_rad();
+        let z = ctx.stock.z_range().1 - p.depth_mm;
+        let tilt = 10f64.to_radians();
+        // Channel 0's arc: one pitch of the ring, axis tilted 10° outward.
+        let mut arc = ToolPath::new(format!("{} arc", self.name), &self.tool);
+        for k in 0..=p.chords {
+            let phi = pitch * k as f64 / p.chords as f64;
+            let (s, c) = phi.sin_cos();
+            let cl = CutterLocation::new(
+                Point3::new(p.radius_mm * c, p.radius_mm * s, z),
+                Vector3::new(tilt.sin() * c, tilt.sin() * s, tilt.cos()),
+            )
+            .map_err(|e| PlanError::cam(&self.name, e))?;
+            arc.moves.push(Move::feed(cl));
+        }
+        let order = order::angular_sequence(set.count(), 0);
+        let paths = pattern::copy_to(&arc, pitch, &order);
+        let mut metrics = Metrics::new();
+        let mean_radius = paths
+            .iter()
+            .flat_map(|q| q.moves.iter())
+            .map(|m| m.cl.tip.x.hypot(m.cl.tip.y))
+            .sum::<f64>()
+            / (paths.len() * (p.chords + 1)) as f64;
+        let min_clearance = paths
+            .iter()
+            .flat_map(|q| q.moves.iter())
+            .map(|m| ctx.clearance.clearance(&m.cl).distance_mm)
+            .fold(f64::INFINITY, f64::min);
+        metrics
+            .count("arcs", paths.len())
+            .number("ring_radius_mm", mean_radius)
+            .number("min_design_clearance_mm", min_clearance)
+            .flag("clear_of_design", min_clearance > 0.0)
+            .text("ring_termination", "complete");
+        let plot = Plot {
+            title: "arc radius per channel".into(),
+            kind: PlotKind::Lines {
+                x_label: "channel".into(),
+                y_label: "radius (mm)".into(),
+                series: vec![PlotSeries {
+                    label: "first tip".into(),
+                    points: paths
+                        .iter()
+                        .enumerate()
+                        .map(|(i, q)| [i as f64, q.moves[0].cl.tip.x.hypot(q.moves[0].cl.tip.y)])
+                        .collect(),
+                }],
+                equal_aspect: false,
+            },
+        };
+        Ok(PlannedOperation {
+            paths,
+            metrics,
+            plots: vec![plot],
+            notes: vec![],
+        })
+    }
+}
+
+fn build_ring(spec: &OperationSpec) -> Result<Box<dyn Operation>, PlanError> {
+    let params: RingParams = params::parse(spec)?;
+    if !(params.radius_mm.is_finite() && params.radius_mm > 0.0) {
+        return Err(PlanError::param(&spec.name, "radius_mm", "must be > 0"));
+    }
+    if params.chords == 0 {
+        return Err(PlanError::param(&spec.name, "chords", "must be at least 1"));
+    }
+    Ok(Box::new(Ring {
+        name: spec.name.clone(),
+        tool: spec.tool.clone(),
+        params,
+    }))
+}
+
+static TEST_REGISTRY: &[(&str, Builder)] = &[("test_ring", build_ring)];
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("impeller-cam-fw-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn job_text(ops: &str) -> String {
+    format!(
+        "name = \"ring-op\"\nimpeller = {:?}\nmachine = {:?}\ndialect = \"linuxcnc\"\n\
+         tools = {:?}\n\n[verification]\nresolution_mm = 0.5\n\n\
+         [[tools]]\nnumber = 3\nname = \"flat-d6\"\nshape = \"flat_end\"\ndiameter_mm = 6.0\n\
+         flute_length_mm = 20.0\nshank_diameter_mm = 6.0\nstick_out_mm = 40.0\n\
+         tool_length_mm = 100.0\nteeth = 2\n\n{ops}",
+        repo()
+            .join("fixtures/impeller-8+8/impeller.toml")
+            .display()
+            .to_string(),
+        repo()
+            .join("fixtures/machines/xyzac-trt.toml")
+            .display()
+            .to_string(),
+        "unused"
+    )
+    .replace("tools = \"unused\"\n", "")
+}
+
+const RING_OP: &str = "[[operations]]\nname = \"ring\"\nkind = \"test_ring\"\ntool = \"flat-d6\"\n\
+    radius_mm = 30.0\ndepth_mm = 0.5\n\n[operations.process]\nspindle_rpm = 10000.0\n\
+    feed_per_tooth_mm = 0.04\n";
+
+#[test]
+fn a_registered_operation_is_planned_linked_posted_verified_and_reported() {
+    let dir = scratch("e2e");
+    let job_path = dir.join("job.toml");
+    std::fs::write(&job_path, job_text(RING_OP)).unwrap();
+    let job = Job::from_file_with(&job_path, TEST_REGISTRY).unwrap();
+    assert_eq!(job.operations.len(), 1);
+    // stock_allowance (default 0.5) fills the allowances the row does not give.
+    assert_eq!(job.operations[0].process.blade_allowance_mm, 0.5);
+    let out = dir.join("out");
+    let report = run_job_with(&job, &out, TEST_REGISTRY).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let op = &json["operations"][0];
+    assert_eq!(op["name"], "ring");
+    assert_eq!(op["kind"], "test_ring");
+    assert_eq!(op["tool"], "flat-d6");
+    assert!(op["plan_ms"].as_f64().unwrap() > 0.0, "{op}");
+    // The kind's metrics, flattened into the operation object (xtask reads
+    // operations.ring.<metric>): counts, numbers, booleans and texts.
+    assert_eq!(op["arcs"], 8);
+    assert!(
+        (op["ring_radius_mm"].as_f64().unwrap() - 30.0).abs() < 1e-9,
+        "{op}"
+    );
+    assert_eq!(op["clear_of_design"], true);
+    assert_eq!(op["ring_termination"], "complete");
+    // Moves: approach (safety point, 2 mm above, plunge), 8 arcs of 9 points whose first
+    // points are reached by the links, links between arcs, final retract.
+    let moves = op["moves"].as_u64().unwrap() as usize;
+    assert_eq!(moves, report.operations[0].moves);
+    let cls = std::fs::read_to_string(out.join("toolpath.cls")).unwrap();
+    assert_eq!(cls.matches("GOTO/").count(), moves);
+    assert!(cls.contains("LOADTL/3"), "tool number from the job");
+    // Feed rate: 10000 rpm · 0.04 mm · 2 teeth = 800 mm/min; cutting time from that rate.
+    assert!(cls.contains("FEDRAT/MMPM,800"), "{cls}");
+    let cut_len = 8.0 * 8.0 * 2.0 * 30.0 * (std::f64::consts::PI / 8.0 / 8.0).sin();
+    let t = op["cutting_time_s"].as_f64().unwrap();
+    assert!(
+        t > 60.0 * cut_len / 800.0,
+        "{t} s for {cut_len} mm at 800 mm/min"
+    );
+    // The program is written and verification found no overcut and no collision.
+    assert!(out.join("program.ngc").is_file());
+    let v = &json["verification"];
+    assert!(v["max_overcut_mm"].as_f64().unwrap() <= 0.5, "{v}");
+    assert_eq!(v["collisions"], 0, "{v}");
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("ring: top view") && html.contains("ring: meridional view"));
+    assert!(html.contains("arc radius per channel"));
+}
+
+fn parse_err(text: &str) -> String {
+    let dir = scratch("err");
+    let path = dir.join("job.toml");
+    std::fs::write(&path, text).unwrap();
+    Job::from_file_with(&path, TEST_REGISTRY)
+        .unwrap_err()
+        .to_string()
+}
+
+/// The line of the first line of `text` that starts with `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines()
+        .position(|l| l.trim_start().starts_with(needle))
+        .unwrap()
+        + 1
+}
+
+#[test]
+fn kind_key_errors_name_file_line_and_key() {
+    // An unknown kind key (the kind's parser rejects it).
+    let text = job_text(&RING_OP.replace("depth_mm", "dept_mm"));
+    let err = parse_err(&text);
+    let line = line_of(&text, "dept_mm");
+    assert!(
+        err.contains(&format!("job.toml:{line}: operations[0].dept_mm")),
+        "{err}"
+    );
+    // A value the kind's builder rejects, named by the builder's key.
+    let text = job_text(&RING_OP.replace("radius_mm = 30.0", "radius_mm = -1.0"));
+    let err = parse_err(&text);
+    let line = line_of(&text, "radius_mm");
+    assert!(
+        err.contains(&format!("job.toml:{line}: operations[0].radius_mm")),
+        "{err}"
+    );
+    // A wrong type of a kind key.
+    let text = job_text(&RING_OP.replace("depth_mm = 0.5", "depth_mm = \"deep\""));
+    let err = parse_err(&text);
+    assert!(
+        err.contains("job.toml:") && err.contains("depth_mm"),
+        "{err}"
+    );
+    // A missing kind key.
+    let text = job_text(&RING_OP.replace("depth_mm = 0.5\n", ""));
+    let err = parse_err(&text);
+    assert!(err.contains("depth_mm") && err.contains("ring"), "{err}");
+}
