@@ -1,17 +1,22 @@
 //! `cargo xtask regress`: end-to-end regressions on the fixture impellers.
 //!
 //! A fixture is a folder `fixtures/<name>/` holding `job.toml` (an `impeller-cam run` job)
-//! and `bounds.toml`:
+//! and `bounds.toml`; further jobs of the same fixture are `job-<variant>.toml` with
+//! `bounds-<variant>.toml` (reported as `<name>/<variant>`):
 //!
 //! ```toml
 //! [bounds]
 //! "impeller.main_blade_count" = { min = 8, max = 8 }
 //! "operations.plunge_rough.path_length_mm" = { max = 5000.0 }
+//! "operations.plunge_rough.alpha_monotone" = { equals = true }
+//! "operations.finish.slp_termination" = { equals = "converged" }
 //! "verification.max_overcut_mm" = { max = 0.01 }
 //! ```
 //!
 //! Keys are dotted paths into `report.json`; a segment applied to an array selects the
-//! element whose `name` equals it. A bound whose metric is missing is a breach.
+//! element whose `name` equals it. Numbers and booleans (as 0/1) are bounded by `min`/`max`;
+//! `equals` compares a text, boolean or number exactly. A bound whose metric is missing is a
+//! breach.
 
 use crate::{run_cmd, target_dir, workspace_root, write_atomic};
 use serde::Deserialize;
@@ -35,10 +40,40 @@ struct BoundsFile {
     bounds: BTreeMap<String, Bound>,
 }
 
-#[derive(Debug, Deserialize, Clone, Copy)]
+#[derive(Debug, Deserialize, Clone)]
+#[serde(deny_unknown_fields)]
 struct Bound {
     min: Option<f64>,
     max: Option<f64>,
+    equals: Option<Expected>,
+}
+
+/// An exact expected value.
+#[derive(Debug, Deserialize, Clone, PartialEq)]
+#[serde(untagged)]
+enum Expected {
+    Bool(bool),
+    Number(f64),
+    Text(String),
+}
+
+impl Expected {
+    fn matches(&self, v: &Value) -> bool {
+        match (self, v) {
+            (Expected::Bool(b), Value::Bool(x)) => b == x,
+            (Expected::Number(n), Value::Number(x)) => x.as_f64() == Some(*n),
+            (Expected::Text(t), Value::String(x)) => t == x,
+            _ => false,
+        }
+    }
+}
+
+/// One regression job: its report name, job file and bounds file.
+#[derive(Debug, Clone)]
+struct FixtureJob {
+    name: String,
+    job: PathBuf,
+    bounds: PathBuf,
 }
 
 pub fn run(args: Args) -> Result<bool, String> {
@@ -66,15 +101,12 @@ pub fn run(args: Args) -> Result<bool, String> {
         "{:<28} {:<52} {:>14} {:>12} {:>12}  status",
         "fixture", "metric", "value", "min", "max"
     );
-    for dir in fixtures {
-        let name = dir
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let out = target.join("regress").join(&name);
+    for fixture in fixtures {
+        let name = fixture.name.clone();
+        let out = target.join("regress").join(name.replace('/', "-"));
         let status = Command::new(&exe)
             .arg("run")
-            .arg(dir.join("job.toml"))
+            .arg(&fixture.job)
             .arg("--out")
             .arg(&out)
             .current_dir(&root)
@@ -90,26 +122,51 @@ pub fn run(args: Args) -> Result<bool, String> {
             continue;
         }
         let report = read_json(&out.join("report.json"))?;
-        let bounds_text = std::fs::read_to_string(dir.join("bounds.toml"))
-            .map_err(|e| format!("{}: {e}", dir.join("bounds.toml").display()))?;
-        let bounds: BoundsFile = toml_lite(&bounds_text)
-            .map_err(|e| format!("{}: {e}", dir.join("bounds.toml").display()))?;
+        let bounds_text = std::fs::read_to_string(&fixture.bounds)
+            .map_err(|e| format!("{}: {e}", fixture.bounds.display()))?;
+        let bounds: BoundsFile =
+            toml_lite(&bounds_text).map_err(|e| format!("{}: {e}", fixture.bounds.display()))?;
         let mut metrics = Vec::new();
         for (path, b) in &bounds.bounds {
-            let value = lookup(&report, path).and_then(as_number);
-            let ok =
-                value.is_some_and(|v| b.min.is_none_or(|m| v >= m) && b.max.is_none_or(|m| v <= m));
+            let raw = lookup(&report, path);
+            let value = raw.and_then(as_number);
+            let ok = check(raw, b);
             all_ok &= ok;
+            let shown = match (raw, value) {
+                (_, Some(v)) => format!("{v:.6}"),
+                (Some(Value::String(t)), None) => t.clone(),
+                _ => "missing".into(),
+            };
+            let (min, max) = match &b.equals {
+                Some(e) => {
+                    let t = match e {
+                        Expected::Bool(x) => x.to_string(),
+                        Expected::Number(x) => x.to_string(),
+                        Expected::Text(x) => x.clone(),
+                    };
+                    (t.clone(), t)
+                }
+                None => (
+                    b.min.map_or("-".into(), |v| format!("{v}")),
+                    b.max.map_or("-".into(), |v| format!("{v}")),
+                ),
+            };
             println!(
-                "{name:<28} {path:<52} {:>14} {:>12} {:>12}  {}",
-                value.map_or("missing".into(), |v| format!("{v:.6}")),
-                b.min.map_or("-".into(), |v| format!("{v}")),
-                b.max.map_or("-".into(), |v| format!("{v}")),
+                "{name:<28} {path:<52} {shown:>14} {min:>12} {max:>12}  {}",
                 if ok { "ok" } else { "BREACH" }
             );
-            metrics.push(
-                json!({ "metric": path, "value": value, "min": b.min, "max": b.max, "ok": ok }),
-            );
+            metrics.push(json!({
+                "metric": path,
+                "value": raw,
+                "min": b.min,
+                "max": b.max,
+                "equals": b.equals.as_ref().map(|e| match e {
+                    Expected::Bool(x) => json!(x),
+                    Expected::Number(x) => json!(x),
+                    Expected::Text(x) => json!(x),
+                }),
+                "ok": ok
+            }));
         }
         summary
             .push(json!({ "fixture": name, "run_ok": true, "metrics": metrics, "report": report }));
@@ -122,20 +179,63 @@ pub fn run(args: Args) -> Result<bool, String> {
     Ok(all_ok)
 }
 
-fn find_fixtures(dir: &Path, filter: Option<&str>) -> Result<Vec<PathBuf>, String> {
+/// Whether the report value `raw` satisfies bound `b` (missing = breach).
+fn check(raw: Option<&Value>, b: &Bound) -> bool {
+    let Some(raw) = raw else {
+        return false;
+    };
+    if let Some(e) = &b.equals {
+        if !e.matches(raw) {
+            return false;
+        }
+    }
+    if b.min.is_none() && b.max.is_none() {
+        return b.equals.is_some();
+    }
+    as_number(raw).is_some_and(|v| b.min.is_none_or(|m| v >= m) && b.max.is_none_or(|m| v <= m))
+}
+
+fn find_fixtures(dir: &Path, filter: Option<&str>) -> Result<Vec<FixtureJob>, String> {
     let mut out = Vec::new();
     let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     for e in entries.flatten() {
         let p = e.path();
         let name = e.file_name().to_string_lossy().into_owned();
-        if p.join("job.toml").is_file()
-            && p.join("bounds.toml").is_file()
-            && filter.is_none_or(|f| name.contains(f))
-        {
-            out.push(p);
+        if !p.is_dir() {
+            continue;
         }
+        let mut jobs = Vec::new();
+        if p.join("job.toml").is_file() && p.join("bounds.toml").is_file() {
+            jobs.push(FixtureJob {
+                name: name.clone(),
+                job: p.join("job.toml"),
+                bounds: p.join("bounds.toml"),
+            });
+        }
+        let files = std::fs::read_dir(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+        for f in files.flatten() {
+            let file = f.file_name().to_string_lossy().into_owned();
+            let Some(variant) = file
+                .strip_prefix("job-")
+                .and_then(|v| v.strip_suffix(".toml"))
+            else {
+                continue;
+            };
+            let bounds = p.join(format!("bounds-{variant}.toml"));
+            if bounds.is_file() {
+                jobs.push(FixtureJob {
+                    name: format!("{name}/{variant}"),
+                    job: f.path(),
+                    bounds,
+                });
+            }
+        }
+        out.extend(
+            jobs.into_iter()
+                .filter(|j| filter.is_none_or(|f| j.name.contains(f))),
+        );
     }
-    out.sort();
+    out.sort_by(|a, b| a.name.cmp(&b.name));
     Ok(out)
 }
 
@@ -184,6 +284,32 @@ mod tests {
         assert_eq!(lookup(&v, "operations.0.moves"), Some(&json!(12)));
         assert_eq!(lookup(&v, "post.limit_violations"), Some(&json!(0)));
         assert_eq!(lookup(&v, "post.missing"), None);
+    }
+
+    #[test]
+    fn bounds_check_numbers_booleans_and_texts() {
+        let b = |t: &str| {
+            toml_lite(&format!("[bounds]\n\"x\" = {t}\n"))
+                .unwrap()
+                .bounds["x"]
+                .clone()
+        };
+        assert!(check(Some(&json!(3)), &b("{ min = 1, max = 3 }")));
+        assert!(!check(Some(&json!(4)), &b("{ max = 3 }")));
+        assert!(check(Some(&json!(true)), &b("{ min = 1 }")));
+        assert!(check(Some(&json!(true)), &b("{ equals = true }")));
+        assert!(!check(Some(&json!(false)), &b("{ equals = true }")));
+        assert!(check(
+            Some(&json!("converged")),
+            &b("{ equals = \"converged\" }")
+        ));
+        assert!(!check(
+            Some(&json!("max_iterations")),
+            &b("{ equals = \"converged\" }")
+        ));
+        assert!(!check(Some(&json!("text")), &b("{ max = 1 }")));
+        assert!(!check(None, &b("{ max = 1 }")));
+        assert!(toml_lite("[bounds]\n\"x\" = { maxx = 1 }\n").is_err());
     }
 
     #[test]
