@@ -10,34 +10,76 @@
 //! - blade k: the points inside both sides (each side's signed distance is positive along its
 //!   outward normal) and below the shroud contour: `max(d_pressure, d_suction, d_shroud)`.
 //!   Only the two instances of each row that enclose the query's polar angle are evaluated
-//!   (the reference blade's angle at the nearest meridional position is tabulated), so a
-//!   query costs four blade-side projections however many blades there are.
+//!   (the reference blade's angle at the nearest meridional position is tabulated), so an
+//!   exact query costs four blade-side projections however many blades there are.
 //!
-//! The tool assembly is a solid of revolution of radius `ρ(h)` about its axis for heights
-//! `0 ≤ h ≤ H` above the tip ([`cam_core::Cutter::assembly_radius_at`]). Its cross-section
-//! at height `h` is a disc inside the ball of radius `ρ(h)` about `c(h) = tip + h·axis`, so
-//! `d(c(h)) − ρ(h)` (with `d` the design's signed distance) is a lower bound of the disc's
-//! clearance. The query takes the minimum over sample heights: the ball centre of ball and
-//! tapered-ball ends (where the ball is the cutter's end exactly), then a grid up the
-//! flutes, the shank and the holder with a step `s ≤ min(ρ/2, √(2·ρ·tol))`; between two
-//! samples the union of balls misses a rim band of depth `≤ s²/(4ρ) ≤ tol/2`.
+//! A [`DesignMesh`] triangulates the design within a chord tolerance `c` (hub surface with its
+//! inlet disc and outlet cylinder, every blade side; parry BVH): the true surfaces lie within
+//! `c` of the mesh.
 //!
-//! The ball test is exact for a ball end, and conservative elsewhere: a flat bottom is
-//! tested with the ball about the tip, which reaches below it, and a wide holder's ball
-//! reaches down the axis by its radius. Operations whose tools touch a floor with a flat
-//! bottom (plunge roughing) ask for the blades only ([`ClearanceOptions::parts`]).
+//! **Cutter** (the fluted part, `0 ≤ h ≤ L`): a solid of revolution of radius `ρ(h)` about the
+//! axis. Its cross-section at height `h` is a disc inside the ball of radius `ρ(h)` about
+//! `c(h) = tip + h·axis`, so `d(c(h)) − ρ(h)` (`d` the design's signed distance) bounds the
+//! disc's clearance from below. The query takes the minimum over sample heights: the ball
+//! centre of ball and tapered-ball ends (where the ball is the cutter's end exactly), then a
+//! grid up the flutes with a step `s ≤ min(ρ/2, √(2·ρ·tol))`; between two samples the union of
+//! balls misses a rim band of depth `≤ s²/(4ρ) ≤ tol/2`. `d` is exact (NURBS) where it matters:
+//! the blade distance is first bounded with the mesh (unsigned distance `d_m` to the blade
+//! sides, BVH, O(log T)); when `d_m − c − t/2 ≥ ρ + EXACT_BAND_MM` (`t` the thickest blade) the
+//! ball centre is outside every blade and `d_m − c` is used (a lower bound at least
+//! `EXACT_BAND_MM` beyond the ball), otherwise the exact NURBS distance. The hub distance is
+//! always exact (a meridional curve projection).
 //!
-//! Cost: O(H / s) distance evaluations per posture (each four blade-side projections and
-//! two contour projections), stopping early in [`DesignClearance::is_clear`].
+//! **Shank and holder**: the frusta of [`cam_core::Cutter::frusta`] above the flutes, each as
+//! a convex polyhedron circumscribing it (polygon rings whose sides stay within `c` of the
+//! circle), placed at the posture and measured against the hub and blade meshes with parry's
+//! contact query (signed: negative = penetration depth), minus `c` for the mesh. A frustum
+//! buried entirely inside material (no mesh crossing) is caught by the exact signed distance
+//! at its axis midpoint. Unlike balls as wide as the holder, this does not reach down the axis
+//! by the holder's radius: a holder 5 mm above a plane is 5 mm clear.
+//!
+//! Stated error: the answer is a lower bound of the true clearance, tighter than `tol/2`
+//! (cutter sampling) near a surface for the cutter, and than `2c` (mesh chord + polygon) for
+//! shank and holder. The shroud contour, when asked for ([`PartSet::shroud`]), is measured
+//! with the balls at every sample height up to the holder's top (exact 2D projections;
+//! conservative for wide parts).
+//!
+//! A flat bottom is tested with the ball about the tip, which reaches below it (conservative);
+//! operations whose tools touch a floor with a flat bottom (plunge roughing) ask for the blades
+//! only ([`ClearanceOptions::parts`]).
+//!
+//! Cost per posture: O(L / s) mesh point queries and hub projections, exact blade projections
+//! only for samples within the band of a blade, and one BVH contact query per frustum;
+//! [`DesignClearance::is_clear`] stops at the first failing part.
+//!
+//! Dependency: parry3d-f64 (the workspace's chosen BVH and convex-shape queries).
 
 use crate::{PlanError, Point3, Tool, Vector3};
 use cam_core::{CutterLocation, CutterShape};
+use impeller_model::export::stl::tessellate;
 use impeller_model::query::blade_side_distance;
 use impeller_model::{BladeSet, Impeller, Side};
+use parry3d_f64::math::{Pose, Rotation, Vector as PVec};
+use parry3d_f64::query::{self, PointQueryWithLocation};
+use parry3d_f64::shape::{ConvexPolyhedron, TriMesh};
+use std::sync::Arc;
 
 /// Default sampling tolerance of the swept balls (mm): the largest rim band between two
-/// sample heights the union of balls may miss.
+/// sample heights the union of balls may miss; also the chord of the design mesh and of the
+/// frusta polygons built by [`DesignClearance::new`].
 pub const DEFAULT_SAMPLE_TOL_MM: f64 = 0.01;
+
+/// Width beyond a cutter ball within which blade distances are computed exactly (mm): a
+/// bound from the mesh is used only when it leaves at least this much room, so every answer
+/// within this distance of a blade is exact.
+pub const EXACT_BAND_MM: f64 = 1.0;
+
+/// Coarsest chord of the design mesh (mm): a finer `sample_tol_mm` makes the mesh follow it,
+/// a coarser one is capped here so the shank/holder answers stay within 0.1 mm.
+pub const MAX_MESH_CHORD_MM: f64 = 0.05;
+
+/// Blade thickness grid (u × v samples per pressure side) for the thickest blade `t`.
+const THICKNESS_GRID: (usize, usize) = (24, 8);
 
 /// A blade row.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -175,24 +217,315 @@ impl RowAngles {
     }
 }
 
+/// The design triangulated within a chord tolerance, with a BVH (parry): the hub surface
+/// closed by its inlet disc and outlet cylinder, and every blade side of every instance.
+/// Built once per impeller and shared by the clearance queries of every tool.
+#[derive(Clone)]
+pub struct DesignMesh {
+    hub: TriMesh,
+    blades: TriMesh,
+    /// (row, instance) of each blade triangle.
+    blade_of: Vec<(Row, usize)>,
+    chord_mm: f64,
+    thickest_blade_mm: f64,
+}
+
+impl std::fmt::Debug for DesignMesh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DesignMesh")
+            .field("hub_triangles", &self.hub.indices().len())
+            .field("blade_triangles", &self.blade_of.len())
+            .field("chord_mm", &self.chord_mm)
+            .field("thickest_blade_mm", &self.thickest_blade_mm)
+            .finish()
+    }
+}
+
+fn pv(p: &Point3) -> PVec {
+    PVec::new(p.x, p.y, p.z)
+}
+
+impl DesignMesh {
+    /// Triangulates `impeller` within `chord_mm` (> 0; capped at [`MAX_MESH_CHORD_MM`]).
+    /// Cost: the tessellation of the hub and of each row's two sides (O(area / chord)), the
+    /// copies to every instance, and a BVH build O(T log T).
+    ///
+    /// Errors: a chord that is not finite and > 0; a surface the tessellation cannot meet the
+    /// chord on.
+    pub fn new(impeller: &Impeller, chord_mm: f64) -> Result<Self, PlanError> {
+        if !(chord_mm.is_finite() && chord_mm > 0.0) {
+            return Err(PlanError::param(
+                "-",
+                "tolerances.chord_tol",
+                format!("{chord_mm} must be finite and > 0"),
+            ));
+        }
+        let chord = chord_mm.min(MAX_MESH_CHORD_MM);
+        let mesh_err = |e: impeller_model::export::ExportError| {
+            PlanError::geometry("-", "design mesh", e.to_string())
+        };
+        // Hub surface, inlet disc (z = z_inlet, r ≤ r_inlet) and outlet cylinder
+        // (r = r_outlet, 0 ≤ z ≤ z_outlet): the capped hub body's boundary.
+        let hub_surface = tessellate(impeller.hub().surface(), chord, "hub").map_err(mesh_err)?;
+        let mut hub_v: Vec<PVec> = hub_surface
+            .vertices
+            .iter()
+            .map(|v| PVec::new(v.x, v.y, v.z))
+            .collect();
+        let mut hub_t = hub_surface.triangles.clone();
+        let m = impeller.hub().meridional();
+        let (t0, t1) = m.domain();
+        let (a, b) = (m.point(t0), m.point(t1));
+        let (inlet, outlet) = if a[0] >= b[0] { (a, b) } else { (b, a) };
+        // Polygon sides within the chord of circles up to the outlet radius.
+        let r_max = inlet[1].max(outlet[1]).max(chord);
+        let n = (std::f64::consts::PI / (1.0 - chord / r_max).clamp(-1.0, 1.0).acos())
+            .ceil()
+            .max(12.0) as usize;
+        let ring = |r: f64, z: f64| -> Vec<PVec> {
+            (0..n)
+                .map(|k| {
+                    let t = std::f64::consts::TAU * k as f64 / n as f64;
+                    PVec::new(r * t.cos(), r * t.sin(), z)
+                })
+                .collect()
+        };
+        let centre = hub_v.len() as u32;
+        hub_v.push(PVec::new(0.0, 0.0, inlet[0]));
+        let base = hub_v.len() as u32;
+        hub_v.extend(ring(inlet[1], inlet[0]));
+        for k in 0..n as u32 {
+            hub_t.push([centre, base + k, base + (k + 1) % n as u32]);
+        }
+        if outlet[0] > 0.0 {
+            let lo = hub_v.len() as u32;
+            hub_v.extend(ring(outlet[1], 0.0));
+            let hi = hub_v.len() as u32;
+            hub_v.extend(ring(outlet[1], outlet[0]));
+            for k in 0..n as u32 {
+                let k1 = (k + 1) % n as u32;
+                hub_t.push([lo + k, lo + k1, hi + k1]);
+                hub_t.push([lo + k, hi + k1, hi + k]);
+            }
+        }
+        let hub = TriMesh::new(hub_v, hub_t)
+            .map_err(|e| PlanError::geometry("-", "hub mesh", format!("{e:?}")))?;
+
+        let mut vertices: Vec<PVec> = Vec::new();
+        let mut triangles: Vec<[u32; 3]> = Vec::new();
+        let mut blade_of = Vec::new();
+        let mut thickest: f64 = 0.0;
+        let rows = std::iter::once((Row::Main, impeller.main()))
+            .chain(impeller.splitter().map(|s| (Row::Splitter, s)));
+        for (row, set) in rows {
+            let blade = set.blade();
+            for side in [Side::Pressure, Side::Suction] {
+                let name = format!("{row:?} blade {side:?} side");
+                let sm = clip_at_shroud(
+                    impeller,
+                    &tessellate(blade.side(side), chord, &name).map_err(mesh_err)?,
+                );
+                for k in 0..set.count() {
+                    let rot = set.rotation(k);
+                    let base = vertices.len() as u32;
+                    vertices.extend(sm.vertices.iter().map(|v| {
+                        let q = rot * v;
+                        PVec::new(q.x, q.y, q.z)
+                    }));
+                    triangles.extend(
+                        sm.triangles
+                            .iter()
+                            .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+                    );
+                    blade_of.extend(std::iter::repeat_n((row, k), sm.triangles.len()));
+                }
+            }
+            // Thickest blade: suction-side distance of pressure-side grid points.
+            let ps = blade.side(Side::Pressure);
+            let ((u0, u1), (v0, v1)) = ps.domain();
+            let (nu, nv) = THICKNESS_GRID;
+            for i in 0..=nu {
+                for j in 0..=nv {
+                    let p = ps.point(
+                        u0 + (u1 - u0) * i as f64 / nu as f64,
+                        v0 + (v1 - v0) * j as f64 / nv as f64,
+                    );
+                    let (_, d) = blade_side_distance(blade, Side::Suction, &p, None);
+                    thickest = thickest.max(-d);
+                }
+            }
+        }
+        let blades = TriMesh::new(vertices, triangles)
+            .map_err(|e| PlanError::geometry("-", "blade mesh", format!("{e:?}")))?;
+        Ok(Self {
+            hub,
+            blades,
+            blade_of,
+            chord_mm: chord,
+            thickest_blade_mm: thickest,
+        })
+    }
+
+    /// The chord tolerance of the mesh (mm).
+    pub fn chord_mm(&self) -> f64 {
+        self.chord_mm
+    }
+
+    /// The thickest blade found (mm).
+    pub fn thickest_blade_mm(&self) -> f64 {
+        self.thickest_blade_mm
+    }
+
+    /// Unsigned distance from `p` to the nearest blade side triangle and the blade it
+    /// belongs to. O(log T).
+    fn blade_mesh_distance(&self, p: &Point3) -> (f64, DesignPart) {
+        let q = pv(p);
+        let (proj, (tri, _)) = self.blades.project_local_point_and_get_location(q, false);
+        let part = self
+            .blade_of
+            .get(tri as usize)
+            .map_or(DesignPart::Hub, |&(row, index)| DesignPart::Blade {
+                row,
+                index,
+            });
+        ((proj.point - q).length(), part)
+    }
+}
+
+/// The part of a blade side's mesh below the shroud contour (blade sides extend a little
+/// beyond it, as the model does; the blade material stops at the shroud). Each triangle is
+/// clipped by the zero set of the shroud's signed distance, interpolated linearly along its
+/// edges (Sutherland–Hodgman against one linear function): exact where the distance is linear
+/// across the triangle, within its second-order variation otherwise. O(T).
+fn clip_at_shroud(
+    impeller: &Impeller,
+    mesh: &impeller_model::export::stl::TriMesh,
+) -> impeller_model::export::stl::TriMesh {
+    let d: Vec<f64> = mesh
+        .vertices
+        .iter()
+        .map(|v| impeller.shroud().signed_distance(v))
+        .collect();
+    let mut out = impeller_model::export::stl::TriMesh::default();
+    for t in &mesh.triangles {
+        let idx = t.map(|i| i as usize);
+        if idx.iter().all(|&i| d[i] <= 0.0) {
+            let base = out.vertices.len() as u32;
+            out.vertices.extend(idx.iter().map(|&i| mesh.vertices[i]));
+            out.triangles.push([base, base + 1, base + 2]);
+            continue;
+        }
+        // Keep the polygon where d ≤ 0.
+        let mut poly = Vec::with_capacity(4);
+        for k in 0..3 {
+            let (a, b) = (idx[k], idx[(k + 1) % 3]);
+            let (da, db) = (d[a], d[b]);
+            if da <= 0.0 {
+                poly.push(mesh.vertices[a]);
+            }
+            if (da <= 0.0) != (db <= 0.0) {
+                let f = da / (da - db);
+                poly.push(mesh.vertices[a] + (mesh.vertices[b] - mesh.vertices[a]) * f);
+            }
+        }
+        if poly.len() >= 3 {
+            let base = out.vertices.len() as u32;
+            out.vertices.extend(poly.iter().copied());
+            for k in 1..poly.len() as u32 - 1 {
+                out.triangles.push([base, base + k, base + k + 1]);
+            }
+        }
+    }
+    out
+}
+
+/// One shank or holder frustum as a convex polyhedron in the tool frame (tip at the origin,
+/// axis +Z).
+#[derive(Clone)]
+struct FrustumShape {
+    shape: ConvexPolyhedron,
+    h_mid: f64,
+    r_mid: f64,
+    part: ToolPart,
+}
+
+/// The convex polyhedron circumscribing the frustum `(h0, r0)–(h1, r1)`: two rings of `n`
+/// points at radius `r / cos(π/n)` with `n` chosen so the polygon's sides stay within `chord`
+/// of the circle.
+fn frustum_shape(h0: f64, h1: f64, r0: f64, r1: f64, chord: f64) -> Option<ConvexPolyhedron> {
+    let r = r0.max(r1).max(chord);
+    let n = (std::f64::consts::PI / (1.0 / (1.0 + chord / r)).acos())
+        .ceil()
+        .max(8.0) as usize;
+    let scale = 1.0 / (std::f64::consts::PI / n as f64).cos();
+    let mut pts = Vec::with_capacity(2 * n);
+    for (h, r) in [(h0, r0), (h1, r1)] {
+        for k in 0..n {
+            let t = std::f64::consts::TAU * k as f64 / n as f64;
+            pts.push(PVec::new(r * scale * t.cos(), r * scale * t.sin(), h));
+        }
+    }
+    ConvexPolyhedron::from_convex_hull(&pts)
+}
+
 /// Clearance of one tool against one impeller's design.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct DesignClearance<'a> {
     impeller: &'a Impeller,
     options: ClearanceOptions,
-    /// (height, radius, tool part) of each sample.
+    /// (height, radius, tool part) of each cutter sample; with the shroud in the part set,
+    /// also of shank and holder heights (see the module docs).
     samples: Vec<(f64, f64, ToolPart)>,
+    /// Ball samples of the shank and holder, for the shroud contour only.
+    upper_samples: Vec<(f64, f64, ToolPart)>,
+    frusta: Vec<FrustumShape>,
+    mesh: Arc<DesignMesh>,
     hub_z_max: f64,
     hub_r_max: f64,
     rows: Vec<(Row, RowAngles)>,
 }
 
+impl std::fmt::Debug for DesignClearance<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DesignClearance")
+            .field("impeller", &self.impeller.name())
+            .field("options", &self.options)
+            .field("samples", &self.samples.len())
+            .field("frusta", &self.frusta.len())
+            .field("mesh", &self.mesh)
+            .finish()
+    }
+}
+
 impl<'a> DesignClearance<'a> {
-    /// The query of `tool` against `impeller`.
+    /// The query of `tool` against `impeller`, with a design mesh of its own at the options'
+    /// sampling tolerance (see [`DesignClearance::with_mesh`] to share one).
     ///
-    /// Errors: invalid tool or a sampling tolerance that is not finite and > 0.
+    /// Errors: invalid tool, a sampling tolerance that is not finite and > 0, a design the
+    /// mesh cannot be built for.
     pub fn new(
         impeller: &'a Impeller,
+        tool: &Tool,
+        options: ClearanceOptions,
+    ) -> Result<Self, PlanError> {
+        let tol = options.sample_tol_mm;
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(PlanError::param(
+                "-",
+                "clearance.sample_tol_mm",
+                format!("{tol} must be finite and > 0"),
+            ));
+        }
+        let mesh = Arc::new(DesignMesh::new(impeller, tol)?);
+        Self::with_mesh(impeller, mesh, tool, options)
+    }
+
+    /// The query of `tool` against `impeller` over a shared design mesh of that impeller.
+    ///
+    /// Errors: invalid tool or a sampling tolerance that is not finite and > 0.
+    pub fn with_mesh(
+        impeller: &'a Impeller,
+        mesh: Arc<DesignMesh>,
         tool: &Tool,
         options: ClearanceOptions,
     ) -> Result<Self, PlanError> {
@@ -207,6 +540,7 @@ impl<'a> DesignClearance<'a> {
         }
         let c = &tool.cutter;
         let mut samples = Vec::new();
+        let mut upper_samples = Vec::new();
         let (centre, grid_start) = match c.shape {
             CutterShape::BallEnd { radius } => (Some(radius), radius),
             CutterShape::TaperedBallEnd {
@@ -231,7 +565,11 @@ impl<'a> DesignClearance<'a> {
             } else {
                 ToolPart::Holder
             };
-            samples.push((h, rho, part));
+            if part == ToolPart::Cutter {
+                samples.push((h, rho, part));
+            } else {
+                upper_samples.push((h, rho, part));
+            }
             if h >= top {
                 break;
             }
@@ -246,6 +584,26 @@ impl<'a> DesignClearance<'a> {
             }
             h = next;
         }
+        let chord = mesh.chord_mm;
+        let frusta = c
+            .frusta(chord)
+            .map_err(|e| PlanError::tool("-", &c.name, e.to_string()))?
+            .into_iter()
+            .filter(|f| f.h0 >= c.flute_length - 1e-12)
+            .filter_map(|f| {
+                let part = if f.h0 < c.overall_length - 1e-12 {
+                    ToolPart::Shank
+                } else {
+                    ToolPart::Holder
+                };
+                frustum_shape(f.h0, f.h1, f.r0, f.r1, chord).map(|shape| FrustumShape {
+                    shape,
+                    h_mid: 0.5 * (f.h0 + f.h1),
+                    r_mid: 0.5 * (f.r0 + f.r1),
+                    part,
+                })
+            })
+            .collect();
         let hub = impeller.hub().meridional();
         let (t0, t1) = hub.domain();
         let (a, b) = (hub.point(t0), hub.point(t1));
@@ -257,13 +615,17 @@ impl<'a> DesignClearance<'a> {
             impeller,
             options,
             samples,
+            upper_samples,
+            frusta,
+            mesh,
             hub_z_max: a[0].max(b[0]),
             hub_r_max: a[1].max(b[1]),
             rows,
         })
     }
 
-    /// The same query with other options.
+    /// The same query with other options (the design mesh is kept: its chord stays that of
+    /// the original sampling tolerance).
     pub fn with_options(&self, options: ClearanceOptions) -> Self {
         Self {
             options,
@@ -271,7 +633,12 @@ impl<'a> DesignClearance<'a> {
         }
     }
 
-    /// The sample (height, radius) pairs along the tool axis.
+    /// The design mesh (shareable with [`DesignClearance::with_mesh`]).
+    pub fn mesh(&self) -> &Arc<DesignMesh> {
+        &self.mesh
+    }
+
+    /// The cutter's sample (height, radius) pairs along the tool axis.
     pub fn samples(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
         self.samples.iter().map(|s| (s.0, s.1))
     }
@@ -288,7 +655,8 @@ impl<'a> DesignClearance<'a> {
         -self.impeller.shroud().signed_distance(&p.coords)
     }
 
-    /// Signed distance of the nearest blade (negative inside it) and which blade it is.
+    /// Signed distance of the nearest blade (negative inside it) and which blade it is
+    /// (exact: NURBS projections on the two instances of each row around `p`).
     pub fn blade_signed_distance(&self, p: &Point3) -> (f64, DesignPart) {
         let d_shroud = self.impeller.shroud().signed_distance(&p.coords);
         let mut best = (f64::INFINITY, DesignPart::Hub);
@@ -323,9 +691,27 @@ impl<'a> DesignClearance<'a> {
         best
     }
 
+    /// The blade distance a ball of radius `rho` about `p` needs: exact within
+    /// [`EXACT_BAND_MM`] of the ball, else the mesh's lower bound (see the module docs).
+    fn blade_distance_for(&self, p: &Point3, rho: f64) -> (f64, DesignPart) {
+        let (dm, part) = self.mesh.blade_mesh_distance(p);
+        let c = self.mesh.chord_mm;
+        if dm - c - 0.5 * self.mesh.thickest_blade_mm >= rho + EXACT_BAND_MM {
+            (dm - c, part)
+        } else {
+            self.blade_signed_distance(p)
+        }
+    }
+
     /// Signed distance of the selected design parts at `p` (negative inside material; for
-    /// the shroud, negative beyond it) and the nearest part.
+    /// the shroud, negative beyond it) and the nearest part. Exact (NURBS).
     pub fn design_signed_distance(&self, p: &Point3) -> (f64, DesignPart) {
+        self.design_distance_for(p, f64::INFINITY)
+    }
+
+    /// [`DesignClearance::design_signed_distance`] for a ball of radius `rho` about `p`:
+    /// blade distances more than [`EXACT_BAND_MM`] beyond the ball may be mesh lower bounds.
+    fn design_distance_for(&self, p: &Point3, rho: f64) -> (f64, DesignPart) {
         let parts = self.options.parts;
         let mut best = (f64::INFINITY, DesignPart::Hub);
         if parts.hub {
@@ -338,7 +724,11 @@ impl<'a> DesignClearance<'a> {
             }
         }
         if parts.blades {
-            let b = self.blade_signed_distance(p);
+            let b = if rho.is_finite() {
+                self.blade_distance_for(p, rho)
+            } else {
+                self.blade_signed_distance(p)
+            };
             if b.0 < best.0 {
                 best = b;
             }
@@ -348,6 +738,17 @@ impl<'a> DesignClearance<'a> {
 
     /// The smallest clearance of the tool at `cl` (see the module docs for what it bounds).
     pub fn clearance(&self, cl: &CutterLocation) -> Clearance {
+        self.evaluate(cl, None)
+    }
+
+    /// Whether the tool at `cl` keeps at least `min_clearance_mm` from the design (stops at
+    /// the first part that fails).
+    pub fn is_clear(&self, cl: &CutterLocation, min_clearance_mm: f64) -> bool {
+        self.evaluate(cl, Some(min_clearance_mm)).distance_mm >= min_clearance_mm
+    }
+
+    /// The clearance at `cl`; with `stop_below`, returns as soon as a part is found below it.
+    fn evaluate(&self, cl: &CutterLocation, stop_below: Option<f64>) -> Clearance {
         let axis: Vector3 = cl.axis.into_inner();
         let mut best = Clearance {
             distance_mm: f64::INFINITY,
@@ -355,27 +756,100 @@ impl<'a> DesignClearance<'a> {
             tool_part: ToolPart::Cutter,
             height_mm: 0.0,
         };
+        let failed = |b: &Clearance| stop_below.is_some_and(|m| b.distance_mm < m);
         for &(h, rho, part) in &self.samples {
-            let (d, dp) = self.design_signed_distance(&(cl.tip + axis * h));
-            let c = d - rho;
-            if c < best.distance_mm {
+            let (d, dp) = self.design_distance_for(&(cl.tip + axis * h), rho);
+            if d - rho < best.distance_mm {
                 best = Clearance {
-                    distance_mm: c,
+                    distance_mm: d - rho,
                     design_part: dp,
                     tool_part: part,
                     height_mm: h,
                 };
+                if failed(&best) {
+                    return best;
+                }
+            }
+        }
+        if self.options.parts.shroud {
+            for &(h, rho, part) in &self.upper_samples {
+                let d = self.shroud_signed_distance(&(cl.tip + axis * h));
+                if d - rho < best.distance_mm {
+                    best = Clearance {
+                        distance_mm: d - rho,
+                        design_part: DesignPart::Shroud,
+                        tool_part: part,
+                        height_mm: h,
+                    };
+                    if failed(&best) {
+                        return best;
+                    }
+                }
+            }
+        }
+        if self.frusta.is_empty() || !(self.options.parts.hub || self.options.parts.blades) {
+            return best;
+        }
+        let a = PVec::new(axis.x, axis.y, axis.z);
+        let pose = Pose::from_parts(pv(&cl.tip), Rotation::from_rotation_arc(PVec::Z, a));
+        let c = self.mesh.chord_mm;
+        for f in &self.frusta {
+            let mut meshes: Vec<(&TriMesh, bool)> = Vec::with_capacity(2);
+            if self.options.parts.hub {
+                meshes.push((&self.mesh.hub, false));
+            }
+            if self.options.parts.blades {
+                meshes.push((&self.mesh.blades, true));
+            }
+            let mut crossed = false;
+            for (mesh, blades) in meshes {
+                // Only contacts that could lower the answer (or fail the check) matter.
+                let reach = match stop_below {
+                    Some(m) => m.min(best.distance_mm),
+                    None => best.distance_mm,
+                };
+                let prediction = (reach + c).max(0.0);
+                let Ok(Some(k)) =
+                    query::contact(&pose, &f.shape, &Pose::IDENTITY, mesh, prediction)
+                else {
+                    continue;
+                };
+                crossed |= k.dist <= 0.0;
+                let d = k.dist - c;
+                if d < best.distance_mm {
+                    let at = Point3::new(k.point2.x, k.point2.y, k.point2.z);
+                    best = Clearance {
+                        distance_mm: d,
+                        design_part: if blades {
+                            self.mesh.blade_mesh_distance(&at).1
+                        } else {
+                            DesignPart::Hub
+                        },
+                        tool_part: f.part,
+                        height_mm: (at - cl.tip).dot(&axis).max(0.0),
+                    };
+                    if failed(&best) {
+                        return best;
+                    }
+                }
+            }
+            // A frustum buried inside material crosses no mesh triangle.
+            if !crossed {
+                let mid = cl.tip + axis * f.h_mid;
+                let (d, dp) = self.design_distance_for(&mid, f.r_mid);
+                if d < 0.0 && d - f.r_mid < best.distance_mm {
+                    best = Clearance {
+                        distance_mm: d - f.r_mid,
+                        design_part: dp,
+                        tool_part: f.part,
+                        height_mm: f.h_mid,
+                    };
+                    if failed(&best) {
+                        return best;
+                    }
+                }
             }
         }
         best
-    }
-
-    /// Whether the tool at `cl` keeps at least `min_clearance_mm` from the design (stops at
-    /// the first sample that fails).
-    pub fn is_clear(&self, cl: &CutterLocation, min_clearance_mm: f64) -> bool {
-        let axis: Vector3 = cl.axis.into_inner();
-        self.samples.iter().all(|&(h, rho, _)| {
-            self.design_signed_distance(&(cl.tip + axis * h)).0 - rho >= min_clearance_mm
-        })
     }
 }

@@ -184,34 +184,29 @@ impl Linker {
         Ok(moves)
     }
 
-    /// Prepends the approach (from the safety surface along the first move's axis) and
-    /// appends the retract to `path` when it has moves.
+    /// Prepends the approach (from the safety surface along the first move's axis: a rapid
+    /// to the surface, a rapid to `approach_mm` above the first point, and a plunge replacing
+    /// a first cutting move) and appends the retract along the last move's axis, when `path`
+    /// has moves and its ends lie inside the surface.
     pub fn close(&self, path: &mut ToolPath, approach_mm: f64) -> Result<(), PlanError> {
-        let (Some(first), Some(last)) = (path.moves.first().copied(), path.moves.last().copied())
-        else {
+        let Some(last) = path.moves.last().copied() else {
             return Ok(());
         };
-        let start = self.retract_point(&first.cl)?;
-        let above = CutterLocation {
-            tip: first.cl.tip + first.cl.axis.into_inner() * approach_mm.max(0.0),
-            axis: first.cl.axis,
-        };
-        let mut head = vec![Move::rapid(start), Move::rapid(above)];
-        if first.kind == MoveKind::Feed {
-            head.push(Move {
-                kind: MoveKind::Plunge,
-                cl: first.cl,
+        if path
+            .moves
+            .first()
+            .is_some_and(|m| self.surface.contains(&m.cl.tip))
+        {
+            self.close_start(path, approach_mm)?;
+        }
+        if self.surface.contains(&last.cl.tip) {
+            let end = self.retract_point(&last.cl)?;
+            path.moves.push(Move {
+                kind: MoveKind::Retract,
+                cl: end,
                 feed_mm_per_min: None,
             });
         }
-        head.append(&mut path.moves);
-        path.moves = head;
-        let end = self.retract_point(&last.cl)?;
-        path.moves.push(Move {
-            kind: MoveKind::Retract,
-            cl: end,
-            feed_mm_per_min: None,
-        });
         Ok(())
     }
 

@@ -17,6 +17,7 @@ use crate::job::Job;
 use crate::registry::{self, Registry};
 use crate::report::{OperationReport, PostOperationReport, PostReport, Report, VerificationReport};
 use cam_core::{Cutter, CutterLocation, MoveKind, Rates, ToolPath};
+use cam_plan::clearance::DesignMesh;
 use cam_plan::{
     ClearanceOptions, DesignClearance, Linker, Metrics, PlanContext, PlanError, Plot,
     SafetySurface, Tool,
@@ -31,6 +32,7 @@ use machining_sim::{ImpellerDesign, ImpellerSampling, SimOptions, TriDexel};
 use postproc_kinematics::{AccessibilityChecker, Machine, PostOptions, ReverseMotionOptions};
 use rayon::prelude::*;
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// The machine used when a job names none: LinuxCNC `xyzac-trt` table-table trunnion.
@@ -173,6 +175,11 @@ pub fn plan(
     let surface =
         SafetySurface::around_stock(impeller.stock(), job.safety.clearance_mm).map_err(msg)?;
     let linker = Linker::new(surface);
+    let mesh = if job.operations.is_empty() {
+        None
+    } else {
+        Some(design_mesh(job, impeller)?)
+    };
     let planned: Vec<Result<JobOperation, CliError>> = job
         .operations
         .par_iter()
@@ -188,8 +195,12 @@ pub fn plan(
             })?;
             let op = registry::build(registry, spec).map_err(fail)?;
             let t = Instant::now();
-            let clearance = DesignClearance::new(impeller, tool, clearance_options(job))
-                .map_err(|e| fail(rename(e, &spec.name)))?;
+            let mesh = mesh
+                .clone()
+                .ok_or_else(|| fail(PlanError::geometry(&spec.name, "design mesh", "not built")))?;
+            let clearance =
+                DesignClearance::with_mesh(impeller, mesh, tool, clearance_options(job))
+                    .map_err(|e| fail(rename(e, &spec.name)))?;
             let ctx = PlanContext {
                 impeller,
                 stock: impeller.stock(),
@@ -286,6 +297,14 @@ fn rename(e: PlanError, operation: &str) -> PlanError {
     }
 }
 
+/// The design mesh of the clearance queries at the job's `chord_tol` (built once, shared by
+/// every operation's query and every gouge check).
+pub fn design_mesh(job: &Job, impeller: &Impeller) -> Result<Arc<DesignMesh>, CliError> {
+    DesignMesh::new(impeller, job.tolerances.chord_tol)
+        .map(Arc::new)
+        .map_err(|e| CliError::Message(format!("design mesh: {e}")))
+}
+
 /// The clearance options of the job: the design mesh and tool frusta at the job's
 /// `chord_tol`.
 pub fn clearance_options(job: &Job) -> ClearanceOptions {
@@ -374,13 +393,16 @@ pub fn post(
     }
     // One gouge check per operation with a known tool: the same design clearance query the
     // planners use.
+    let mesh = if operations.iter().any(|o| o.tool.is_some()) {
+        Some(design_mesh(job, impeller)?)
+    } else {
+        None
+    };
     let checkers: Vec<Option<GougeCheck<'_>>> = operations
         .iter()
-        .map(|op| {
-            op.tool
-                .as_ref()
-                .map(|t| GougeCheck::new(impeller, t, job))
-                .transpose()
+        .map(|op| match (&op.tool, &mesh) {
+            (Some(t), Some(m)) => GougeCheck::with_mesh(impeller, m.clone(), t, job).map(Some),
+            _ => Ok(None),
         })
         .collect::<Result<_, _>>()?;
     let access: Vec<OperationAccess<'_>> = checkers
@@ -537,6 +559,18 @@ impl<'a> GougeCheck<'a> {
     /// The check of `tool` against `impeller` with the tolerances of `job`.
     pub fn new(impeller: &'a Impeller, tool: &Tool, job: &Job) -> Result<Self, CliError> {
         let clearance = DesignClearance::new(impeller, tool, clearance_options(job))
+            .map_err(|e| CliError::Message(format!("tool \"{}\": {e}", tool.name())))?;
+        Ok(Self::with(clearance, job.tolerances.machining_tol))
+    }
+
+    /// [`GougeCheck::new`] over a shared design mesh.
+    pub fn with_mesh(
+        impeller: &'a Impeller,
+        mesh: Arc<DesignMesh>,
+        tool: &Tool,
+        job: &Job,
+    ) -> Result<Self, CliError> {
+        let clearance = DesignClearance::with_mesh(impeller, mesh, tool, clearance_options(job))
             .map_err(|e| CliError::Message(format!("tool \"{}\": {e}", tool.name())))?;
         Ok(Self::with(clearance, job.tolerances.machining_tol))
     }

@@ -1,0 +1,405 @@
+//! The design clearance query against hand-built cases with known distances (cutter, shank,
+//! holder), linking moves kept at the safety clearance, rotational copy of a whole planned
+//! operation, and ordering that keeps rapids short.
+#![allow(clippy::unwrap_used, clippy::panic)] // test code
+
+use cam_core::{
+    Cutter, CutterLocation, CutterShape, HolderSegment, Move, Point3, ToolPath, Vector3,
+};
+use cam_plan::clearance::DesignMesh;
+use cam_plan::{
+    order, pattern, ClearanceOptions, DesignClearance, DesignPart, Linker, SafetySurface, Tool,
+    ToolPart,
+};
+use impeller_model::{Impeller, Side};
+use std::sync::{Arc, OnceLock};
+
+/// Chord and sampling tolerance of these tests (mm).
+const TOL: f64 = 0.01;
+
+fn impeller() -> &'static Impeller {
+    static IMP: OnceLock<Impeller> = OnceLock::new();
+    IMP.get_or_init(|| impeller_model::fixtures::default_impeller().unwrap())
+}
+
+fn mesh() -> Arc<DesignMesh> {
+    static MESH: OnceLock<Arc<DesignMesh>> = OnceLock::new();
+    MESH.get_or_init(|| Arc::new(DesignMesh::new(impeller(), TOL).unwrap()))
+        .clone()
+}
+
+fn tool(
+    shape: CutterShape,
+    flute: f64,
+    shank_r: f64,
+    stick_out: f64,
+    holder: &[(f64, f64, f64)],
+) -> Tool {
+    let mut cutter = Cutter::new("t", shape, flute, shank_r, stick_out).unwrap();
+    cutter.holder = holder
+        .iter()
+        .map(|&(bottom_radius, top_radius, length)| HolderSegment {
+            bottom_radius,
+            top_radius,
+            length,
+        })
+        .collect();
+    let total = stick_out + holder.iter().map(|h| h.2).sum::<f64>();
+    Tool {
+        number: 1,
+        cutter,
+        teeth: 2,
+        tool_length_mm: total,
+        plunge_edge_length_mm: None,
+    }
+}
+
+fn query(t: &Tool) -> DesignClearance<'static> {
+    DesignClearance::with_mesh(
+        impeller(),
+        mesh(),
+        t,
+        ClearanceOptions {
+            sample_tol_mm: TOL,
+            ..ClearanceOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+/// The hub's inlet disc (r < 9 mm) is the plane z = 43 mm; nothing of the design rises above
+/// it within r < 8.5 mm (the blades' rounded leading edges, which reach z = 43.04 mm, start
+/// at r = 9 mm).
+fn top() -> f64 {
+    impeller().summary().axial_height_mm
+}
+
+#[test]
+fn mesh_stays_within_its_chord_of_the_design() {
+    let m = mesh();
+    assert!(m.chord_mm() <= TOL);
+    // The fixture's blades are 0.8 mm thick (thicker near the rounded edges).
+    assert!(
+        m.thickest_blade_mm() > 0.7 && m.thickest_blade_mm() < 3.0,
+        "{m:?}"
+    );
+}
+
+#[test]
+fn shank_lying_over_the_inlet_disc_is_clear_by_its_gap() {
+    // A horizontal tool (axis +X) whose Ø4 shank lies over the inlet disc (x from −5 to 7,
+    // |y| ≤ 2, so r < 7.3 mm) at gap g; the Ø1 flutes hang 1.5 mm higher. Known clearance: g,
+    // on the shank.
+    let t = tool(CutterShape::BallEnd { radius: 0.5 }, 2.0, 2.0, 14.0, &[]);
+    let q = query(&t);
+    for g in [0.05, 0.3, 1.0] {
+        let cl =
+            CutterLocation::new(Point3::new(-7.0, 0.0, top() + g + 2.0), Vector3::x()).unwrap();
+        let c = q.clearance(&cl);
+        assert_eq!(c.tool_part, ToolPart::Shank, "{c:?}");
+        assert_eq!(c.design_part, DesignPart::Hub, "{c:?}");
+        // A lower bound within the mesh chord plus the polygon's (2·TOL).
+        assert!(
+            c.distance_mm <= g + 1e-9 && c.distance_mm >= g - 2.0 * TOL,
+            "g {g}: {c:?}"
+        );
+        assert!(q.is_clear(&cl, g - 2.0 * TOL));
+        assert!(!q.is_clear(&cl, g + 1e-6));
+    }
+    // Lowered into the disc by 0.2 mm: penetration, negative.
+    let cl = CutterLocation::new(Point3::new(-7.0, 0.0, top() - 0.2 + 2.0), Vector3::x()).unwrap();
+    let c = q.clearance(&cl);
+    assert!(
+        c.distance_mm <= -0.2 + 1e-9 && c.distance_mm >= -0.2 - 3.0 * TOL,
+        "{c:?}"
+    );
+    assert!(!q.is_clear(&cl, 0.0));
+}
+
+#[test]
+fn holder_lying_over_the_inlet_disc_is_clear_by_its_gap() {
+    // Horizontal: a Ø7 holder over the inlet disc (x from −7 to 6, r < 7.8 mm) at gap g; the
+    // Ø2 shank and the flutes are 2.5 mm higher, out beyond the blades' tips.
+    let t = tool(
+        CutterShape::BallEnd { radius: 1.0 },
+        3.0,
+        1.0,
+        23.0,
+        &[(3.5, 3.5, 13.0)],
+    );
+    let q = query(&t);
+    let g = 0.4;
+    let cl = CutterLocation::new(Point3::new(-30.0, 0.0, top() + g + 3.5), Vector3::x()).unwrap();
+    let c = q.clearance(&cl);
+    assert_eq!(c.tool_part, ToolPart::Holder, "{c:?}");
+    assert_eq!(c.design_part, DesignPart::Hub, "{c:?}");
+    assert!(
+        c.distance_mm <= g + 1e-9 && c.distance_mm >= g - 2.0 * TOL,
+        "{c:?}"
+    );
+}
+
+#[test]
+fn a_wide_holder_above_a_short_tool_does_not_reach_down_its_radius() {
+    // Vertical tool on the axis, tip 0.5 mm above the inlet disc, 6 mm stick-out under a
+    // Ø40 holder: the holder face is 6.5 mm above the disc; a ball as wide as the holder
+    // would reach 13.5 mm below it. The nearest part is the cutter at 0.5 mm.
+    let t = tool(
+        CutterShape::BallEnd { radius: 1.0 },
+        3.0,
+        1.5,
+        6.0,
+        &[(20.0, 20.0, 20.0)],
+    );
+    let q = query(&t);
+    let cl = CutterLocation::new(Point3::new(0.0, 0.0, top() + 0.5), Vector3::z()).unwrap();
+    let c = q.clearance(&cl);
+    assert_eq!(c.tool_part, ToolPart::Cutter, "{c:?}");
+    assert_eq!(c.design_part, DesignPart::Hub, "{c:?}");
+    assert!((c.distance_mm - 0.5).abs() < 1e-9, "{c:?}");
+    assert!(q.is_clear(&cl, 0.49));
+}
+
+/// Mid-meridian hub point farthest from the blades (0.5° scan over one pitch) and its normal.
+fn hub_point_mid_channel(q: &DesignClearance<'_>) -> (Point3, Vector3) {
+    let imp = impeller();
+    let (t0, t1) = imp.hub().meridional().domain();
+    let t = 0.5 * (t0 + t1);
+    let steps = (imp.main().pitch_rad().to_degrees() * 2.0).ceil() as usize;
+    let (_, phi) = (0..steps)
+        .map(|k| {
+            let phi = (k as f64 * 0.5).to_radians();
+            let p = Point3::from(imp.hub().point(t, phi) + imp.hub().normal(t, phi));
+            (q.blade_signed_distance(&p).0, phi)
+        })
+        .fold(
+            (f64::NEG_INFINITY, 0.0),
+            |a, b| if b.0 > a.0 { b } else { a },
+        );
+    (
+        Point3::from(imp.hub().point(t, phi)),
+        imp.hub().normal(t, phi),
+    )
+}
+
+#[test]
+fn ball_above_the_hub_is_clear_by_its_height_exactly() {
+    let t = tool(CutterShape::BallEnd { radius: 0.5 }, 2.0, 0.5, 3.0, &[]);
+    let q = query(&t);
+    let (p, n) = hub_point_mid_channel(&q);
+    for g in [0.0, 0.1, 0.3] {
+        let cl = CutterLocation::new(p + n * g, n).unwrap();
+        let c = q.clearance(&cl);
+        assert_eq!(c.design_part, DesignPart::Hub, "{c:?}");
+        // The ball centre sample is exact (hub distance by meridional projection).
+        assert!((c.distance_mm - g).abs() < 1e-6, "g {g}: {c:?}");
+    }
+}
+
+#[test]
+fn ball_beside_a_blade_is_clear_by_its_lateral_gap() {
+    // A ball end whose ball touches the main blade's pressure side at mid-chord, mid-span,
+    // moved off along the side's normal by g; the axis runs along the blade's span (its
+    // ruling), so the flutes stay beside the side. Known clearance: g (exact NURBS within
+    // the band).
+    let imp = impeller();
+    let r = 0.5;
+    let t = tool(CutterShape::BallEnd { radius: r }, 1.0, r, 1.0, &[]);
+    let q = query(&t);
+    let blade = imp.main().blade();
+    let ps = blade.side(Side::Pressure);
+    let ((u0, u1), (v0, v1)) = ps.domain();
+    let (u, v) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
+    let p = ps.point(u, v);
+    let e = 1e-5;
+    let du = (ps.point(u + e, v) - ps.point(u - e, v)) / (2.0 * e);
+    let dv = (ps.point(u, v + e) - ps.point(u, v - e)) / (2.0 * e);
+    let mut n = du.cross(&dv).normalize();
+    // Outward: the signed side distance is positive along it.
+    let probe = Point3::from(p + n * 0.05);
+    if q.blade_signed_distance(&probe).0 < 0.0 {
+        n = -n;
+    }
+    let axis = (dv - n * dv.dot(&n)).normalize();
+    for g in [0.05, 0.2] {
+        let centre = p + n * (r + g);
+        let cl = CutterLocation::new(Point3::from(centre - axis * r), axis).unwrap();
+        let c = q.clearance(&cl);
+        assert!(matches!(c.design_part, DesignPart::Blade { .. }), "{c:?}");
+        assert!(
+            c.distance_mm <= g + 1e-6 && c.distance_mm >= g - TOL,
+            "g {g}: {c:?}"
+        );
+    }
+}
+
+/// Straight segments between consecutive postures, tip and axis interpolated (axis
+/// normalised), sampled every `step` mm of tip travel (and at least 8 times per segment).
+fn sample_moves(moves: &[Move], step: f64) -> Vec<CutterLocation> {
+    let mut out = Vec::new();
+    for w in moves.windows(2) {
+        let (a, b) = (w[0].cl, w[1].cl);
+        let n = (((b.tip - a.tip).norm() / step).ceil() as usize).max(8);
+        for i in 0..=n {
+            let f = i as f64 / n as f64;
+            let axis = a.axis.into_inner() * (1.0 - f) + b.axis.into_inner() * f;
+            out.push(CutterLocation::new(a.tip + (b.tip - a.tip) * f, axis).unwrap());
+        }
+    }
+    out
+}
+
+#[test]
+fn linking_moves_keep_the_safety_clearance_from_the_design() {
+    // Two cutting postures deep in neighbouring channels, axes tilted differently (one
+    // toward the impeller axis, one outward): the travel between their retract points on the
+    // safety surface, sampled at 1 mm (a tenth of the clearance), never comes closer to the
+    // design than the clearance (within the query's stated error).
+    let imp = impeller();
+    let clearance = 10.0;
+    let linker = Linker::new(SafetySurface::around_stock(imp.stock(), clearance).unwrap());
+    let t = tool(
+        CutterShape::TaperedBallEnd {
+            ball_radius: 1.5,
+            half_angle: 2f64.to_radians(),
+        },
+        20.0,
+        3.0,
+        35.0,
+        &[(10.5, 13.5, 38.0), (13.5, 13.5, 42.0)],
+    );
+    let q = query(&t);
+    let (p, n) = hub_point_mid_channel(&q);
+    let from = CutterLocation::new(p + n * 0.2, n + Vector3::new(-p.x, -p.y, 0.0) * 0.02).unwrap();
+    let rot = nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), 1.3);
+    let to_tip = rot * (p + n * 0.2);
+    let to = CutterLocation::new(
+        to_tip,
+        rot * n + Vector3::new(to_tip.x, to_tip.y, 0.0) * 0.03,
+    )
+    .unwrap();
+    let link = linker.connect(&from, &to, 2.0).unwrap();
+    // The travel: from the retract point (first move) to the entry point above `to`.
+    let out = linker.retract_point(&from).unwrap();
+    let inn = linker.retract_point(&to).unwrap();
+    let start = link.iter().position(|m| m.cl == out).unwrap();
+    let end = link.iter().position(|m| m.cl == inn).unwrap();
+    assert!(end > start + 1, "{link:?}");
+    let mut min = f64::INFINITY;
+    for cl in sample_moves(&link[start..=end], 1.0) {
+        min = min.min(q.clearance(&cl).distance_mm);
+    }
+    assert!(min >= clearance - 2.0 * TOL, "closest {min} mm");
+    // Retract and approach run along the cutting postures' axes: the clearance grows from the
+    // cut out to the surface.
+    let back: Vec<f64> = sample_moves(&[Move::feed(from), link[0]], 1.0)
+        .iter()
+        .map(|cl| q.clearance(cl).distance_mm)
+        .collect();
+    assert!(
+        back.first().unwrap() < &1.0 && back.last().unwrap() >= &(clearance - 2.0 * TOL),
+        "{back:?}"
+    );
+}
+
+#[test]
+fn rotational_copy_of_a_whole_planned_operation_is_exact() {
+    // One channel's path with its approach and retract over the safety surface, copied to
+    // every channel and joined: each channel's copy equals channel 0's turned by k·pitch
+    // within 1e-9 mm (tips) and 1e-12 (axes).
+    let imp = impeller();
+    let set = imp.main();
+    let pitch = set.pitch_rad();
+    let linker = Linker::new(SafetySurface::around_stock(imp.stock(), 10.0).unwrap());
+    let mut path = ToolPath::new("op", "t");
+    for i in 0..40 {
+        let s = i as f64 / 39.0;
+        let tip = Point3::new(12.0 + 20.0 * s, 3.0 * s, 40.0 - 25.0 * s);
+        path.moves.push(Move::feed(
+            CutterLocation::new(tip, Vector3::new(0.2 * s, 0.1, 1.0)).unwrap(),
+        ));
+    }
+    linker.close(&mut path, 2.0).unwrap();
+    let order = order::angular_sequence(set.count(), 0);
+    let copies = pattern::copy_to(&path, pitch, &order);
+    let joined = linker.join("op", "t", &copies, 2.0).unwrap();
+    for (k, c) in copies.iter().enumerate() {
+        let rot = nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), pitch * k as f64);
+        assert_eq!(c.moves.len(), path.moves.len());
+        for (m, m0) in c.moves.iter().zip(&path.moves) {
+            assert!((m.cl.tip - rot * m0.cl.tip).norm() < 1e-9);
+            assert!((m.cl.axis.into_inner() - rot * m0.cl.axis.into_inner()).norm() < 1e-12);
+            assert_eq!(m.kind, m0.kind);
+        }
+        // Every cutting move of every copy is in the joined operation, in order.
+        let cuts: Vec<&Move> = c
+            .moves
+            .iter()
+            .filter(|m| m.kind == cam_core::MoveKind::Feed)
+            .collect();
+        let at = joined
+            .moves
+            .iter()
+            .position(|m| m.cl == cuts[0].cl)
+            .unwrap();
+        for (j, m) in cuts.iter().enumerate() {
+            assert_eq!(joined.moves[at + j].cl, m.cl);
+        }
+    }
+}
+
+#[test]
+fn nearest_first_ordering_keeps_rapids_shortest() {
+    // Copies of one path to 7 channels, shuffled: the greedy order from channel 0's start
+    // gives the least total rapid length (tip of one path's end to the next one's start) of
+    // every order starting with channel 0 (brute force over 6! orders).
+    let mut path = ToolPath::new("p", "t");
+    for i in 0..5 {
+        let tip = Point3::new(20.0 + i as f64, 2.0 * i as f64, 30.0);
+        path.moves
+            .push(Move::feed(CutterLocation::new(tip, Vector3::z()).unwrap()));
+    }
+    let n = 7;
+    let pitch = std::f64::consts::TAU / n as f64;
+    let shuffled = [0, 4, 2, 6, 1, 5, 3];
+    let copies = pattern::copy_to(&path, pitch, &shuffled);
+    let start = copies[0].moves[0].cl.tip;
+    let greedy = order::nearest_first(&copies, start);
+    let rapid = |ord: &[usize]| -> f64 {
+        ord.windows(2)
+            .map(|w| {
+                let a = copies[w[0]].moves.last().unwrap().cl.tip;
+                let b = copies[w[1]].moves[0].cl.tip;
+                (b - a).norm()
+            })
+            .sum()
+    };
+    let mut best = f64::INFINITY;
+    let mut rest: Vec<usize> = (1..n).collect();
+    permute(&mut rest, 0, &mut |p| {
+        let mut ord = vec![0];
+        ord.extend_from_slice(p);
+        best = best.min(rapid(&ord));
+    });
+    assert_eq!(greedy[0], 0);
+    assert!(
+        rapid(&greedy) <= best + 1e-9,
+        "{} vs {best}",
+        rapid(&greedy)
+    );
+    // And it visits the channels in angular sequence (each link one pitch).
+    let channels: Vec<usize> = greedy.iter().map(|&i| shuffled[i]).collect();
+    assert_eq!(channels, order::angular_sequence(n, 0));
+}
+
+fn permute(v: &mut Vec<usize>, k: usize, f: &mut impl FnMut(&[usize])) {
+    if k == v.len() {
+        f(v);
+        return;
+    }
+    for i in k..v.len() {
+        v.swap(k, i);
+        permute(v, k + 1, f);
+        v.swap(k, i);
+    }
+}
