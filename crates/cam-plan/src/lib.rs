@@ -9,7 +9,9 @@
 //!
 //! The services every planner needs live here once:
 //! - [`clearance`]: signed clearance of the cutter, shank and holder against the design (hub,
-//!   shroud contour, every blade), with the part that is nearest;
+//!   shroud contour, every blade), with the part that is nearest: a triangulated
+//!   [`DesignMesh`] (shared by every tool's query) as prefilter, exact NURBS distances near
+//!   the surface for the cutter, shank and holder frusta as convex shapes against the mesh;
 //! - [`linking`]: retract along the tool axis to a safety surface, travel on it, approach
 //!   along the tool axis;
 //! - [`pattern`]: rotational copy of one channel's or blade's paths to every channel/blade
@@ -22,7 +24,8 @@
 //! a kind's own keys with errors that name the key).
 //!
 //! Dependency direction (DESIGN §2): `nurbs`, `cam-core`, `impeller-model` only; the verifier
-//! (`machining-sim`) never depends on this crate.
+//! (`machining-sim`) never depends on this crate. Third-party: parry3d-f64 (the workspace's
+//! choice for BVH and convex-shape distance queries) in [`clearance`].
 
 pub mod clearance;
 pub mod error;
@@ -36,7 +39,7 @@ pub mod process;
 pub mod tool;
 
 pub use clearance::{
-    Clearance, ClearanceOptions, DesignClearance, DesignPart, PartSet, Row, ToolPart,
+    Clearance, ClearanceOptions, DesignClearance, DesignMesh, DesignPart, PartSet, Row, ToolPart,
 };
 pub use error::PlanError;
 pub use linking::{Linker, SafetySurface};
