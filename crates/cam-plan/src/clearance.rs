@@ -27,7 +27,10 @@
 //! the blade distance is first bounded with the mesh (unsigned distance `d_m` to the blade
 //! sides, BVH, O(log T)); when `d_m − c − t/2 ≥ ρ + EXACT_BAND_MM` (`t` the thickest blade) the
 //! ball centre is outside every blade and `d_m − c` is used (a lower bound at least
-//! `EXACT_BAND_MM` beyond the ball), otherwise the exact NURBS distance. The hub distance is
+//! `EXACT_BAND_MM` beyond the ball), and likewise when the centre is outside every blade and
+//! the bound already shows the sample cannot lower the minimum found so far (nor fail
+//! `is_clear`); otherwise the exact NURBS distance. So the minimum is exact wherever it lies
+//! within the band. The hub distance is
 //! always exact (a meridional curve projection).
 //!
 //! **Shank and holder**: the frusta of [`cam_core::Cutter::frusta`] above the flutes, each as
@@ -694,9 +697,19 @@ impl<'a> DesignClearance<'a> {
     /// The blade distance a ball of radius `rho` about `p` needs: exact within
     /// [`EXACT_BAND_MM`] of the ball, else the mesh's lower bound (see the module docs).
     fn blade_distance_for(&self, p: &Point3, rho: f64) -> (f64, DesignPart) {
+        self.blade_distance_below(p, rho, f64::INFINITY)
+    }
+
+    /// [`DesignClearance::blade_distance_for`], also using the mesh bound when it shows the
+    /// ball's clearance `d − ρ` is at least `need` (it cannot lower a minimum already at
+    /// `need`, nor fail a check against it).
+    fn blade_distance_below(&self, p: &Point3, rho: f64, need: f64) -> (f64, DesignPart) {
         let (dm, part) = self.mesh.blade_mesh_distance(p);
         let c = self.mesh.chord_mm;
-        if dm - c - 0.5 * self.mesh.thickest_blade_mm >= rho + EXACT_BAND_MM {
+        let outside = dm - c - 0.5 * self.mesh.thickest_blade_mm >= 0.0;
+        if (outside && dm - c - rho >= need)
+            || dm - c - 0.5 * self.mesh.thickest_blade_mm >= rho + EXACT_BAND_MM
+        {
             (dm - c, part)
         } else {
             self.blade_signed_distance(p)
@@ -712,6 +725,12 @@ impl<'a> DesignClearance<'a> {
     /// [`DesignClearance::design_signed_distance`] for a ball of radius `rho` about `p`:
     /// blade distances more than [`EXACT_BAND_MM`] beyond the ball may be mesh lower bounds.
     fn design_distance_for(&self, p: &Point3, rho: f64) -> (f64, DesignPart) {
+        self.design_distance_below(p, rho, f64::INFINITY)
+    }
+
+    /// [`DesignClearance::design_distance_for`] where only clearances `d − ρ` below `need`
+    /// must be exact (see [`DesignClearance::blade_distance_below`]).
+    fn design_distance_below(&self, p: &Point3, rho: f64, need: f64) -> (f64, DesignPart) {
         let parts = self.options.parts;
         let mut best = (f64::INFINITY, DesignPart::Hub);
         if parts.hub {
@@ -725,7 +744,7 @@ impl<'a> DesignClearance<'a> {
         }
         if parts.blades {
             let b = if rho.is_finite() {
-                self.blade_distance_for(p, rho)
+                self.blade_distance_below(p, rho, need.min(best.0 - rho))
             } else {
                 self.blade_signed_distance(p)
             };
@@ -758,7 +777,9 @@ impl<'a> DesignClearance<'a> {
         };
         let failed = |b: &Clearance| stop_below.is_some_and(|m| b.distance_mm < m);
         for &(h, rho, part) in &self.samples {
-            let (d, dp) = self.design_distance_for(&(cl.tip + axis * h), rho);
+            // Exact only where this sample could lower the answer (or fail the check).
+            let need = stop_below.map_or(best.distance_mm, |m| m.min(best.distance_mm));
+            let (d, dp) = self.design_distance_below(&(cl.tip + axis * h), rho, need);
             if d - rho < best.distance_mm {
                 best = Clearance {
                     distance_mm: d - rho,
