@@ -695,12 +695,8 @@ impl<'a> DesignClearance<'a> {
     }
 
     /// The blade distance a ball of radius `rho` about `p` needs: exact within
-    /// [`EXACT_BAND_MM`] of the ball, else the mesh's lower bound (see the module docs).
-    fn blade_distance_for(&self, p: &Point3, rho: f64) -> (f64, DesignPart) {
-        self.blade_distance_below(p, rho, f64::INFINITY)
-    }
-
-    /// [`DesignClearance::blade_distance_for`], also using the mesh bound when it shows the
+    /// [`EXACT_BAND_MM`] of the ball, else the mesh's lower bound (see the module docs);
+    /// also using the mesh bound when it shows the
     /// ball's clearance `d − ρ` is at least `need` (it cannot lower a minimum already at
     /// `need`, nor fail a check against it).
     fn blade_distance_below(&self, p: &Point3, rho: f64, need: f64) -> (f64, DesignPart) {
