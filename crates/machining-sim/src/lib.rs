@@ -7,9 +7,13 @@
 //! Pipeline: [`TriDexel::from_shape`] samples the blank ([`BoxStock`], [`RevolvedStock`]);
 //! [`simulate()`] sweeps every move's cutter through the stock ([`removal`]) and checks the
 //! non-cutting parts against the stock in process (on the dexels, exact along each ray) and
-//! against the design mesh (parry BVH, [`collision`]); [`measure`] probes the finished stock
-//! along design normals for overcut and residual; [`surface_mesh`] extracts an STL of the
-//! final stock; [`crosscheck`] compares the dexel overcut with cam-core's swept envelopes.
+//! against the design mesh (parry BVH, [`collision`]); [`endpoints`] reads the overcut at
+//! the dexel segment end points (exact ray–cutter intersections: the depth of every cut end
+//! point inside the design, within `Metrics::overcut_error_bound_mm` =
+//! sweep tolerance + ¾·h²/ρ of the truth) and [`measure`] probes the finished stock along
+//! design normals for the residual and for through-cuts where no end point is left;
+//! [`surface_mesh`] extracts an STL of the final stock; [`crosscheck`] compares the dexel
+//! overcut with cam-core's swept envelopes.
 //! [`ImpellerDesign`] makes an `impeller_model::Impeller` a [`DesignModel`].
 //!
 //! Figures (blank of the 77 mm fixture impeller, Ø79 × 44 mm; `examples/removal_100k.rs`,
