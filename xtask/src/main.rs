@@ -4,6 +4,9 @@
 //!   compares the metrics of its `report.json` with the bounds stored beside the fixture
 //!   (`fixtures/<name>/bounds.toml`), prints a table, writes `target/regress/summary.json`
 //!   and exits non-zero on any breach.
+//! - `cargo xtask ci`: what CI runs — installs the test consumers (`rs274`, `chromium`) when
+//!   missing, then fmt, clippy, the whole test suite, the regressions and a closing
+//!   `tests: N passed, N failed` line (see [`ci`]).
 //! - `cargo xtask bench`: runs the criterion benchmarks in release, collects the median of
 //!   every benchmark into `target/bench/bmf.json` (Bencher Metric Format) and writes the
 //!   closest-point query set to `target/bench/closest_point_queries.csv`.
@@ -11,6 +14,7 @@
 #![allow(clippy::print_stdout)]
 
 mod bench;
+mod ci;
 mod regress;
 
 use clap::{Parser, Subcommand};
@@ -28,6 +32,8 @@ struct Cli {
 enum Cmd {
     /// Run every fixture job end to end and check its metrics against the stored bounds.
     Regress(regress::Args),
+    /// What CI runs: install test consumers, fmt, clippy, tests, regressions, totals.
+    Ci(ci::Args),
     /// Run the criterion benchmarks and export them in Bencher Metric Format.
     Bench(bench::Args),
 }
@@ -37,6 +43,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Cmd::Regress(a) => regress::run(a),
         Cmd::Bench(a) => bench::run(a),
+        Cmd::Ci(a) => ci::run(a),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

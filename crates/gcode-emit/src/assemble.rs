@@ -290,8 +290,9 @@ pub fn assemble_program_with_access(
         let nc_moves = posted
             .blocks
             .iter()
-            .map(|b| nc_move(machine, b, options.mode))
-            .collect();
+            .enumerate()
+            .map(|(k, b)| nc_move(machine, b, options.mode, &path.name, k))
+            .collect::<Result<Vec<_>, _>>()?;
         metrics.push((path.name.clone(), posted.metrics));
         let (before, after) = match &posted.reverse_motion {
             Some(r) => (r.before.clone(), r.after.clone()),
@@ -355,17 +356,29 @@ pub fn rotary_words(machine: &Machine, j: &Joints) -> Vec<RotaryWord> {
         .collect()
 }
 
-/// One posted block as an NC move in `mode`.
-pub fn nc_move(machine: &Machine, b: &PostedBlock, mode: OutputMode) -> NcMove {
+/// One posted block as an NC move in `mode`. A cutting block without its feed (inverse
+/// time in [`OutputMode::Joint`], mm/min otherwise) is an error naming the operation and
+/// the block: a controller reads `F0` as "no motion" or an alarm, never as intended.
+pub fn nc_move(
+    machine: &Machine,
+    b: &PostedBlock,
+    mode: OutputMode,
+    operation: &str,
+    block: usize,
+) -> Result<NcMove, GcodeError> {
     let rapid = b.kind == MoveKind::Rapid;
+    let missing = |what| GcodeError::MissingFeed {
+        operation: operation.to_string(),
+        block,
+        what,
+    };
     let (xyz, feed) = match mode {
         OutputMode::Joint => (
             [b.joints.x, b.joints.y, b.joints.z],
             if rapid {
                 Feed::Rapid
             } else {
-                // post_path gives an inverse-time value for every non-rapid block.
-                Feed::InverseTime(b.inverse_time_feed.unwrap_or(0.0))
+                Feed::InverseTime(b.inverse_time_feed.ok_or_else(|| missing("inverse-time"))?)
             },
         ),
         OutputMode::TcpAngles | OutputMode::TcpVector => (
@@ -373,16 +386,16 @@ pub fn nc_move(machine: &Machine, b: &PostedBlock, mode: OutputMode) -> NcMove {
             if rapid {
                 Feed::Rapid
             } else {
-                Feed::PerMinute(b.feed_mm_per_min.unwrap_or(0.0))
+                Feed::PerMinute(b.feed_mm_per_min.ok_or_else(|| missing("mm/min"))?)
             },
         ),
     };
-    NcMove {
+    Ok(NcMove {
         xyz,
         rotary: rotary_words(machine, &b.joints),
         tool_vector: Some([b.cl.axis.x, b.cl.axis.y, b.cl.axis.z]),
         feed,
-    }
+    })
 }
 
 #[cfg(test)]
@@ -428,6 +441,55 @@ mod tests {
             },
             ..AssembleOptions::default()
         }
+    }
+
+    /// A cutting block without its feed is refused (it used to be written `F0`).
+    #[test]
+    fn a_cutting_block_without_feed_is_an_error_not_f0() {
+        let m = machine();
+        let cl = CutterLocation::vertical(Point3::new(1.0, 2.0, 3.0));
+        let mut b = PostedBlock {
+            joints: Joints {
+                x: 1.0,
+                y: 2.0,
+                z: 3.0,
+                tilt: 0.0,
+                rotate: 0.0,
+            },
+            cl,
+            kind: MoveKind::Feed,
+            feed_mm_per_min: None,
+            inverse_time_feed: None,
+            source_index: 4,
+            inserted: false,
+            unwound: false,
+            linearisation_error_mm: 0.0,
+            limit_violation: None,
+        };
+        for mode in [OutputMode::Joint, OutputMode::TcpAngles] {
+            match nc_move(&m, &b, mode, "finish", 7) {
+                Err(GcodeError::MissingFeed {
+                    operation, block, ..
+                }) => assert_eq!((operation.as_str(), block), ("finish", 7)),
+                other => panic!("{mode:?}: {other:?}"),
+            }
+        }
+        b.inverse_time_feed = Some(12.5);
+        b.feed_mm_per_min = Some(800.0);
+        assert_eq!(
+            nc_move(&m, &b, OutputMode::Joint, "finish", 7)
+                .unwrap()
+                .feed,
+            Feed::InverseTime(12.5)
+        );
+        b.kind = MoveKind::Rapid;
+        b.inverse_time_feed = None;
+        assert_eq!(
+            nc_move(&m, &b, OutputMode::Joint, "finish", 7)
+                .unwrap()
+                .feed,
+            Feed::Rapid
+        );
     }
 
     #[test]

@@ -82,6 +82,19 @@ pub enum GcodeError {
         /// What was wrong.
         reason: String,
     },
+    /// A cutting block reached the output without a feed (it would be written `F0`).
+    #[error(
+        "operation `{operation}` block {block}: no {what} feed for a cutting move \
+         (give the CL data a FEDRAT or the post a default feed)"
+    )]
+    MissingFeed {
+        /// Operation name.
+        operation: String,
+        /// 0-based block index inside the posted operation.
+        block: usize,
+        /// `inverse-time` or `mm/min`.
+        what: &'static str,
+    },
     /// Post-processing (kinematics) failed on a block.
     #[error("operation `{operation}` move {index}: {reason}")]
     Kinematics {

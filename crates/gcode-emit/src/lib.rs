@@ -11,6 +11,9 @@
 //! - [`NumberFormat`]: fixed decimals, never an exponent, `-0` printed as `0`.
 //! - [`gcode_read`]: a small LinuxCNC G-code reader returning joint blocks, for verification
 //!   by forward kinematics ([`gcode_read::joints_of`]).
+//! - [`readback`]: an emitted program read back through the machine's forward kinematics
+//!   with the controller's interpolation into the cutter locations a simulator sweeps
+//!   ([`read_back`]), every move included.
 //!
 //! Work offsets: joint output ([`OutputMode::Joint`]) writes machine joint values computed
 //! with the machine file's rotary centres and workpiece origin, so the controller's work
@@ -64,6 +67,7 @@ mod error;
 pub mod gcode_read;
 mod number;
 pub mod program;
+pub mod readback;
 pub mod tilted_plane;
 
 pub use apt_cutter::{apt_from_cl_params, apt_to_cl_params};
@@ -82,4 +86,5 @@ pub use program::{
     Feed, LineNumbers, Motion, NcMove, NcOperation, NcProgram, OutputMode, ProgramOptions,
     RotaryWord, ToolCall,
 };
+pub use readback::{read_back, Readback, ReadbackMode, ReadbackOptions};
 pub use tilted_plane::TiltedPlane;

@@ -77,6 +77,9 @@ fn round_trip(path: &Path, tag: &str, opts: &ImportOptions) -> (Imported, Import
 
 #[test]
 fn centrifugal_round_trip() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let opts = ImportOptions::default();
     let (a, b, dev) = round_trip(&import_common::centrifugal_geomturbo(), "cc", &opts);
     let (sa, sb) = (a.impeller.summary(), b.impeller.summary());
@@ -96,6 +99,9 @@ fn rtzt_sample_round_trip() {
 
 #[test]
 fn rotor37_round_trip() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let opts = ImportOptions::default();
     let (_, _, dev) = round_trip(&import_common::rotor37_inf(), "r37", &opts);
     assert!(dev <= opts.fit_tol_mm, "{dev}");

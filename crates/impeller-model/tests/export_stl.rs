@@ -104,6 +104,9 @@ fn whole_impeller_written_atomically() {
 
 #[test]
 fn imported_centrifugal_exports_stl() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let imp = impeller_model::load(import_common::centrifugal_geomturbo()).unwrap();
     let mesh = mesh_parts(&imp, &[Part::Impeller], 0.05).unwrap();
     let r_max = mesh

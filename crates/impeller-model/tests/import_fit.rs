@@ -37,6 +37,9 @@ fn fitted(p: &PreparedImpeller) -> FittedImpeller {
 
 #[test]
 fn rotor37_fits_within_tolerance() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let raw = read_turbogrid(&import_common::rotor37_inf()).unwrap();
     let p = prepare(&raw, None).unwrap();
     let f = fitted(&p);
@@ -45,6 +48,9 @@ fn rotor37_fits_within_tolerance() {
 
 #[test]
 fn centrifugal_fits_within_tolerance() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
     let p = prepare(&raw, None).unwrap();
     let f = fitted(&p);
@@ -66,6 +72,9 @@ fn rtzt_sample_fits() {
 /// within the fit tolerance of its fitted side surface (global closest point).
 #[test]
 fn centrifugal_data_points_lie_on_fitted_sides() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
     let p = prepare(&raw, None).unwrap();
     let f = fit(&p, DEFAULT_FIT_TOL_MM, 0.0).unwrap();

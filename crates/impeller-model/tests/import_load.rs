@@ -15,7 +15,9 @@ fn fixture() -> PathBuf {
 
 #[test]
 fn fixture_autoblade_loads() {
-    import_common::shared_data(); // clear message when the data are missing
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let imp = impeller_model::load(fixture()).unwrap();
     let s = imp.summary();
     assert_eq!(s.name, "impeller-autoblade-12+12");
@@ -25,12 +27,15 @@ fn fixture_autoblade_loads() {
 
 #[test]
 fn exports_load_by_extension() {
-    let imp = impeller_model::load(import_common::rotor37_inf()).unwrap();
-    assert_eq!(imp.summary().main_blade_count, 36);
     let imp = impeller_model::load(import_common::sample("sample-6+6.rtzt")).unwrap();
     assert_eq!(imp.summary().splitter_blade_count, 6);
     let imp = impeller_model::load(import_common::sample("tg-cylindrical/sample.inf")).unwrap();
     assert_eq!(imp.summary().splitter_blade_count, 6);
+    if import_common::skip_without_shared_data() {
+        return;
+    }
+    let imp = impeller_model::load(import_common::rotor37_inf()).unwrap();
+    assert_eq!(imp.summary().main_blade_count, 36);
 }
 
 fn write_tmp(name: &str, text: &str) -> PathBuf {

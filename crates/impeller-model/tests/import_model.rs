@@ -9,6 +9,9 @@ use impeller_model::BladeKind;
 
 #[test]
 fn centrifugal_12_plus_12_imports() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let imp = import_file(
         &import_common::centrifugal_geomturbo(),
         &ImportOptions::default(),
@@ -32,6 +35,9 @@ fn centrifugal_12_plus_12_imports() {
 
 #[test]
 fn rotor37_imports() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let imp = import_file(&import_common::rotor37_inf(), &ImportOptions::default()).unwrap();
     let s = imp.impeller.summary();
     eprintln!("{s:#?}\nfit {:.2e} mm", imp.fitted.max_fit_mm());

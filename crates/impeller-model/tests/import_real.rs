@@ -6,6 +6,9 @@ use impeller_model::import::{read_geomturbo, read_turbogrid, BladeRole, SectionS
 
 #[test]
 fn rotor37_raw_counts_and_units() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let raw = read_turbogrid(&import_common::rotor37_inf()).unwrap();
     assert_eq!(raw.main_blade_count(), 36);
     assert_eq!(raw.splitter_blade_count(), 0);
@@ -27,6 +30,9 @@ fn rotor37_raw_counts_and_units() {
 
 #[test]
 fn centrifugal_raw_counts_and_units() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
     assert_eq!(raw.main_blade_count(), 12);
     assert_eq!(raw.splitter_blade_count(), 12);
@@ -66,6 +72,9 @@ fn z_range(p: &impeller_model::import::PreparedImpeller) -> (f64, f64) {
 
 #[test]
 fn centrifugal_prepared_in_workpiece_frame() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
     let p = prepare(&raw, None).unwrap();
     assert!(p.flipped, "the file's inlet is at low z");
@@ -103,6 +112,9 @@ fn centrifugal_prepared_in_workpiece_frame() {
 /// pressure labels on the centrifugal impeller.
 #[test]
 fn convexity_rule_matches_autogrid_labels() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let raw = read_geomturbo(&import_common::centrifugal_geomturbo()).unwrap();
     let labelled = prepare(&raw, None).unwrap();
     let mut looped: RawImpeller = raw.clone();
@@ -137,6 +149,9 @@ fn convexity_rule_matches_autogrid_labels() {
 
 #[test]
 fn rotor37_prepared() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let raw = read_turbogrid(&import_common::rotor37_inf()).unwrap();
     let p = prepare(&raw, None).unwrap();
     assert!(p.flipped, "rotor 37's inlet is at low z in the file");
@@ -155,6 +170,9 @@ fn rotor37_prepared() {
 /// twist the skinned sides through each other).
 #[test]
 fn side_labels_are_consistent_across_sections() {
+    if import_common::skip_without_shared_data() {
+        return;
+    }
     let sources = [
         read_turbogrid(&import_common::rotor37_inf()).unwrap(),
         read_turbogrid(&import_common::sample("tg-cylindrical/sample.inf")).unwrap(),

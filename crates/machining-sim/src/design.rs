@@ -46,6 +46,17 @@ pub trait DesignModel: Sync {
     fn contains(&self, p: &Point3) -> bool {
         self.signed_distance(p) < 0.0
     }
+    /// Depth (mm) of the inside point `p` below the one design surface through which a cut
+    /// reached it, entering the design at `entry` (a point on that surface). Where walls are
+    /// thin the distance to the nearest boundary (−signed distance) is capped by half the
+    /// wall, while the cut's depth below the face it entered is not; designs made of
+    /// several faces return the signed distance to the face nearest `entry`, negated.
+    /// Default: `−signed_distance(p)` (right for designs whose walls are thicker than any
+    /// overcut).
+    fn depth_below(&self, p: &Point3, entry: &Point3) -> f64 {
+        let _ = entry;
+        -self.signed_distance(p)
+    }
 }
 
 /// Axis-aligned box design.

@@ -17,6 +17,8 @@ pub struct Summary<'a> {
     pub max_residual_mm: f64,
     /// Moves with a collision.
     pub collisions: usize,
+    /// How much `max_overcut_mm` may under-read the true overcut (mm).
+    pub overcut_error_bound_mm: f64,
     /// Where the largest overcut is.
     pub max_overcut: Option<&'a Extremum>,
     /// Where the largest residual is.
@@ -43,6 +45,7 @@ impl Report {
             max_overcut_mm: self.metrics.max_overcut_mm,
             max_residual_mm: self.metrics.max_residual_mm,
             collisions: self.metrics.collisions,
+            overcut_error_bound_mm: self.metrics.overcut_error_bound_mm,
             max_overcut: self.max_overcut.as_ref(),
             max_residual: self.max_residual.as_ref(),
             collision_list: &self.collisions,

@@ -447,6 +447,30 @@ impl DesignModel for ImpellerDesign {
             .min(self.blade_signed_distance(p))
     }
 
+    /// The face nearest to `entry` among the hub, the shroud contour (blade tips) and the
+    /// nearest blade side (found on the side mesh, its foot point the Newton start); the
+    /// depth is `p`'s signed distance to that face alone, negated.
+    fn depth_below(&self, p: &Point3, entry: &Point3) -> f64 {
+        let hub = self.hub_signed_distance(entry).abs();
+        let shroud = self.shroud_sd.signed_distance(entry).abs();
+        let q = PVec::new(entry.x, entry.y, entry.z);
+        let (_, (tri, _)) = self
+            .sides_mesh
+            .project_local_point_and_get_location(q, false);
+        let side = self.tri_info.get(tri as usize).map(|&(bi, side, u, v)| {
+            let blade = &self.blades[bi as usize].1;
+            let d = side_distance(blade, side, entry, (u, v)).abs();
+            (d, blade, side, (u, v))
+        });
+        match side {
+            Some((d, blade, s, hint)) if d <= hub && d <= shroud => {
+                -side_distance(blade, s, p, hint)
+            }
+            _ if hub <= shroud => -self.hub_signed_distance(p),
+            _ => -self.shroud_sd.signed_distance(p),
+        }
+    }
+
     fn surface_grids(&self) -> Vec<SurfaceGrid> {
         let mut out = Vec::new();
         for (name, blade) in &self.blades {

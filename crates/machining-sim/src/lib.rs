@@ -7,9 +7,13 @@
 //! Pipeline: [`TriDexel::from_shape`] samples the blank ([`BoxStock`], [`RevolvedStock`]);
 //! [`simulate()`] sweeps every move's cutter through the stock ([`removal`]) and checks the
 //! non-cutting parts against the stock in process (on the dexels, exact along each ray) and
-//! against the design mesh (parry BVH, [`collision`]); [`measure`] probes the finished stock
-//! along design normals for overcut and residual; [`surface_mesh`] extracts an STL of the
-//! final stock; [`crosscheck`] compares the dexel overcut with cam-core's swept envelopes.
+//! against the design mesh (parry BVH, [`collision`]); [`endpoints`] reads the overcut at
+//! the dexel segment end points (exact ray–cutter intersections: the depth of every cut end
+//! point inside the design, within `Metrics::overcut_error_bound_mm` =
+//! sweep tolerance + ¾·h²/ρ of the truth) and [`measure`] probes the finished stock along
+//! design normals for the residual and for through-cuts where no end point is left;
+//! [`surface_mesh`] extracts an STL of the final stock; [`crosscheck`] compares the dexel
+//! overcut with cam-core's swept envelopes.
 //! [`ImpellerDesign`] makes an `impeller_model::Impeller` a [`DesignModel`].
 //!
 //! Figures (blank of the 77 mm fixture impeller, Ø79 × 44 mm; `examples/removal_100k.rs`,
@@ -48,6 +52,7 @@ pub mod collision;
 pub mod crosscheck;
 pub mod design;
 pub mod dexel;
+pub mod endpoints;
 pub mod error;
 pub mod export;
 pub mod impeller_design;
@@ -63,9 +68,10 @@ pub mod tool_solid;
 pub use crosscheck::{crosscheck_overcut, CrossCheckPoint, Envelopes};
 pub use design::{BoxDesign, CylinderDesign, DesignModel, SurfaceGrid, TriangleMesh, UnionDesign};
 pub use dexel::{DexelGrid, Segments, TriDexel};
+pub use endpoints::{overcut_error_bound, EndpointDepth};
 pub use error::SimError;
 pub use impeller_design::{blank_of, ImpellerDesign, ImpellerSampling};
-pub use measure::{Extremum, SurfaceMap};
+pub use measure::{Extremum, Measured, SurfaceMap};
 pub use motion::Interpolation;
 pub use removal::PartKind;
 pub use simulate::{

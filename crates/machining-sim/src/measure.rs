@@ -1,15 +1,24 @@
-//! Overcut and residual maps: for each design surface sample, the thickness of removed
-//! material inside the design (overcut) or of material left outside it (residual), measured
-//! along the surface normal through the dexels.
+//! Overcut and residual maps over the design surfaces.
 //!
-//! Membership along the normal line `P + t n` uses the grid whose ray direction is most
-//! aligned with `n` (|n_d| ≥ 1/√3): the nearest ray is exact along its direction and the
+//! **Overcut** is read at the dexel segment end points ([`crate::endpoints`]): each cut end
+//! point is an exact ray–cutter intersection, and its signed distance to the design is the
+//! exact depth of the cut there; the remaining error is the bound of
+//! [`crate::endpoints::overcut_error_bound`] (ray spacing against the cutter curvature, plus
+//! the sweep tolerance). Each end point's depth is attributed to the nearest design sample for
+//! the maps. Where no end point lies inside the design — a cut through a thin wall or a whole
+//! blade tip, so a ray lost all its material there — the normal probes below supply the value.
+//!
+//! **Residual** and the through-cut overcut are probed along the design normals through the
+//! dexels. Membership along the normal line `P + t n` uses the grid whose ray direction is
+//! most aligned with `n` (|n_d| ≥ 1/√3): the nearest ray is exact along its direction and the
 //! lateral offset (≤ h/√2) moves a boundary of normal `n` by at most `h/√2 · tan∠(n, e_d)
-//! ≤ h`, so each thickness is accurate to about one cell `h`. The line is marched in steps of
-//! `h/2` and each material transition is refined by bisection to `h/64`.
+//! ≤ h`, so each probed thickness is accurate to about one cell `h`. The line is marched in
+//! steps of `h/2` and each material transition is refined by bisection to `h/64`.
 //!
-//! * overcut at P: if P is empty, the distance along `−n` to the first material, stopping
-//!   when the line leaves the design (cut through a thin wall) or at the probe depth;
+//! * probed overcut at P: if P is empty, the removed depth along `−n` is kept only when the
+//!   line crosses the design (or reaches the probe depth) without meeting material — the
+//!   through-cut case without end points; a line that meets material inside the design has an
+//!   end point there, which is exact and replaces the probe's cell-sized estimate;
 //! * residual at P: if P is in material, the distance along `+n` to the first empty point,
 //!   stopping when the line enters the design again or at the probe depth.
 //!
@@ -19,6 +28,7 @@
 
 use crate::design::{DesignModel, SurfaceGrid};
 use crate::dexel::TriDexel;
+use crate::endpoints::{endpoint_depths, pool_deepest, SampleIndex};
 use cam_core::{Point3, Vector3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -159,10 +169,10 @@ pub fn probe(
                 };
             }
             if kept(-next) {
-                let tt = refine(-t, -next, false, &kept).abs();
-                best = best.max(-sd(-tt));
+                // Material inside the design: a dexel ends there, and the end-point
+                // measurement (exact) replaces this cell-sized estimate.
                 return Probe {
-                    overcut: best,
+                    overcut: 0.0,
                     residual: 0.0,
                 };
             }
@@ -187,7 +197,7 @@ pub fn probe(
 }
 
 /// Measures every sample of every grid (parallel over samples); `initial` is the blank
-/// before machining (removed = material in `initial`, none in `stock`).
+/// before machining (removed = material in `initial`, none in `stock`). See [`measure`].
 pub fn measure_maps(
     stock: &TriDexel,
     initial: &TriDexel,
@@ -195,7 +205,41 @@ pub fn measure_maps(
     grids: &[SurfaceGrid],
     max_depth: f64,
 ) -> Vec<SurfaceMap> {
-    grids
+    measure(stock, initial, design, grids, max_depth).maps
+}
+
+/// Overcut/residual maps plus the deepest cut end point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measured {
+    /// Per-surface maps (probes, with every end point's depth merged into its nearest
+    /// sample).
+    pub maps: Vec<SurfaceMap>,
+    /// The deepest cut end point inside the design, located at the end point itself and
+    /// named after its nearest sample.
+    pub deepest_endpoint: Option<Extremum>,
+    /// Cut end points found inside the design.
+    pub endpoints_inside: usize,
+}
+
+/// Largest distance (mm) from a cut end point to the design sample it is attributed to in
+/// the maps; farther end points still count in the metric and the extremum (named after the
+/// nearest sample found) but colour no sample.
+const ATTRIBUTION_REACH_MM: f64 = 10.0;
+
+/// Hash-cell edge of the sample index (mm).
+const SAMPLE_INDEX_CELL_MM: f64 = 1.0;
+
+/// Overcut at the dexel end points ([`crate::endpoints`]) and the normal probes, residual
+/// by the probes (see module docs). Cost: one design evaluation per cut end point plus
+/// O(depth/h) per sample; parallel.
+pub fn measure(
+    stock: &TriDexel,
+    initial: &TriDexel,
+    design: &dyn DesignModel,
+    grids: &[SurfaceGrid],
+    max_depth: f64,
+) -> Measured {
+    let mut maps: Vec<SurfaceMap> = grids
         .iter()
         .map(|g| {
             let probes: Vec<Option<Probe>> = g
@@ -220,7 +264,47 @@ pub fn measure_maps(
                 residual_mm: probes.iter().map(|p| p.map(|p| p.residual)).collect(),
             }
         })
-        .collect()
+        .collect();
+    let ends = endpoint_depths(stock, initial, design);
+    let endpoints_inside = ends.len();
+    let pooled = pool_deepest(&ends);
+    let mut deepest_endpoint = None;
+    if !pooled.is_empty() {
+        let index = SampleIndex::new(grids, SAMPLE_INDEX_CELL_MM, ATTRIBUTION_REACH_MM);
+        let near: Vec<Option<(usize, usize)>> = pooled
+            .par_iter()
+            .map(|e| index.nearest(grids, &e.point))
+            .collect();
+        for (e, at) in pooled.iter().zip(&near) {
+            let depth = e.depth_mm.min(max_depth);
+            if let Some((gi, k)) = *at {
+                let slot = &mut maps[gi].overcut_mm[k];
+                *slot = Some(slot.unwrap_or(0.0).max(depth));
+            }
+        }
+        // `pooled` is sorted deepest first.
+        let e = &pooled[0];
+        let (surface, i, j) = match near[0] {
+            Some((gi, k)) => {
+                let nu = grids[gi].nu.max(1);
+                (grids[gi].name.clone(), k % nu, k / nu)
+            }
+            None => (String::new(), 0, 0),
+        };
+        deepest_endpoint = Some(Extremum {
+            value_mm: e.depth_mm.min(max_depth),
+            surface,
+            i,
+            j,
+            point: e.point,
+            capped: e.depth_mm >= max_depth,
+        });
+    }
+    Measured {
+        maps,
+        deepest_endpoint,
+        endpoints_inside,
+    }
 }
 
 /// Largest overcut (`residual = false`) or residual over the maps.

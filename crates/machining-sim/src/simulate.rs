@@ -11,8 +11,9 @@
 use crate::collision::{DesignCollider, PartShapes};
 use crate::design::DesignModel;
 use crate::dexel::TriDexel;
+use crate::endpoints::overcut_error_bound;
 use crate::error::SimError;
-use crate::measure::{extremum, measure_maps, Extremum, SurfaceMap};
+use crate::measure::{extremum, measure, Extremum, SurfaceMap};
 use crate::motion::{positions_for_move, Interpolation};
 use crate::removal::{apply_batch, PartKind, Placement, ToolBody};
 use cam_core::{Cutter, MoveKind, ToolPath};
@@ -64,6 +65,10 @@ pub struct Metrics {
     pub max_residual_mm: f64,
     /// Number of moves with at least one collision.
     pub collisions: usize,
+    /// How much `max_overcut_mm` may under-read the true overcut (mm): ray spacing against
+    /// the cutter curvature plus the sweep tolerance
+    /// ([`crate::endpoints::overcut_error_bound`]).
+    pub overcut_error_bound_mm: f64,
 }
 
 /// What a colliding part hit.
@@ -119,6 +124,8 @@ pub struct SimStats {
     pub design_collision_ms: f64,
     /// Wall-clock time of the overcut/residual measurement (ms).
     pub measure_ms: f64,
+    /// Cut dexel end points found inside the design (each an exact overcut reading).
+    pub endpoints_inside_design: usize,
 }
 
 /// Outcome of sweeping the tool paths through the stock.
@@ -387,15 +394,26 @@ pub fn simulate(
         eprintln!("verify: measuring overcut and residual over the design surfaces");
     }
     let grids = design.surface_grids();
-    let maps = measure_maps(stock, &initial, design, &grids, options.probe_depth_mm);
-    let max_overcut = extremum(&maps, false, options.probe_depth_mm);
+    let measured = measure(stock, &initial, design, &grids, options.probe_depth_mm);
+    let maps = measured.maps;
+    let probed = extremum(&maps, false, options.probe_depth_mm);
+    let max_overcut = match (probed, measured.deepest_endpoint) {
+        (Some(p), Some(e)) => Some(if e.value_mm >= p.value_mm { e } else { p }),
+        (p, e) => e.or(p),
+    };
     let max_residual = extremum(&maps, true, options.probe_depth_mm);
     let mut stats = outcome.stats;
     stats.measure_ms = t.elapsed().as_secs_f64() * 1e3;
+    stats.endpoints_inside_design = measured.endpoints_inside;
     let metrics = Metrics {
         max_overcut_mm: max_overcut.as_ref().map_or(0.0, |e| e.value_mm),
         max_residual_mm: max_residual.as_ref().map_or(0.0, |e| e.value_mm),
         collisions: colliding_moves(&outcome.collisions),
+        overcut_error_bound_mm: overcut_error_bound(
+            stats.resolution_mm,
+            stats.sweep_tol_mm,
+            ops.iter().map(|(c, _)| c),
+        ),
     };
     Ok(Report {
         metrics,

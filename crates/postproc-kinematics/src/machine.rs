@@ -269,6 +269,19 @@ impl Machine {
     pub fn safe_z(&self) -> Option<f64> {
         self.safe_z
     }
+    /// The safe retract height (machine Z, mm) a post must use, or an error naming the
+    /// missing machine-file key `safe_z`: a post never invents one (machine Z0 may be the
+    /// table on one machine and the top of travel on another).
+    pub fn require_safe_z(&self) -> Result<f64, crate::PostError> {
+        self.safe_z.ok_or_else(|| crate::PostError::InvalidOption {
+            field: "safe_z",
+            message: format!(
+                "machine `{}` has no `safe_z` (the machine Z to retract to before tool \
+                 changes and reorientations); add it to the machine file",
+                self.name
+            ),
+        })
+    }
     /// Angle (rad) between tool axis and C axis below which the pose counts as singular and
     /// the previous C is held.
     pub fn singularity_tol(&self) -> f64 {

@@ -107,8 +107,69 @@ pub struct ReverseMotionOptions {
     pub max_angle_change: f64,
     /// C increment `ΔC` for the accessibility repair (default 1.5°, paper: 1–2°).
     pub c_step: f64,
-    /// Largest C change of the repair `C_max` (default 10°).
+    /// Largest C change of the repair `C_max` (default 10°). The repair offset counts
+    /// toward `max_angle_change`: a run whose smoothed change plus the offset would exceed
+    /// it is not repaired by that offset.
     pub c_max: f64,
+    /// Height along the tool axis (mm from the tip) of the point a changed posture turns the
+    /// tool about. The ball radius for a ball end (its centre stays, so the ball surface and
+    /// every contact on it stay where the CAM system put them); the middle of the contact
+    /// line for flank contact; 0 turns about the tip. Default 0.
+    #[serde(default)]
+    pub pivot_height_mm: f64,
+    /// Heights (mm from the tip) of the lowest and highest cutter point in contact with the
+    /// part. Turning the axis by δ about the pivot moves a contact point at height h by at
+    /// most `|h − pivot|·δ`; for a ball end with the pivot at its centre give `(r, r)`: the
+    /// ball surface turns onto itself. Default `(0, 0)` (contact at the tip).
+    #[serde(default)]
+    pub contact_heights_mm: (f64, f64),
+    /// Largest movement of the contact allowed by a changed posture (mm, the surface
+    /// deviation bound); a run needing more keeps its original postures. Default
+    /// [`DEFAULT_MAX_CONTACT_SHIFT_MM`].
+    #[serde(default = "default_max_contact_shift")]
+    pub max_contact_shift_mm: f64,
+}
+
+/// Default bound of the contact movement of reverse-motion smoothing (mm): a tenth of the
+/// usual 0.1 mm finishing tolerance of the project's fixtures.
+pub const DEFAULT_MAX_CONTACT_SHIFT_MM: f64 = 0.01;
+
+fn default_max_contact_shift() -> f64 {
+    DEFAULT_MAX_CONTACT_SHIFT_MM
+}
+
+impl ReverseMotionOptions {
+    /// Options keeping the contact of `cutter`: for a ball end (or tapered ball end) in
+    /// point contact the pivot is the ball centre and the contact `(r, r)`; with
+    /// `flank = Some((lo, hi))` (contact heights along the flutes, mm) the pivot is the middle
+    /// of the contact line.
+    pub fn keeping_contact(cutter: &cam_core::Cutter, flank: Option<(f64, f64)>) -> Self {
+        let mut o = Self::default();
+        match (flank, &cutter.shape) {
+            (Some((lo, hi)), _) => {
+                o.pivot_height_mm = 0.5 * (lo + hi);
+                o.contact_heights_mm = (lo, hi);
+            }
+            (None, cam_core::CutterShape::BallEnd { radius }) => {
+                o.pivot_height_mm = *radius;
+                o.contact_heights_mm = (*radius, *radius);
+            }
+            (None, cam_core::CutterShape::TaperedBallEnd { ball_radius, .. }) => {
+                o.pivot_height_mm = *ball_radius;
+                o.contact_heights_mm = (*ball_radius, *ball_radius);
+            }
+            _ => {}
+        }
+        o
+    }
+
+    /// Largest contact movement (mm) when the tool axis turns by `angle` (rad) about the
+    /// pivot.
+    pub fn contact_shift(&self, angle: f64) -> f64 {
+        let (lo, hi) = self.contact_heights_mm;
+        let p = self.pivot_height_mm;
+        (lo - p).abs().max((hi - p).abs()) * angle.abs()
+    }
 }
 
 impl Default for ReverseMotionOptions {
@@ -120,6 +181,9 @@ impl Default for ReverseMotionOptions {
             max_angle_change: 10f64.to_radians(),
             c_step: 1.5f64.to_radians(),
             c_max: 10f64.to_radians(),
+            pivot_height_mm: 0.0,
+            contact_heights_mm: (0.0, 0.0),
+            max_contact_shift_mm: DEFAULT_MAX_CONTACT_SHIFT_MM,
         }
     }
 }
@@ -144,6 +208,19 @@ impl ReverseMotionOptions {
         }
         if !(pos(self.c_step) && self.c_max.is_finite() && self.c_max >= 0.0) {
             return bad("reverse_motion.c_step", "c_step must be > 0 and c_max >= 0");
+        }
+        let (lo, hi) = self.contact_heights_mm;
+        if !(self.pivot_height_mm.is_finite() && lo.is_finite() && hi.is_finite() && lo <= hi) {
+            return bad(
+                "reverse_motion.pivot_height_mm",
+                "pivot and contact heights must be finite, contact low <= high",
+            );
+        }
+        if !(self.max_contact_shift_mm.is_finite() && self.max_contact_shift_mm >= 0.0) {
+            return bad(
+                "reverse_motion.max_contact_shift_mm",
+                "must be finite and >= 0",
+            );
         }
         Ok(())
     }
@@ -224,8 +301,17 @@ pub struct ReverseMotionReport {
     /// Source index of the first inaccessible (or out-of-limits) posture of each run that
     /// could not be repaired (the run was kept unchanged).
     pub inaccessible_blocks: Vec<usize>,
-    /// Largest angle change applied (deg).
+    /// Largest angle change applied (deg), C repair included.
     pub max_angle_change_deg: f64,
+    /// Largest movement of the cutter's contact caused by the changed postures (mm): the
+    /// bound of the surface deviation the smoothing introduces (see
+    /// [`ReverseMotionOptions::contact_shift`]).
+    #[serde(default)]
+    pub max_contact_shift_mm: f64,
+    /// Runs kept because the contact would have moved more than
+    /// `ReverseMotionOptions::max_contact_shift_mm`.
+    #[serde(default)]
+    pub runs_kept_for_contact: usize,
     /// Displacement curves before removal.
     pub before: DisplacementCurves,
     /// Displacement curves after removal.
@@ -698,6 +784,10 @@ pub fn smooth_monotone_windowed(
     })
 }
 
+/// A run placed with one C offset: (offset, joints and cutter location per block, largest
+/// contact movement).
+type PlacedRun = (f64, Vec<(Joints, CutterLocation)>, f64);
+
 /// A shift-and-smooth of one angle sequence (parameters, angles, options).
 type SmoothingStrategy = fn(&[f64], &[f64], &ReverseMotionOptions) -> Option<SmoothedAngles>;
 
@@ -707,13 +797,18 @@ type SmoothingStrategy = fn(&[f64], &[f64], &ReverseMotionOptions) -> Option<Smo
 /// windows cannot be made monotone within `max_angle_change`, over the whole run; both with
 /// the adaptive control-value count of [`smooth_monotone_adaptive`] (the paper's four cubic
 /// B-splines first, refitted with more control values when a run — e.g. a plunge followed by
-/// a sweep — needs it); recompute the
-/// linear axes for the changed postures keeping the tool tips ([`Machine::joints_for_angles`]);
-/// check limits and re-check every changed posture with `checker`; where one fails, turn C of
-/// the whole run by `±k·c_step` (smallest first, up to `c_max`; a constant offset keeps the
-/// run monotone) and re-check. A run that cannot be repaired, or for which no tried fit is
-/// free of reverse motions within `max_angle_change`, keeps its original angles.
-/// Blocks' `cl.axis` becomes the smoothed tool axis.
+/// a sweep — needs it); turn the tool of every changed posture about the point
+/// `pivot_height_mm` up its original axis (the ball centre keeps a ball end's contact; the
+/// middle of the contact line bounds a flank's) and recompute the linear axes
+/// ([`Machine::joints_for_angles`]); refuse a posture whose contact would move more than
+/// `max_contact_shift_mm` ([`ReverseMotionOptions::contact_shift`]); check limits and
+/// re-check every changed posture, and the midpoint of the joint-interpolated motion into and
+/// out of it, with `checker`; where one fails, turn C of the whole run by `±k·c_step`
+/// (smallest first, up to `c_max`, and never beyond `max_angle_change` together with the
+/// smoothing's own change; a constant offset keeps the run monotone) and re-check. A run that
+/// cannot be repaired, or for which no tried fit is free of reverse motions within
+/// `max_angle_change`, keeps its original postures. Blocks' `cl` becomes the turned cutter
+/// location.
 ///
 /// Cost: per run and reversing axis at most `⌈log₂(cap / n0)⌉ + 1` fits of
 /// O(m·n² + max_iterations·m·n) each (see [`smooth_monotone_adaptive`]), plus
@@ -789,14 +884,19 @@ pub fn remove_reverse_motions(
                 .map(|b| (b.joints.tilt, b.joints.rotate))
                 .collect();
             let steps = (opts.c_max / opts.c_step).floor() as usize;
-            let offsets = std::iter::once(0.0).chain((1..=steps).flat_map(|k| {
-                let d = k as f64 * opts.c_step;
-                [d, -d]
-            }));
-            let mut accepted: Option<(f64, Vec<(Joints, CutterLocation)>)> = None;
+            // The C repair counts toward the angle limit.
+            let offsets = std::iter::once(0.0)
+                .chain((1..=steps).flat_map(|k| {
+                    let d = k as f64 * opts.c_step;
+                    [d, -d]
+                }))
+                .filter(|off| run_max_change + off.abs() <= opts.max_angle_change + LIMIT_SLACK);
+            let mut accepted: Option<PlacedRun> = None;
             let mut first_failure: Option<usize> = None;
+            let mut contact_failure = false;
             'offsets: for off in offsets {
-                let mut placed = Vec::with_capacity(run.len());
+                let mut placed: Vec<(Joints, CutterLocation)> = Vec::with_capacity(run.len());
+                let mut shift: f64 = 0.0;
                 for (b, ((tilt, rot), (oj, ocl))) in run.iter().zip(smoothed.iter().zip(&original))
                 {
                     let rot = rot + off;
@@ -804,11 +904,22 @@ pub fn remove_reverse_motions(
                         placed.push((*oj, *ocl));
                         continue;
                     }
-                    let j = machine.joints_for_angles(&b.cl.tip, tool_length, *tilt, rot);
-                    let cl = CutterLocation {
-                        tip: b.cl.tip,
-                        axis: machine.tool_axis(*tilt, rot),
-                    };
+                    // Turn about the pivot: the point `pivot` up the original axis stays.
+                    let axis = machine.tool_axis(*tilt, rot);
+                    let pivot = ocl.tip + ocl.axis.into_inner() * opts.pivot_height_mm;
+                    let tip = pivot - axis.into_inner() * opts.pivot_height_mm;
+                    let angle = ocl.axis.dot(&axis).clamp(-1.0, 1.0).acos();
+                    let s = opts.contact_shift(angle);
+                    if s > opts.max_contact_shift_mm {
+                        contact_failure = true;
+                        if first_failure.is_none() {
+                            first_failure = Some(b.source_index);
+                        }
+                        continue 'offsets;
+                    }
+                    shift = shift.max(s);
+                    let j = machine.joints_for_angles(&tip, tool_length, *tilt, rot);
+                    let cl = CutterLocation { tip, axis };
                     let fits = machine.check_limits(&j, LIMIT_SLACK).is_ok();
                     if !fits || !checker.is_none_or(|c| c.is_accessible(&cl)) {
                         if first_failure.is_none() {
@@ -818,11 +929,29 @@ pub fn remove_reverse_motions(
                     }
                     placed.push((j, cl));
                 }
-                accepted = Some((off, placed));
+                // The motion between postures: the midpoint of every segment touching a
+                // changed posture, as the controller interpolates it (joints linear).
+                if let Some(c) = checker {
+                    for (k, w) in placed.windows(2).enumerate() {
+                        let (a, b) = (&w[0], &w[1]);
+                        if a.0 == original[k].0 && b.0 == original[k + 1].0 {
+                            continue;
+                        }
+                        let mid = machine.forward(&a.0.lerp(&b.0, 0.5), tool_length);
+                        if !c.is_accessible(&mid) {
+                            if first_failure.is_none() {
+                                first_failure = Some(run[k + 1].source_index);
+                            }
+                            continue 'offsets;
+                        }
+                    }
+                }
+                accepted = Some((off, placed, shift));
                 break;
             }
             match accepted {
-                Some((off, placed)) => {
+                Some((off, placed, shift)) => {
+                    rep.max_contact_shift_mm = rep.max_contact_shift_mm.max(shift);
                     for (b, (j, cl)) in run.iter_mut().zip(placed) {
                         b.joints = j;
                         b.cl = cl;
@@ -838,6 +967,9 @@ pub fn remove_reverse_motions(
                     rep.max_angle_change_deg = rep.max_angle_change_deg.max(change.to_degrees());
                 }
                 None => {
+                    if contact_failure {
+                        rep.runs_kept_for_contact += 1;
+                    }
                     rep.inaccessible_blocks.extend(first_failure);
                     ok = false;
                 }

@@ -149,7 +149,12 @@ fn accessibility_recheck_steps_c_or_keeps_run() {
     let m = fixture("xyzac-trt");
     let moves = swing_path(&m);
     let opts = PostOptions {
-        reverse_motion: Some(ReverseMotionOptions::default()),
+        // The smoothing and the C repair together turn C by more than the default 10°
+        // (checked below); 20° lets the repair happen.
+        reverse_motion: Some(ReverseMotionOptions {
+            max_angle_change: 20f64.to_radians(),
+            ..Default::default()
+        }),
         ..Default::default()
     };
     // A checker that forbids turning C back by more than 1° from the CAM posture of the
@@ -187,6 +192,18 @@ fn accessibility_recheck_steps_c_or_keeps_run() {
     for b in posted.blocks.iter().filter(|b| !b.inserted) {
         assert!(checker(&b.cl), "every posted posture passes the checker");
     }
+    let total = rep.max_angle_change_deg;
+    assert!(total > 10.0 && total <= 20.0 + 1e-9, "{total}");
+    // With the default 10° limit the repair would exceed it (smoothing + C offset): the run
+    // keeps its CAM postures instead (the old repair went past the limit).
+    let strict = PostOptions {
+        reverse_motion: Some(ReverseMotionOptions::default()),
+        ..Default::default()
+    };
+    let posted = post_path_checked(&m, &moves, &strict, Some(&checker)).unwrap();
+    let rep = posted.reverse_motion.as_ref().unwrap();
+    assert_eq!((rep.c_repaired_runs, rep.runs_kept), (0, 1), "{rep:?}");
+    assert!(rep.max_angle_change_deg <= 10.0 + 1e-9);
     // A checker that rejects every changed posture: the run keeps its angles.
     let never = |_: &CutterLocation| false;
     let posted = post_path_checked(&m, &moves, &opts, Some(&never)).unwrap();

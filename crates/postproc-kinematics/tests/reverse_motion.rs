@@ -281,3 +281,63 @@ mod props {
         }
     }
 }
+
+/// Smoothing keeps the cutting contact: with a ball end the changed postures turn about the
+/// ball centre (the ball surface turns onto itself: no contact movement), and a flank
+/// contact line that would move beyond the bound keeps its run unchanged.
+#[test]
+fn smoothing_turns_a_ball_end_about_its_centre_and_bounds_flank_contact() {
+    let m = fixture("xyzac-trt");
+    let moves = plunge_and_swing(&m);
+    let r = 3.0;
+    let ball = cam_core::Cutter::new(
+        "b6",
+        cam_core::CutterShape::BallEnd { radius: r },
+        20.0,
+        r,
+        50.0,
+    )
+    .unwrap();
+    let opts = ReverseMotionOptions::keeping_contact(&ball, None);
+    assert_eq!(opts.pivot_height_mm, r);
+    let all_ok = |_: &CutterLocation| true;
+    let checker: &dyn AccessibilityChecker = &all_ok;
+    let post_opts = PostOptions {
+        reverse_motion: Some(opts),
+        ..Default::default()
+    };
+    let posted = post_path_checked(&m, &moves, &post_opts, Some(checker)).unwrap();
+    let rep = posted.reverse_motion.as_ref().unwrap();
+    assert_eq!(rep.runs_changed, 1, "{rep:?}");
+    assert_eq!(rep.max_contact_shift_mm, 0.0);
+    let mut turned = 0;
+    for b in posted.blocks.iter().filter(|b| !b.inserted) {
+        let src = moves[b.source_index].cl;
+        let centre = src.tip + src.axis.into_inner() * r;
+        let now = b.cl.tip + b.cl.axis.into_inner() * r;
+        // The ball centre stays (the old smoothing kept the tip and moved the centre by
+        // r·Δθ).
+        assert!((now - centre).norm() < 1e-9, "block {}", b.source_index);
+        if (b.cl.axis.into_inner() - src.axis.into_inner()).norm() > 1e-6 {
+            turned += 1;
+            assert!((b.cl.tip - src.tip).norm() > 1e-4);
+        }
+        let f = m.forward(&b.joints, 0.0);
+        assert!((f.tip - b.cl.tip).norm() < 1e-9);
+    }
+    assert!(turned > 0);
+
+    // Flank contact along 0..20 mm turning about its middle: a few degrees move the ends of
+    // the contact line by far more than 0.01 mm, so the run keeps its postures.
+    let flank = ReverseMotionOptions::keeping_contact(&ball, Some((0.0, 20.0)));
+    assert_eq!(flank.pivot_height_mm, 10.0);
+    let post_opts = PostOptions {
+        reverse_motion: Some(flank),
+        ..Default::default()
+    };
+    let posted = post_path_checked(&m, &moves, &post_opts, Some(checker)).unwrap();
+    let rep = posted.reverse_motion.as_ref().unwrap();
+    assert_eq!((rep.runs_changed, rep.runs_kept), (0, 1), "{rep:?}");
+    assert_eq!(rep.runs_kept_for_contact, 1, "{rep:?}");
+    assert_eq!(rep.rotate_after, rep.rotate_before);
+}

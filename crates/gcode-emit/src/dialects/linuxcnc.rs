@@ -1,5 +1,10 @@
 //! LinuxCNC (rs274ngc) output.
 //!
+//! - Every program first selects identity kinematics with the configuration's M code
+//!   (`M429` by default, [`LinuxCnc::tcp_off`]): joint values are only the machine's joints
+//!   when the controller is in identity kinematics, and a previous program (or an operator)
+//!   may have left TCP on. A configuration without switchable kinematics maps this M code
+//!   to an empty remap subroutine.
 //! - Joint output ([`OutputMode::Joint`]) for trivial/identity kinematics: X Y Z A/B C are
 //!   the machine's joints, tool length compensation by `G43 H<tool>`, moves that turn a
 //!   rotary axis in inverse time (`G93`, an `F` on every block), back to `G94` after.
@@ -27,7 +32,8 @@ pub struct LinuxCnc {
     /// M code switching the kinematics to tool-centre-point (`M428` in LinuxCNC's
     /// `xyzac-trt` sample configuration).
     pub tcp_on: String,
-    /// M code switching back to identity kinematics (`M429`).
+    /// M code selecting identity kinematics (`M429`): written at the start of every program
+    /// and after each TCP operation.
     pub tcp_off: String,
     /// Program end code (`M2` or `M30`).
     pub program_end: String,
@@ -67,6 +73,8 @@ impl Dialect for LinuxCnc {
             w.raw(&format!("({})", program_name(&program.name)));
         }
         w.block(&format!("G21 G17 G90 G94 G40 G49 G{}", 53 + o.work_offset));
+        // Identity kinematics before any motion (see module docs).
+        w.block(&self.tcp_off);
         let safe = retract_block("G53 G0", "", o, style.linear_fmt)?;
         let mut tool: Option<u32> = None;
         for op in &program.operations {

@@ -120,7 +120,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }),
         linear_decimals: args.decimals,
         angular_decimals: args.decimals,
-        safe_z_machine: args.safe_z.or(machine.safe_z()).unwrap_or(0.0),
+        safe_z_machine: match args.safe_z {
+            Some(z) => z,
+            None => machine
+                .require_safe_z()
+                .map_err(|e| CliError::Message(format!("{}: {e}", args.machine.display())))?,
+        },
         program_number: args.program_number,
         ..ProgramOptions::default()
     };
@@ -225,6 +230,37 @@ mod tests {
         a.out = dir.join("missing-dir/out.nc");
         assert!(run(a).is_err());
         assert!(!e.contains('\n'));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A machine without `safe_z` is refused (the post used to retract to machine Z0).
+    #[test]
+    fn a_machine_without_safe_z_is_an_error_naming_the_key() {
+        let dir = scratch("nosafe");
+        let text = std::fs::read_to_string(
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../fixtures/machines/xyzac-trt.toml"),
+        )
+        .unwrap();
+        let stripped: String = text
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("safe_z"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        assert!(text.contains("safe_z") && !stripped.contains("safe_z"));
+        let machine = dir.join("nosafe.toml");
+        std::fs::write(&machine, stripped).unwrap();
+        let mut a = args(&dir, "linuxcnc", None);
+        a.machine = machine;
+        let out = a.out.clone();
+        let e = run(a).unwrap_err().to_string();
+        assert!(e.contains("`safe_z`") && e.contains("nosafe.toml"), "{e}");
+        assert!(!out.exists(), "no program written");
+        // An explicit --safe-z still works.
+        let mut a = args(&dir, "linuxcnc", None);
+        a.machine = dir.join("nosafe.toml");
+        a.safe_z = Some(150.0);
+        run(a).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -9,23 +9,28 @@
 //! envelopes at the deepest samples).
 //!
 //! A LinuxCNC G-code program can be verified instead of a CL file: `--gcode PROG --machine
-//! MACHINE.toml --cutter SPEC`. Each block's joint values go through the machine's forward
-//! kinematics, and between blocks the joints move linearly (what a controller without TCP
-//! does), so the swept volume follows the real, curved tool motion. `G53` blocks (machine
-//! coordinates) break the path: the next block starts a new segment.
+//! MACHINE.toml --cutter SPEC`. The program is read back with `gcode_emit::read_back`: every
+//! block, rapids included, goes through the machine's forward kinematics with the
+//! controller's interpolation (`--interpolation joint`, the default: the joints move
+//! linearly, what a controller without TCP does; `tcp`: tool tip and angles linear), cut into
+//! chords that follow that motion within 1 µm, so the swept volume is the real, curved tool
+//! motion. An axis moved before it was ever programmed is an error, and so is a `G53` move in
+//! a tool-tip program (its workpiece position is unknown); in joint output `G53` values are
+//! the joints (the work offset is the machine zero). The set-up rapids before the first fully
+//! known position (wherever the machine stood when the program started) are listed, not
+//! simulated.
 
 use crate::error::CliError;
-use cam_core::{Cutter, CutterShape, Move, MoveKind, ToolPath};
+use cam_core::{Cutter, CutterShape, ToolPath};
+use gcode_emit::{read_back, read_gcode_file, ReadbackMode, ReadbackOptions};
 use gcode_emit::{read_cl_file, ClReadOptions};
-use gcode_emit::{read_gcode_file, GcodeMotion};
 use machining_sim::Interpolation;
 use machining_sim::{
     crosscheck_overcut, export::write_json, extract_surface, simulate, write_stl, BoxStock,
     ImpellerDesign, ImpellerSampling, RevolvedStock, SimOptions, StockShape, TriDexel,
 };
-use postproc_kinematics::{AxisId, Joints, Machine};
+use postproc_kinematics::Machine;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 /// Arguments of `impeller-cam verify`.
@@ -58,6 +63,10 @@ pub struct Args {
     /// Stick-out (tip to holder face) of --cutter (mm).
     #[arg(long, default_value_t = 50.0)]
     pub stick_out: f64,
+    /// How the controller interpolates --gcode blocks: `joint` (joints linear) or `tcp`
+    /// (tool tip and rotary angles linear).
+    #[arg(long, default_value = "joint", value_parser = ["joint", "tcp"])]
+    pub interpolation: String,
     /// Tool length, gauge line to tip (mm), for the kinematics of head machines.
     #[arg(long, default_value_t = 0.0)]
     pub tool_length: f64,
@@ -317,7 +326,12 @@ fn parse_cutter(args: &Args, spec: &str) -> Result<Cutter, CliError> {
         .map_err(|e| CliError::Message(format!("--cutter {spec}: {e}")))
 }
 
-/// Operations of a LinuxCNC program through forward kinematics, with joint-linear motion.
+/// Largest deviation (mm) of the read-back chords from the controller's tip path (and,
+/// over the flute length, of the tool axis): far below any dexel cell.
+const READBACK_PATH_TOL_MM: f64 = 0.001;
+
+/// The operation of a G-code program read back through forward kinematics (one tool path
+/// with every move, subdivided to follow the controller's interpolation).
 fn read_gcode_ops(
     args: &Args,
     gcode: &Path,
@@ -330,79 +344,38 @@ fn read_gcode_ops(
     let machine = Machine::from_file(machine_file).map_err(|e| CliError::Message(e.to_string()))?;
     let cutter = parse_cutter(args, cutter_spec)?;
     let blocks = read_gcode_file(gcode).map_err(|e| CliError::Message(e.to_string()))?;
-    let tilt = machine.letter(AxisId::Tilt);
-    let ti = "XYZABC".find(tilt).unwrap_or(3);
-    let mut segments: Vec<Vec<(Joints, MoveKind)>> = vec![Vec::new()];
-    for b in &blocks {
-        if b.machine_coordinates {
-            if segments.last().is_some_and(|s| !s.is_empty()) {
-                segments.push(Vec::new());
-            }
-            continue;
-        }
-        let get = |k: usize| b.axes[k].unwrap_or(0.0);
-        let j = Joints {
-            x: get(0),
-            y: get(1),
-            z: get(2),
-            tilt: get(ti).to_radians(),
-            rotate: get(5).to_radians(),
-        };
-        if !j.is_finite() {
-            return Err(CliError::Message(format!(
-                "{}:{}: axis values are not finite",
-                gcode.display(),
-                b.line
-            )));
-        }
-        let kind = match b.motion {
-            GcodeMotion::Rapid => MoveKind::Rapid,
-            GcodeMotion::Linear => MoveKind::Feed,
-        };
-        if let Some(seg) = segments.last_mut() {
-            seg.push((j, kind));
-        }
+    let options = ReadbackOptions {
+        mode: if args.interpolation == "tcp" {
+            ReadbackMode::TcpAngles
+        } else {
+            ReadbackMode::Joint
+        },
+        tool_length_mm: args.tool_length,
+        path_tol_mm: READBACK_PATH_TOL_MM,
+        reach_mm: cutter.flute_length,
+    };
+    let file = gcode.display().to_string();
+    let rb = read_back(&blocks, &machine, &options, &file, "gcode", &cutter.name)
+        .map_err(|e| CliError::Message(e.to_string()))?;
+    if !rb.unplaced_start_lines.is_empty() {
+        eprintln!(
+            "verify: {file}: lines {:?}: set-up rapids before the first fully programmed \
+             position (machine position unknown) are not simulated",
+            rb.unplaced_start_lines
+        );
     }
-    segments.retain(|s| !s.is_empty());
-    if segments.is_empty() {
-        return Err(CliError::Message(format!(
-            "{}: no motion blocks in workpiece coordinates",
-            gcode.display()
-        )));
+    if rb.path.moves.is_empty() {
+        return Err(CliError::Message(format!("{file}: no motion blocks")));
     }
-    let tool_length = args.tool_length;
-    let mut ops = Vec::new();
-    let mut joints: Vec<Vec<Joints>> = Vec::new();
-    for (k, seg) in segments.iter().enumerate() {
-        let mut path = ToolPath::new(format!("gcode_segment_{k}"), cutter.name.clone());
-        for (j, kind) in seg {
-            path.moves.push(Move {
-                kind: *kind,
-                cl: machine.forward(j, tool_length),
-                feed_mm_per_min: None,
-            });
-        }
-        ops.push((cutter.clone(), path));
-        joints.push(seg.iter().map(|(j, _)| *j).collect());
-    }
-    let machine = Arc::new(machine);
-    let joints = Arc::new(joints);
-    let interp = Interpolation::Custom(Arc::new(move |op, index, from, to, s| {
-        match joints
-            .get(op)
-            .and_then(|js| Some((js.get(index.wrapping_sub(1))?, js.get(index)?)))
-        {
-            Some((a, b)) => machine.forward(&a.lerp(b, s), tool_length),
-            None => Interpolation::Tcp.at(op, index, from, to, s),
-        }
-    }));
-    Ok((ops, interp))
+    Ok((vec![(cutter, rb.path)], Interpolation::Tcp))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use cam_core::MoveKind;
     use clap::Parser;
+    use postproc_kinematics::Joints;
 
     #[derive(Debug, Parser)]
     struct Cli {
@@ -464,11 +437,19 @@ mod tests {
             "ball:2",
         ]);
         let (ops, interp) = read_gcode_ops(&a, &prog).unwrap();
-        assert_eq!(ops.len(), 1, "the G53 block only starts the path");
+        assert!(matches!(interp, Interpolation::Tcp));
+        assert_eq!(ops.len(), 1);
         let path = &ops[0].1;
-        assert_eq!(path.moves.len(), 3);
+        // The G53 retract comes before X/Y are known: a set-up move, not placed.
         assert_eq!(path.moves[0].kind, MoveKind::Rapid);
         let m = Machine::from_file(machine).unwrap();
+        let j0 = Joints {
+            x: 10.0,
+            y: 0.0,
+            z: 60.0,
+            tilt: 0.0,
+            rotate: 0.0,
+        };
         let j1 = Joints {
             x: 12.0,
             y: 1.0,
@@ -483,13 +464,31 @@ mod tests {
             tilt: 30f64.to_radians(),
             rotate: 90f64.to_radians(),
         };
-        let want = m.forward(&j1, 0.0);
-        assert!((path.moves[1].cl.tip - want.tip).norm() < 1e-9);
-        // Halfway through the last move: the forward kinematics of the mid joints.
-        let mid = interp.at(0, 2, &path.moves[1].cl, &path.moves[2].cl, 0.5);
-        let want = m.forward(&j1.lerp(&j2, 0.5), 0.0);
-        assert!((mid.tip - want.tip).norm() < 1e-9);
-        assert!((mid.axis.into_inner() - want.axis.into_inner()).norm() < 1e-12);
+        assert!((path.moves[0].cl.tip - m.forward(&j0, 0.0).tip).norm() < 1e-9);
+        let last = path.moves.last().unwrap().cl;
+        assert!((last.tip - m.forward(&j2, 0.0).tip).norm() < 1e-9);
+        // Every point of the joint-interpolated last block lies within the read-back
+        // tolerance of the chords the simulator sweeps.
+        let tips: Vec<_> = path.moves.iter().map(|mv| mv.cl.tip.coords).collect();
+        for k in 0..=200 {
+            let t = m.forward(&j1.lerp(&j2, k as f64 / 200.0), 0.0).tip.coords;
+            let d = tips
+                .windows(2)
+                .map(|w| {
+                    let ab = w[1] - w[0];
+                    let s = ((t - w[0]).dot(&ab) / ab.norm_squared().max(1e-300)).clamp(0.0, 1.0);
+                    (t - (w[0] + ab * s)).norm()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(d <= READBACK_PATH_TOL_MM + 1e-9, "{d}");
+        }
+        // A feed move with C never programmed is an error naming the line and the axis.
+        std::fs::write(&prog, "G0 X1 Y2 Z60 A0\nG1 X3 F500\n").unwrap();
+        let e = read_gcode_ops(&a, &prog)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains(":2:") && e.contains("axis C"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
