@@ -8,6 +8,7 @@
 
 pub(crate) mod bezier;
 mod curve;
+mod curve_cert;
 pub(crate) mod decompose;
 mod newton;
 mod surface;
