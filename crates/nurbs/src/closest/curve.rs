@@ -139,7 +139,8 @@ fn certified<const D: usize>(
     lo > 0.0
 }
 
-/// Deepest query-time subdivision of an uncertified piece (1/256 of it).
+/// Deepest query-time subdivision of an uncertified piece (the piece is depth 1, so the
+/// finest pieces are 2⁻⁷ = 1/128 of it).
 const MAX_BB_DEPTH: usize = 8;
 
 /// Precomputed closest-point query structure for one curve. See the module docs.

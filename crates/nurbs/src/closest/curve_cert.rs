@@ -53,6 +53,10 @@ pub(crate) const MAX_SPLIT_DEPTH: usize = 40;
 /// interval (|N| ≤ 1e-13 × |S'|-scale: round-off of the products).
 const FLAT_REL: f64 = 1e-13;
 
+/// Root of `N` to this fraction of the interval: 1e-14 of a 100 mm piece is 1e-12 mm along
+/// the curve, and the distance, stationary there, changes by its square.
+const ROOT_TOL: f64 = 1e-14;
+
 /// Bracketed root iterations on `N` (each halves the bracket at least once per two steps).
 const ROOT_ITER: usize = 80;
 
@@ -334,7 +338,7 @@ fn root(n: &Poly) -> Option<f64> {
         if !(next > lo && next < hi) {
             next = 0.5 * (lo + hi);
         }
-        if (next - t).abs() <= 1e-16 || hi - lo <= 1e-16 {
+        if (next - t).abs() <= ROOT_TOL || hi - lo <= ROOT_TOL {
             return Some(next);
         }
         t = next;
