@@ -26,7 +26,10 @@
 //!   `S` and `W` and each half is searched.
 //!
 //! Every interval is first pruned by the lower bound `min_k S_k / (max_k W_k)²` of the squared
-//! distance (convex hull of the Bernstein coefficients) against the best distance found. An
+//! distance (convex hull of the Bernstein coefficients) against the best distance found, and
+//! settled by its nearer end when `max_k S_k / (min_k W_k)²` shows its distances span less
+//! than [`CERT_TOL`] = 1e-10 mm: the answer is certified to be within 1e-10 mm of the global
+//! minimum distance. An
 //! identically zero `N` (the query at the centre of a circular arc) makes every point of the
 //! interval a closest point. An interval still ambiguous at [`MAX_SPLIT_DEPTH`] halvings
 //! (width 2⁻⁴⁰ of the piece: roots closer than that, i.e. a tangential double root within
@@ -56,6 +59,13 @@ const FLAT_REL: f64 = 1e-13;
 /// Root of `N` to this fraction of the interval: 1e-14 of a 100 mm piece is 1e-12 mm along
 /// the curve, and the distance, stationary there, changes by its square.
 const ROOT_TOL: f64 = 1e-14;
+
+/// Distance tolerance of the certificate, mm: an interval is dropped when nothing in it can
+/// be nearer than the best found by more than this, and settled by its nearer end when its
+/// distances span less than this (this bounds the search near a centre of curvature, where
+/// the distance is almost constant over a whole piece). Far below any machining tolerance
+/// and above the round-off of the Bernstein products on parts of a few hundred mm.
+pub(crate) const CERT_TOL: f64 = 1e-10;
 
 /// Bracketed root iterations on `N` (each halves the bracket at least once per two steps).
 const ROOT_ITER: usize = 80;
@@ -231,9 +241,10 @@ fn isolate(
     piece: usize,
     best: &mut Best,
 ) {
-    let wmax = w.max();
+    let (wmin, wmax) = (w.min(), w.max());
     let lb = s.min().max(0.0) / (wmax * wmax);
-    if lb >= best.d2 {
+    // Nothing here can be nearer than the best by more than the tolerance.
+    if lb.sqrt() >= best.d2.sqrt() - CERT_TOL {
         return;
     }
     let consider = |t: f64, d2: f64, cert: bool, best: &mut Best| {
@@ -250,6 +261,13 @@ fn isolate(
     };
     let end0 = s.c[0] / (w.c[0] * w.c[0]);
     let end1 = s.c[s.deg] / (w.c[w.deg] * w.c[w.deg]);
+    // Every point of the interval is within the tolerance of the nearer end: done.
+    let ub = s.max() / (wmin * wmin);
+    if ub.sqrt() - lb.sqrt() <= CERT_TOL {
+        let (t, d2) = if end0 <= end1 { (a, end0) } else { (b, end1) };
+        consider(t, d2, true, best);
+        return;
+    }
     let (nmin, nmax) = (n.min(), n.max());
     if nmax.abs().max(nmin.abs()) <= flat {
         // Constant distance on the interval.
