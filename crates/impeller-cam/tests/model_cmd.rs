@@ -55,3 +55,43 @@ fn user_errors_exit_1_with_one_line() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--fit-tol` sets the import fit tolerance: a tolerance below what the sample's data allow
+/// is a one-line error naming the section, data point and distance; the default succeeds; a
+/// parametric impeller refuses the option.
+#[test]
+fn fit_tol_option() {
+    let sample = format!(
+        "{}/../impeller-model/tests/data/tg-cylindrical/sample.inf",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let ok = cli()
+        .args(["model", &sample, "--json", "--fit-tol", "0.01"])
+        .output()
+        .unwrap();
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let tight = cli()
+        .args(["model", &sample, "--json", "--fit-tol", "1e-9"])
+        .output()
+        .unwrap();
+    assert_eq!(tight.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&tight.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("data point") && err.contains("misses it by") && err.contains("1.000e-9"),
+        "{err}"
+    );
+    let param = format!(
+        "{}/../../fixtures/impeller-8+8/impeller.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = cli()
+        .args(["model", &param, "--fit-tol", "0.01"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}

@@ -32,6 +32,28 @@ fn queries(c: &mut Criterion) {
             black_box(blade_side_distance(blade, Side::Suction, &pts[i].0, None))
         })
     });
+    // A path of queries 1 mm off the side, 0.2 % of u apart: each warm-starts from the
+    // previous answer (the way an operation walks a tool path).
+    let path: Vec<Vector3<f64>> = (0..400)
+        .map(|k| {
+            let (u, v) = (0.1 + 0.002 * k as f64, 0.4 + 0.0005 * k as f64);
+            let n = blade.outward_normal(Side::Suction, u, v).unwrap();
+            blade.suction().point(u, v) + n
+        })
+        .collect();
+    let mut prev: Option<(f64, f64)> = None;
+    let mut j = 0;
+    c.bench_function("blade_side_signed_distance_warm", |b| {
+        b.iter(|| {
+            j = (j + 1) % path.len();
+            if j == 0 {
+                prev = None;
+            }
+            let (sp, d) = blade_side_distance(blade, Side::Suction, &path[j], prev);
+            prev = Some((sp.u, sp.v));
+            black_box(d)
+        })
+    });
     c.bench_function("blade_side_closest_point_local_hint", |b| {
         b.iter(|| {
             i = (i + 1) % pts.len();
@@ -42,6 +64,12 @@ fn queries(c: &mut Criterion) {
         b.iter(|| {
             i = (i + 1) % pts.len();
             black_box(imp.hub().signed_distance(&pts[i].0))
+        })
+    });
+    c.bench_function("shroud_signed_distance", |b| {
+        b.iter(|| {
+            i = (i + 1) % pts.len();
+            black_box(imp.shroud().signed_distance(&pts[i].0))
         })
     });
     let mut g = c.benchmark_group("model");

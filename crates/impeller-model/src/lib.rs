@@ -62,6 +62,16 @@ use std::path::Path;
 /// set), `.geomTurbo` (AutoGrid) and `.rtzt` (BladeGen, mm) exports are imported with
 /// [`import::ImportOptions::default`].
 pub fn load(path: impl AsRef<Path>) -> Result<Impeller, ModelError> {
+    load_with_fit_tol(path, None)
+}
+
+/// [`load`] with the import fit tolerance (mm) set to `fit_tol_mm` when given: it replaces
+/// the default of export files and the `fit_tol_mm` of import `.toml` files. A parametric
+/// impeller file is not fitted, so a tolerance given for one is an error (never ignored).
+pub fn load_with_fit_tol(
+    path: impl AsRef<Path>,
+    fit_tol_mm: Option<f64>,
+) -> Result<Impeller, ModelError> {
     let path = path.as_ref();
     let ext = path
         .extension()
@@ -74,12 +84,28 @@ pub fn load(path: impl AsRef<Path>) -> Result<Impeller, ModelError> {
                 source,
             })?;
             if import::is_import_toml(&text) {
-                return Ok(import::from_import_toml(&text, path)?.impeller);
+                return Ok(import::from_import_toml_with(&text, path, fit_tol_mm)?.impeller);
+            }
+            if let Some(t) = fit_tol_mm {
+                return Err(import::ImportError::Invalid {
+                    file: path.to_path_buf(),
+                    line: 0,
+                    field: "fit tolerance".into(),
+                    reason: format!(
+                        "{t} mm given, but a parametric impeller file is built exactly, not \
+                         fitted to data"
+                    ),
+                }
+                .into());
             }
             from_toml_str(&text, path)
         }
         Some("inf" | "geomturbo" | "rtzt") => {
-            Ok(import::import_file(path, &import::ImportOptions::default())?.impeller)
+            let mut opts = import::ImportOptions::default();
+            if let Some(t) = fit_tol_mm {
+                opts.fit_tol_mm = t;
+            }
+            Ok(import::import_file(path, &opts)?.impeller)
         }
         _ => Err(ModelError::UnsupportedFormat {
             path: path.to_path_buf(),

@@ -180,16 +180,23 @@ impl MeridionalCurve {
     }
 
     /// Closest point of the contour to `zr`: (parameter, signed distance along the
-    /// channel-side normal). Global, by the `nurbs` crate's `CurveProjector` (Bézier pieces in
-    /// a bounding tree, Newton per candidate piece, end points included).
+    /// channel-side normal). Global and certified, by the `nurbs` crate's `CurveProjector`
+    /// (Bézier segments in a bounding-volume tree, each candidate segment searched by
+    /// Bernstein root isolation of the distance's derivative, rational segments included).
     pub fn closest(&self, zr: Vector2<f64>) -> (f64, f64) {
+        let (t, d, _) = self.closest_point(zr);
+        (t, d)
+    }
+
+    /// [`Self::closest`] with the certificate: (parameter, signed distance, proven global).
+    pub fn closest_point(&self, zr: Vector2<f64>) -> (f64, f64, bool) {
         let cp = self.projector.closest_point(&zr);
         let sign = if (zr - cp.point).dot(&self.normal(cp.u)) >= 0.0 {
             1.0
         } else {
             -1.0
         };
-        (cp.u, sign * cp.distance)
+        (cp.u, sign * cp.distance, cp.certified)
     }
 
     /// (z, r) of a 3-D point.

@@ -124,6 +124,84 @@ pub fn blade_side_distance(
     (sp, sign * sp.distance)
 }
 
+/// One side of a blade as a [`nurbs::closest::PointQuery`]: hint `(u, v)` (the previous
+/// answer), distance positive outside the blade material (along the side's outward
+/// normal), as [`blade_side_distance`].
+///
+/// ```
+/// use impeller_model::{fixtures, query::BladeSideQuery, Side};
+/// use nurbs::closest::PointQuery;
+/// let imp = fixtures::default_impeller().unwrap();
+/// let blade = imp.main().blade();
+/// let q = BladeSideQuery { blade, side: Side::Suction };
+/// let n = blade.outward_normal(Side::Suction, 0.5, 0.5).unwrap();
+/// let p = blade.suction().point(0.5, 0.5) + n * 0.25;
+/// let a = q.query(&p, None);
+/// assert!((a.signed_distance - 0.25).abs() < 1e-6);
+/// let warm = q.query(&(p + n * 0.01), Some(a.hint));
+/// assert!((warm.signed_distance - 0.26).abs() < 1e-6);
+/// ```
+#[derive(Debug, Clone, Copy)]
+pub struct BladeSideQuery<'a> {
+    /// The blade (reference copy).
+    pub blade: &'a Blade,
+    /// Which side.
+    pub side: Side,
+}
+
+impl nurbs::closest::PointQuery for BladeSideQuery<'_> {
+    type Hint = (f64, f64);
+
+    fn query(
+        &self,
+        q: &Vector3<f64>,
+        hint: Option<(f64, f64)>,
+    ) -> nurbs::closest::PointProjection<(f64, f64)> {
+        let (sp, d) = blade_side_distance(self.blade, self.side, q, hint);
+        nurbs::closest::PointProjection {
+            point: sp.point,
+            signed_distance: d,
+            hint: (sp.u, sp.v),
+            certified: !self.blade.side(self.side).is_rational() && d.is_finite(),
+        }
+    }
+}
+
+/// Hub or shroud as a [`nurbs::closest::PointQuery`] (no hint: the query is a certified
+/// search on the meridional contour): distance positive on the channel side of the hub and
+/// outside the shroud, as [`crate::RevolvedSurface::signed_distance`].
+///
+/// ```
+/// use impeller_model::fixtures;
+/// use nalgebra::Vector3;
+/// use nurbs::closest::PointQuery;
+/// let imp = fixtures::default_impeller().unwrap();
+/// let hub = imp.hub();
+/// let (t, phi) = (0.5, 0.3);
+/// let p = hub.point(t, phi) + hub.normal(t, phi) * 1.5;
+/// let a = hub.query(&p, None);
+/// assert!((a.signed_distance - 1.5).abs() < 1e-9 && a.certified);
+/// ```
+impl nurbs::closest::PointQuery for crate::RevolvedSurface {
+    type Hint = ();
+
+    fn query(&self, q: &Vector3<f64>, _hint: Option<()>) -> nurbs::closest::PointProjection<()> {
+        let phi = q.y.atan2(q.x);
+        let zr = nalgebra::Vector2::new(q.z, q.x.hypot(q.y));
+        let c = self.meridional().closest_point(zr);
+        nurbs::closest::PointProjection {
+            point: self.point(c.0, phi),
+            signed_distance: c.1,
+            hint: (),
+            certified: c.2,
+        }
+    }
+
+    fn signed_distance(&self, q: &Vector3<f64>) -> f64 {
+        crate::RevolvedSurface::signed_distance(self, q)
+    }
+}
+
 /// Which surface of the impeller a query refers to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Part {

@@ -1,4 +1,4 @@
-//! `impeller-cam model [IMPELLER] [--json] [--stl FILE] [--curves DIR]`: build an impeller,
+//! `impeller-cam model [IMPELLER] [--json] [--fit-tol MM] [--stl FILE] [--curves DIR]`: build an impeller,
 //! print its measured summary, and optionally export it as a binary STL (hub and blades,
 //! within `--chord-tol`) and as TurboGrid curve files (`impeller.inf`, hub, shroud and
 //! profile curves, which `model` reads back).
@@ -22,6 +22,11 @@ pub struct Args {
     /// Largest distance between the STL triangles and the exact surfaces (mm).
     #[arg(long, value_name = "MM", default_value_t = 0.01)]
     pub chord_tol: f64,
+    /// Fit tolerance of an imported export (mm): the largest deviation of the fitted hub,
+    /// shroud and blade sides from the file's points. Overrides an import file's
+    /// `fit_tol_mm`; default 0.01 mm. Not accepted for a parametric impeller (not fitted).
+    #[arg(long, value_name = "MM")]
+    pub fit_tol: Option<f64>,
     /// Write TurboGrid curve files (impeller.inf, hub.curve, shroud.curve, profiles) into DIR.
     #[arg(long, value_name = "DIR")]
     pub curves: Option<PathBuf>,
@@ -30,7 +35,14 @@ pub struct Args {
 /// Loads the impeller, measures it and prints the summary.
 pub fn run(args: Args) -> Result<(), CliError> {
     let imp = match &args.impeller {
-        Some(path) => impeller_model::load(path),
+        Some(path) => impeller_model::load_with_fit_tol(path, args.fit_tol),
+        None if args.fit_tol.is_some() => {
+            return Err(CliError::Message(
+                "--fit-tol applies to an imported export; the embedded default impeller is \
+                 parametric"
+                    .into(),
+            ))
+        }
         None => impeller_model::fixtures::default_impeller(),
     }
     .map_err(|e| CliError::Message(e.to_string()))?;

@@ -173,33 +173,77 @@ pub fn assemble(fitted: &FittedImpeller, opts: &ImportOptions) -> Result<Impelle
 }
 
 /// Fails when a fitted curve or surface misses its data by more than the tolerance, naming
-/// the entity and the deviation reached.
+/// the entity, the section and data point farthest from it, and its distance.
 pub fn check_tolerance(fitted: &FittedImpeller) -> Result<(), ImportError> {
     let mut entities = vec![
-        ("hub".to_string(), fitted.hub_fit_mm),
-        ("shroud".to_string(), fitted.shroud_fit_mm),
+        ("hub".to_string(), fitted.hub_fit_mm, fitted.hub_miss, false),
+        (
+            "shroud".to_string(),
+            fitted.shroud_fit_mm,
+            fitted.shroud_miss,
+            false,
+        ),
     ];
     for b in &fitted.blades {
         entities.push((
             format!("blade {:?} pressure side", b.name),
             b.pressure_fit_mm,
+            b.pressure_miss,
+            true,
         ));
-        entities.push((format!("blade {:?} suction side", b.name), b.suction_fit_mm));
+        entities.push((
+            format!("blade {:?} suction side", b.name),
+            b.suction_fit_mm,
+            b.suction_miss,
+            true,
+        ));
     }
     match entities
         .into_iter()
-        .find(|(_, e)| e.is_nan() || *e > fitted.tol_mm)
+        .find(|(_, d, _, _)| d.is_nan() || *d > fitted.tol_mm)
     {
-        Some((entity, e)) => Err(ImportError::Geometry {
-            file: fitted.source.clone(),
-            entity,
-            reason: format!(
-                "the closest fit misses the data by {e:.4} mm, more than the tolerance {} mm \
-                 (an outlier or a kink in the data; a larger fit tolerance accepts it)",
-                fitted.tol_mm
-            ),
-        }),
+        Some((entity, d, m, blade)) => {
+            let p = m.at_mm;
+            let place = if blade {
+                format!(
+                    "section {} (from the hub), data point {} (from the leading edge) at \
+                     ({:.4}, {:.4}, {:.4}) mm",
+                    m.section + 1,
+                    m.point + 1,
+                    p.x,
+                    p.y,
+                    p.z
+                )
+            } else {
+                format!(
+                    "data point {} (from the inlet) at z = {:.4} mm, r = {:.4} mm",
+                    m.point + 1,
+                    p.z,
+                    p.y
+                )
+            };
+            Err(ImportError::Geometry {
+                file: fitted.source.clone(),
+                entity,
+                reason: format!(
+                    "{place}: the closest fit misses it by {} mm, more than the fit \
+                     tolerance {} mm (an outlier or data too sparse for a knot there; a \
+                     larger tolerance — `--fit-tol`, `fit_tol_mm` — accepts it)",
+                    short_mm(d),
+                    short_mm(fitted.tol_mm)
+                ),
+            })
+        }
         None => Ok(()),
+    }
+}
+
+/// A length for a message: 4 decimals from 1 µm up, else 3 significant digits.
+fn short_mm(x: f64) -> String {
+    if x.abs() >= 1e-3 {
+        format!("{x:.4}")
+    } else {
+        format!("{x:.3e}")
     }
 }
 

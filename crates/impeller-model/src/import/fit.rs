@@ -2,20 +2,19 @@
 //! non-rational B-splines fitted within a stated tolerance.
 //!
 //! - **Hub and shroud**: the meridional (z, r) points are approximated by a cubic B-spline
-//!   with fixed end points and the fewest control points whose deviation at the data
-//!   parameters is within `tol` (`nurbs::fit::approximate_curve_to_tolerance`, NURBS Book
-//!   §9.4.1, chord-length parameters).
-//! - **Blade sides**: all sections of one side are fitted *compatibly* — chord-length
-//!   parameters per section, or, when all sections have the same number of points, their
-//!   average (points of equal index then lie on one iso-parametric line across the span, as
-//!   AutoGrid's ruled sides intend) — one clamped cubic
-//!   knot vector shared by every section, knots at quantiles of the merged chord-length
-//!   parameters of all sections (the idea of eq. 9.69: every span holds data), least squares
-//!   with fixed leading- and trailing-edge points (§9.4.1, eqs. 9.63–9.67) solved by SVD —
-//!   with the control count doubled and then bisected until every section is within `tol`
-//!   (at most the point count of the smallest section, where the fit interpolates: sparse or
-//!   noisy data then are followed exactly, wiggles included; if every larger system is
-//!   singular the closest fit is returned and [`super::build::check_tolerance`] rejects it).
+//!   with fixed end points, chord-length parameters, knots inserted where the fit misses the
+//!   data (`nurbs::fit::approximate_compatible`, NURBS Book §9.4.1–9.4.2).
+//! - **Blade sides**: all sections of one side are fitted *compatibly* by the same function:
+//!   one clamped cubic knot vector shared by every section; chord-length parameters per
+//!   section, or their average per index when all sections have the same point count (points
+//!   of equal index then lie on one iso-parametric line across the span, as AutoGrid's ruled
+//!   sides intend); least squares with fixed leading- and trailing-edge points
+//!   (eqs. 9.63–9.67); knots inserted at the median data parameter of every span that misses
+//!   the tolerance, so a finely sampled leading edge gets knots where it needs them; data
+//!   corners (tangent turning by more than `nurbs::fit::DEFAULT_KINK_ANGLE` = 45°) kept as
+//!   knots of full multiplicity, aligned across sections. A fit that cannot meet the
+//!   tolerance (a span too sparse to split) is still returned with its worst data point
+//!   ([`DataMiss`]) and [`super::build::check_tolerance`] rejects it naming that point.
 //!   The compatible section curves are then skinned (§10.3): the control points of each
 //!   index are interpolated across the sections at averaged chord-length parameters v̄_k
 //!   with knots by averaging (eq. 9.8), degree min(3, sections − 1). The surface reproduces
@@ -23,23 +22,49 @@
 //!   section fit's (reported per side). u runs from leading to trailing edge, v from hub
 //!   to shroud.
 //!
-//! Cost: O(m·n²) per least-squares solve (m data points, n control points), O(log m) solves
-//! per side; skinning O(K³ + n·K) for K sections.
+//! Cost: O(m·n²) per least-squares solve (m data points, n control points), O(log n) rounds
+//! of refinement per side; skinning O(K³ + n·K) for K sections.
 
 use super::error::ImportError;
 use super::prepare::PreparedImpeller;
 use super::raw::{positive, BladeRole};
 use nalgebra::{DMatrix, Vector2, Vector3};
-use nurbs::fit::{approximate_curve_to_tolerance, averaged_knots, Parametrisation};
-use nurbs::{Curve2, KnotVector, NurbsCurve, NurbsSurface};
+use nurbs::fit::{approximate_compatible, averaged_knots, FitMiss, DEFAULT_KINK_ANGLE};
+use nurbs::{Curve2, KnotVector, NurbsSurface};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
 /// Default fit tolerance, mm.
 pub const DEFAULT_FIT_TOL_MM: f64 = 0.01;
 
-/// A shared knot vector, each section's control points, and the largest deviation (mm).
-type CompatibleFit = (KnotVector, Vec<Vec<Vector3<f64>>>, f64);
+/// A shared knot vector, each section's control points, and the worst data point.
+type CompatibleFit = (KnotVector, Vec<Vec<Vector3<f64>>>, DataMiss);
+
+/// The data point that lies farthest from its fitted curve or surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DataMiss {
+    /// Section index, 0-based from the hub (0 for hub and shroud contours).
+    pub section: usize,
+    /// Point index within the section, 0-based from the leading edge (contours: from the
+    /// inlet end).
+    pub point: usize,
+    /// The point, mm, workpiece frame (contours: (0, r, z), the meridional plane y–z).
+    pub at_mm: Vector3<f64>,
+    /// Its distance from the fit at its parameter, mm (an upper bound of its distance from
+    /// the curve or surface).
+    pub distance_mm: f64,
+}
+
+impl DataMiss {
+    fn new(m: FitMiss, at: impl Fn(usize, usize) -> Vector3<f64>) -> Self {
+        Self {
+            section: m.section,
+            point: m.point,
+            at_mm: at(m.section, m.point),
+            distance_mm: m.distance,
+        }
+    }
+}
 
 /// Degree of fitted curves along the flow and along the meridian.
 const DEGREE: usize = 3;
@@ -63,6 +88,10 @@ pub struct FittedBlade {
     pub pressure_fit_mm: f64,
     /// Largest deviation of the suction-side data from the surface, mm.
     pub suction_fit_mm: f64,
+    /// The pressure-side data point farthest from the surface.
+    pub pressure_miss: DataMiss,
+    /// The suction-side data point farthest from the surface.
+    pub suction_miss: DataMiss,
 }
 
 /// An export turned into exact geometry in the workpiece frame.
@@ -80,6 +109,10 @@ pub struct FittedImpeller {
     pub hub_fit_mm: f64,
     /// Largest shroud data deviation, mm.
     pub shroud_fit_mm: f64,
+    /// The hub data point farthest from its curve.
+    pub hub_miss: DataMiss,
+    /// The shroud data point farthest from its curve.
+    pub shroud_miss: DataMiss,
     /// The tolerance asked for, mm.
     pub tol_mm: f64,
 }
@@ -95,182 +128,14 @@ impl FittedImpeller {
     }
 }
 
-/// Chord-length parameters on [0, 1] (points must be distinct consecutively).
-fn chord_params(points: &[Vector3<f64>]) -> Option<Vec<f64>> {
-    let mut acc = vec![0.0; points.len()];
-    for k in 1..points.len() {
-        acc[k] = acc[k - 1] + (points[k] - points[k - 1]).norm();
-    }
-    let total = *acc.last()?;
-    if !(total.is_finite() && total > 0.0) {
-        return None;
-    }
-    Some(acc.into_iter().map(|a| a / total).collect())
-}
-
-/// Clamped knot vector of `degree` with `n_ctrl` control points whose interior knots are
-/// quantiles of the sorted parameters `all` (so each span holds data).
-fn quantile_knots(
-    all: &[f64],
-    degree: usize,
-    n_ctrl: usize,
-) -> Result<KnotVector, nurbs::NurbsError> {
-    let mut knots = vec![0.0; degree + 1];
-    let n_int = n_ctrl - degree - 1;
-    for j in 1..=n_int {
-        let q = j as f64 / (n_int + 1) as f64;
-        let pos = q * (all.len() - 1) as f64;
-        let lo = pos.floor() as usize;
-        let hi = (lo + 1).min(all.len() - 1);
-        let t = pos - lo as f64;
-        knots.push(all[lo] * (1.0 - t) + all[hi] * t);
-    }
-    knots.extend(std::iter::repeat_n(1.0, degree + 1));
-    KnotVector::new(degree, knots)
-}
-
-/// Least squares with both end points interpolated, on the given knot vector; returns the
-/// control points and the largest deviation at the data parameters, or `None` when the
-/// system is rank deficient.
-fn lsq_fixed_ends(
-    points: &[Vector3<f64>],
-    params: &[f64],
-    kv: &KnotVector,
-) -> Option<(Vec<Vector3<f64>>, f64)> {
-    let m = points.len();
-    let n = kv.n_ctrl();
-    let p = kv.degree();
-    let (q0, qm) = (points[0], points[m - 1]);
-    let mut ctrl = vec![q0; n];
-    ctrl[n - 1] = qm;
-    if n > 2 {
-        if m < n {
-            return None;
-        }
-        let rows = m - 2;
-        let cols = n - 2;
-        let mut a = DMatrix::<f64>::zeros(rows, cols);
-        let mut b = DMatrix::<f64>::zeros(rows, 3);
-        let mut nb = [0.0; 16];
-        for k in 1..m - 1 {
-            let u = params[k];
-            let span = kv.find_span(u);
-            kv.basis_funs(span, u, &mut nb);
-            let mut rhs = points[k];
-            for (j, &nj) in nb.iter().enumerate().take(p + 1) {
-                let idx = span - p + j;
-                if idx == 0 {
-                    rhs -= q0 * nj;
-                } else if idx == n - 1 {
-                    rhs -= qm * nj;
-                } else {
-                    a[(k - 1, idx - 1)] = nj;
-                }
-            }
-            for d in 0..3 {
-                b[(k - 1, d)] = rhs[d];
-            }
-        }
-        if !(a.iter().all(|x| x.is_finite()) && b.iter().all(|x| x.is_finite())) {
-            return None;
-        }
-        // Bounded iterations: never loops on pathological input.
-        let svd = a.try_svd(true, true, f64::EPSILON, 10_000)?;
-        let smax = svd.singular_values.max();
-        let smin = svd.singular_values.min();
-        if !(smax > 0.0 && smin > 1e-10 * smax) {
-            return None;
-        }
-        let x = svd.solve(&b, 0.0).ok()?;
-        for i in 0..cols {
-            ctrl[i + 1] = Vector3::new(x[(i, 0)], x[(i, 1)], x[(i, 2)]);
-        }
-    }
-    let curve = NurbsCurve::<3>::from_knot_vector(kv.clone(), ctrl.clone(), None).ok()?;
-    let err = params
-        .iter()
-        .zip(points)
-        .map(|(&u, q)| (curve.point(u) - q).norm())
-        .fold(0.0, f64::max);
-    err.is_finite().then_some((ctrl, err))
-}
-
-/// Fits all `sections` (each LE → TE) with one shared knot vector within `tol`: returns the
-/// knot vector, each section's control points and the largest deviation.
+/// Fits all `sections` (each LE → TE) with one shared knot vector within `tol`
+/// (`nurbs::fit::approximate_compatible`: error-driven knots, kinks as C⁰ knots): returns
+/// the knot vector, each section's control points and the worst data point.
 fn fit_compatible(sections: &[Vec<Vector3<f64>>], tol: f64) -> Result<CompatibleFit, String> {
-    let mut params: Vec<Vec<f64>> = sections
-        .iter()
-        .map(|s| chord_params(s).ok_or_else(|| "a section has zero length".to_string()))
-        .collect::<Result<_, _>>()?;
-    // Sections of equal point counts correspond point by point (AutoGrid sides, our own
-    // exports): one averaged parameter per index keeps those correspondences as the
-    // iso-parametric lines across the span (NURBS Book eq. 9.16's averaging).
-    let m0 = params[0].len();
-    if params.iter().all(|p| p.len() == m0) {
-        let avg: Vec<f64> = (0..m0)
-            .map(|i| params.iter().map(|p| p[i]).sum::<f64>() / params.len() as f64)
-            .collect();
-        for p in &mut params {
-            p.clone_from(&avg);
-        }
-    }
-    let m_min = sections.iter().map(Vec::len).min().unwrap_or(0);
-    if m_min < 2 {
-        return Err("a section has fewer than 2 points".into());
-    }
-    let degree = DEGREE.min(m_min - 1);
-    let mut all: Vec<f64> = params.iter().flatten().copied().collect();
-    all.sort_by(f64::total_cmp);
-    let attempt = |n: usize| -> Option<CompatibleFit> {
-        let kv = quantile_knots(&all, degree, n).ok()?;
-        let mut ctrls = Vec::with_capacity(sections.len());
-        let mut worst: f64 = 0.0;
-        for (s, u) in sections.iter().zip(&params) {
-            let (c, e) = lsq_fixed_ends(s, u, &kv)?;
-            worst = worst.max(e);
-            ctrls.push(c);
-        }
-        Some((kv, ctrls, worst))
-    };
-    let (lo_n, hi_max) = (degree + 1, m_min);
-    // The closest non-singular fit seen, returned when the tolerance cannot be met.
-    let mut closest: Option<CompatibleFit> = None;
-    let mut try_n = |n: usize| -> Option<CompatibleFit> {
-        let r = attempt(n);
-        if let Some(f) = &r {
-            if closest.as_ref().is_none_or(|c| f.2 < c.2) {
-                closest = Some(f.clone());
-            }
-        }
-        r.filter(|f| f.2 <= tol)
-    };
-    if let Some(f) = try_n(lo_n) {
-        return Ok(f);
-    }
-    let (mut lo, mut hi) = (lo_n, (2 * lo_n).min(hi_max));
-    let mut best = loop {
-        if let Some(f) = try_n(hi) {
-            break f;
-        }
-        if hi == hi_max {
-            return closest.ok_or_else(|| {
-                "no compatible fit of the sections exists (singular system)".into()
-            });
-        }
-        lo = hi;
-        hi = (2 * hi).min(hi_max);
-    };
-    while hi - lo > 1 {
-        let mid = lo + (hi - lo) / 2;
-        match try_n(mid) {
-            Some(f) => {
-                hi = mid;
-                best = f;
-            }
-            None => lo = mid,
-        }
-    }
-    Ok(best)
+    let f = approximate_compatible(sections, DEGREE, tol, DEFAULT_KINK_ANGLE)
+        .map_err(|e| e.to_string())?;
+    let miss = DataMiss::new(f.worst, |s, i| sections[s][i]);
+    Ok((f.knots, f.ctrl, miss))
 }
 
 /// Skins compatible section control nets (`ctrls[k][i]`, section k) into a surface, u along
@@ -334,12 +199,15 @@ fn skin(kv_u: &KnotVector, ctrls: &[Vec<Vector3<f64>>]) -> Result<NurbsSurface, 
         .map_err(|e| e.to_string())
 }
 
-/// Fits a meridional contour within `tol`.
-fn fit_contour(points: &[Vector2<f64>], tol: f64) -> Result<(Curve2, f64), String> {
-    let degree = DEGREE.min(points.len().saturating_sub(1)).max(1);
-    let fit = approximate_curve_to_tolerance(points, degree, tol, Parametrisation::ChordLength)
+/// Fits a meridional contour within `tol` (error-driven knots, kinks such as a hub meeting
+/// a diffuser wall kept as C⁰ knots).
+fn fit_contour(points: &[Vector2<f64>], tol: f64) -> Result<(Curve2, DataMiss), String> {
+    let data = [points.to_vec()];
+    let f = approximate_compatible(&data, DEGREE, tol, DEFAULT_KINK_ANGLE)
         .map_err(|e| e.to_string())?;
-    Ok((fit.curve, fit.max_error))
+    let curve = f.curve(0).map_err(|e| e.to_string())?;
+    let miss = DataMiss::new(f.worst, |_, i| Vector3::new(0.0, points[i].y, points[i].x));
+    Ok((curve, miss))
 }
 
 /// Extends compatible section nets beyond the first and last section by `ext` × the span
@@ -393,8 +261,8 @@ pub fn fit(
             format!("{tol_mm} mm is not a positive length"),
         ));
     }
-    let (hub, hub_fit_mm) = fit_contour(&prepared.hub, tol_mm).map_err(|e| err("hub".into(), e))?;
-    let (shroud, shroud_fit_mm) =
+    let (hub, hub_miss) = fit_contour(&prepared.hub, tol_mm).map_err(|e| err("hub".into(), e))?;
+    let (shroud, shroud_miss) =
         fit_contour(&prepared.shroud, tol_mm).map_err(|e| err("shroud".into(), e))?;
     // Every side of every blade is fitted independently (rayon).
     let fit_side = |b: &super::prepare::PreparedBlade, pressure: bool| {
@@ -423,7 +291,7 @@ pub fn fit(
         .par_iter()
         .map(|b| {
             let (p, s) = rayon::join(|| fit_side(b, true), || fit_side(b, false));
-            let ((pressure, pressure_fit_mm), (suction, suction_fit_mm)) = (p?, s?);
+            let ((pressure, pressure_miss), (suction, suction_miss)) = (p?, s?);
             Ok(FittedBlade {
                 name: b.name.clone(),
                 role: b.role,
@@ -431,8 +299,10 @@ pub fn fit(
                 sections: b.sections.len(),
                 pressure,
                 suction,
-                pressure_fit_mm,
-                suction_fit_mm,
+                pressure_fit_mm: pressure_miss.distance_mm,
+                suction_fit_mm: suction_miss.distance_mm,
+                pressure_miss,
+                suction_miss,
             })
         })
         .collect::<Result<Vec<_>, ImportError>>()?;
@@ -441,8 +311,10 @@ pub fn fit(
         hub,
         shroud,
         blades,
-        hub_fit_mm,
-        shroud_fit_mm,
+        hub_fit_mm: hub_miss.distance_mm,
+        shroud_fit_mm: shroud_miss.distance_mm,
+        hub_miss,
+        shroud_miss,
         tol_mm,
     })
 }

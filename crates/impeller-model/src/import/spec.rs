@@ -135,8 +135,21 @@ impl ImportSpec {
 /// Reads the export an import file points at and builds the impeller. Option values out of
 /// range are reported by the stages that use them (prepare, fit, assemble).
 pub fn from_import_toml(text: &str, path: &Path) -> Result<Imported, ImportError> {
+    from_import_toml_with(text, path, None)
+}
+
+/// [`from_import_toml`] with the fit tolerance (mm) replaced by `fit_tol_mm` when given (a
+/// command-line option overriding the file's `fit_tol_mm`).
+pub fn from_import_toml_with(
+    text: &str,
+    path: &Path,
+    fit_tol_mm: Option<f64>,
+) -> Result<Imported, ImportError> {
     let spec = ImportSpec::parse(text, path)?;
-    let opts = spec.options(text, path)?;
+    let mut opts = spec.options(text, path)?;
+    if let Some(t) = fit_tol_mm {
+        opts.fit_tol_mm = t;
+    }
     let base = path.parent().unwrap_or(Path::new("."));
     let file = resolve(base, &spec.import.file).ok_or_else(|| ImportError::Invalid {
         file: path.to_path_buf(),

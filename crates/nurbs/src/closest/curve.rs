@@ -1,5 +1,16 @@
 //! Global closest point on a NURBS curve (any dimension).
 //!
+//! **Degree ≤ 7 (every curve the project builds):** a certified search. The curve's Bézier
+//! segments sit in a bounding-volume tree of their control-point boxes (positive weights: a
+//! segment lies in the convex hull of its control points); the tree is walked best-first
+//! and each segment whose box is nearer than the best distance is searched by root isolation
+//! of the distance's derivative in the Bernstein basis, rational segments included (see
+//! `curve_cert.rs`: `(C − q)·C' = N/W³` with `N` a Bernstein polynomial computed exactly from
+//! the homogeneous control points). The answer's `certified` flag says the minimum is
+//! proven global. The hint only seeds the upper bound.
+//!
+//! **Higher degrees:** the earlier method below, kept as the fallback.
+//!
 //! Same method as the surface projector, one dimension down: the curve is decomposed into
 //! Bézier segments (split further where the tangent turns by more than ~35°); each piece
 //! keeps the axis-aligned box of its control polygon (a lower bound of the distance to the
@@ -35,6 +46,11 @@ pub struct CurvePoint<const D: usize> {
     pub distance: f64,
     /// The answer is a domain end where the distance still decreases outwards.
     pub on_boundary: bool,
+    /// Proven global: every part of the curve was shown to be no nearer (by the Bernstein
+    /// root isolation of [`CurveProjector`]'s tree search). `false` only when an interval
+    /// stayed ambiguous at the finest subdivision, or for curves of degree above 7 (searched
+    /// by the sampled-bound method).
+    pub certified: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -123,7 +139,8 @@ fn certified<const D: usize>(
     lo > 0.0
 }
 
-/// Deepest query-time subdivision of an uncertified piece (1/256 of it).
+/// Deepest query-time subdivision of an uncertified piece (the piece is depth 1, so the
+/// finest pieces are 2⁻⁷ = 1/128 of it).
 const MAX_BB_DEPTH: usize = 8;
 
 /// Precomputed closest-point query structure for one curve. See the module docs.
@@ -134,6 +151,8 @@ pub struct CurveProjector<const D: usize> {
     pieces: Vec<Piece<D>>,
     domain: (f64, f64),
     step_tol: f64,
+    /// Bounding-volume tree over the Bézier segments (empty above degree 7).
+    tree: Vec<super::curve_cert::Node<D>>,
 }
 
 struct Local1<const D: usize> {
@@ -205,12 +224,19 @@ impl<const D: usize> CurveProjector<D> {
         }
         let diag = (hi - lo).norm();
         let step_tol = 1e-13 * (1.0 + if diag.is_finite() { diag } else { 0.0 });
+        let tree = if p <= super::curve_cert::MAX_CERT_DEGREE {
+            let boxes: Vec<_> = segs.iter().map(super::curve_cert::control_box).collect();
+            super::curve_cert::build_tree(&boxes)
+        } else {
+            Vec::new()
+        };
         CurveProjector {
             segs,
             breaks,
             pieces,
             domain: curve.domain(),
             step_tol,
+            tree,
         }
     }
 
@@ -242,7 +268,11 @@ impl<const D: usize> CurveProjector<D> {
                 point: self.derivs2(a)[0],
                 distance: f64::NAN,
                 on_boundary: false,
+                certified: false,
             };
+        }
+        if !self.tree.is_empty() {
+            return self.tree_search(q, hint);
         }
         let mut best: Option<Local1<D>> = None;
         if let Some(h) = hint.filter(|h| h.is_finite()) {
@@ -303,6 +333,7 @@ impl<const D: usize> CurveProjector<D> {
                 point: l.point,
                 distance: l.d2.sqrt(),
                 on_boundary: l.active != 0,
+                certified: false,
             },
             None => {
                 let c = self.derivs2(a)[0];
@@ -311,8 +342,76 @@ impl<const D: usize> CurveProjector<D> {
                     point: c,
                     distance: (c - q).norm(),
                     on_boundary: true,
+                    certified: false,
                 }
             }
+        }
+    }
+
+    /// Certified search: best-first walk of the segment tree, each segment searched by
+    /// Bernstein root isolation ([`super::curve_cert`]). The hint only seeds the upper bound.
+    fn tree_search(&self, q: &SVector<f64, D>, hint: Option<f64>) -> CurvePoint<D> {
+        use super::curve_cert::{box_d2, search_piece, Best};
+        let (a, b) = self.domain;
+        let mut best = Best {
+            t: 0.0,
+            piece: 0,
+            d2: f64::INFINITY,
+            certified: true,
+        };
+        if let Some(h) = hint.filter(|h| h.is_finite()) {
+            let u = h.clamp(a, b);
+            let k = self.seg_index(u);
+            let sg = &self.segs[k];
+            let d2 = (sg.derivs2(u)[0] - q).norm_squared();
+            // Slightly above: the segment search must still run and return its own point.
+            best.d2 = d2 * (1.0 + 1e-12) + f64::MIN_POSITIVE;
+            best.piece = k;
+            best.t = (u - sg.u0) / (sg.u1 - sg.u0);
+        }
+        // Stack of (node, lower bound); depth ≤ log2(segments) + 1 per level pushed.
+        let mut stack = [(0usize, 0.0f64); 128];
+        let mut top = 1;
+        stack[0] = (0, box_d2(&self.tree[0].min, &self.tree[0].max, q));
+        let mut walked_all = true;
+        while top > 0 {
+            top -= 1;
+            let (id, lb) = stack[top];
+            if lb >= best.d2 {
+                continue;
+            }
+            let node = &self.tree[id];
+            match node.kids {
+                None => search_piece(&self.segs[node.lo], node.lo, q, &mut best),
+                Some((l, r)) => {
+                    if top + 2 > stack.len() {
+                        walked_all = false;
+                        continue;
+                    }
+                    let ll = box_d2(&self.tree[l].min, &self.tree[l].max, q);
+                    let lr = box_d2(&self.tree[r].min, &self.tree[r].max, q);
+                    // Nearer child on top.
+                    let (far, near) = if ll <= lr {
+                        ((r, lr), (l, ll))
+                    } else {
+                        ((l, ll), (r, lr))
+                    };
+                    stack[top] = far;
+                    stack[top + 1] = near;
+                    top += 2;
+                }
+            }
+        }
+        let sg = &self.segs[best.piece];
+        let u = (sg.u0 + best.t * (sg.u1 - sg.u0)).clamp(a, b);
+        let e = sg.derivs2(u);
+        let g = (e[0] - q).dot(&e[1]);
+        CurvePoint {
+            u,
+            point: e[0],
+            distance: (e[0] - q).norm(),
+            on_boundary: (u <= a && g > 0.0) || (u >= b && g < 0.0),
+            certified: best.certified && walked_all,
         }
     }
 

@@ -3,13 +3,17 @@
 //! * [`SurfaceProjector`] — precomputed query structure for a [`crate::NurbsSurface`]; global
 //!   minimum with boundary handling and optional warm start.
 //! * [`CurveProjector`] — the same for a [`crate::NurbsCurve`] in any dimension.
+//! * [`PointQuery`] — the point-query vocabulary (closest point, signed distance, warm-start
+//!   hint, certified flag) shared with the other crates' shapes.
 //! * [`closest_point_on_surface`], [`closest_point_on_curve`] — one-off conveniences that
 //!   build the projector and answer one query.
 
 pub(crate) mod bezier;
 mod curve;
+mod curve_cert;
 pub(crate) mod decompose;
 mod newton;
+mod query;
 mod surface;
 
 /// Bounding volumes shared with the projection module.
@@ -18,6 +22,7 @@ pub(crate) mod surface_bounds {
 }
 
 pub use curve::{closest_point_on_curve, CurvePoint, CurveProjector};
+pub use query::{PointProjection, PointQuery};
 pub use surface::{SurfacePoint, SurfaceProjector};
 
 pub(crate) use decompose::{decompose_curve, decompose_surface};

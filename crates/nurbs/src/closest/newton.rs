@@ -169,8 +169,22 @@ pub(crate) fn minimise<F: Fn(f64, f64) -> SurfaceDerivs2>(
         }
         let step = (e.su * (un - u) + e.sv * (vn - v)).norm();
         if !accepted {
-            // No decrease even for tiny steps: at a minimum within round-off.
-            converged = true;
+            // No decrease even for tiny steps. That is a minimum within round-off only if
+            // S − q is already normal to the surface (the angle condition); otherwise the
+            // line search failed at a non-stationary point, which is not convergence (a leaf
+            // solved this way must not be taken as that leaf's minimum).
+            let rn = f.sqrt();
+            let cu = if fix_u {
+                0.0
+            } else {
+                gu.abs() / (rn * auu.sqrt())
+            };
+            let cv = if fix_v {
+                0.0
+            } else {
+                gv.abs() / (rn * avv.sqrt())
+            };
+            converged = !(cu > ANGLE_TOL || cv > ANGLE_TOL);
             break;
         }
         u = un;

@@ -40,10 +40,13 @@
 //! unique minimum. For polynomial surfaces the boxes are rigorous (convex hull of the
 //! hodographs), so the answer is the global minimum. Where the certificate fails (queries
 //! beyond a centre of curvature), the leaf is searched by branch and bound over de Casteljau
-//! pieces (pruned by their boxes, certified pieces solved by Newton, at most 1/64 of the leaf
+//! pieces (pruned by their boxes, certified pieces solved by Newton, down to 1/32 of the leaf
 //! per direction; this path allocates). Rational leaves use derivative boxes from a 5×5
 //! sample widened by 25%, so for them the certificate is a well-founded heuristic rather than
-//! a proof.
+//! a proof (rigorous rational bounds from the homogeneous net are not implemented yet; curves
+//! have them, see [`super::CurveProjector`]). The walk has no cap on leaf solves: it ends when
+//! every leaf is pruned or solved. A Newton run whose line search fails away from a
+//! stationary point is not reported as converged.
 //!
 //! **Warm start.** With a hint `(u, v)` (typically the previous answer along a path) Newton
 //! first runs on the whole domain from the hint; the resulting `d*` is usually already the
@@ -526,10 +529,6 @@ pub struct SurfaceProjector {
     step_tol: f64,
 }
 
-/// Largest number of Newton-solved leaves per query before the walk trusts the best found
-/// (never reached on sane geometry; protects against pathological input).
-const MAX_LEAF_SOLVES: usize = 4096;
-
 /// Entries of the query walk's stack (see `closest_point_with_hint`).
 const WALK_STACK: usize = 64;
 
@@ -605,6 +604,12 @@ impl SurfaceProjector {
     /// The parameter domain of the surface.
     pub fn domain(&self) -> ((f64, f64), (f64, f64)) {
         self.domain
+    }
+
+    /// Whether the surface is rational (its leaves' derivative bounds are then sampled, not
+    /// rigorous; see the module docs).
+    pub fn is_rational(&self) -> bool {
+        self.patches.iter().any(|p| p.rational)
     }
 
     /// Number of leaves (Bézier pieces after subdivision) in the query structure.
@@ -747,7 +752,9 @@ impl SurfaceProjector {
         let mut stack_i = [0u32; N];
         let mut stack_d = [0.0f64; N];
         let mut sp = 1usize;
-        let mut solves = 0usize;
+        // No cap on leaf solves: every leaf is solved at most once by the walk and once by
+        // the overflow scan, so the search always ends, and it ends only when every leaf is
+        // pruned by its box or solved.
         let mut overflow = false;
         while sp > 0 {
             sp -= 1;
@@ -757,11 +764,7 @@ impl SurfaceProjector {
                 continue;
             }
             if index & LEAF_BIT != 0 {
-                if solves >= MAX_LEAF_SOLVES {
-                    continue;
-                }
                 if let Some(l) = self.solve_leaf((index & !LEAF_BIT) as usize, q, best) {
-                    solves += 1;
                     if l.0.d2 < bound {
                         best = Some(l);
                     }
@@ -804,11 +807,10 @@ impl SurfaceProjector {
         if overflow {
             for index in 0..self.leaves.len() {
                 let bound = best.map_or(f64::INFINITY, |b| b.0.d2);
-                if solves >= MAX_LEAF_SOLVES || self.leaves[index].obb.dist2(q) >= bound {
+                if self.leaves[index].obb.dist2(q) >= bound {
                     continue;
                 }
                 if let Some(l) = self.solve_leaf(index, q, best) {
-                    solves += 1;
                     if l.0.d2 < bound {
                         best = Some(l);
                     }
@@ -936,7 +938,8 @@ impl SurfaceProjector {
 }
 
 /// Deepest query-time subdivision of a leaf whose distance function is not certified
-/// convex (pieces of 1/64 of the leaf per direction).
+/// convex: the leaf itself is depth 1, so the finest pieces are 2⁻⁵ = 1/32 of the leaf per
+/// direction.
 const MAX_BB_DEPTH: usize = 6;
 
 impl SurfaceProjector {

@@ -4,6 +4,8 @@
 //!   derivatives (A9.1, §9.2.1–9.2.2).
 //! * [`approximate_curve`], [`approximate_curve_to_tolerance`] — least-squares approximation
 //!   with fixed end points (§9.4.1).
+//! * [`approximate_compatible`] — error-driven knot refinement for one or more sections
+//!   sharing a knot vector, kinks kept as C⁰ knots (§9.4.1–9.4.2).
 //! * [`smooth_curve`] — least squares with an added derivative energy (penalised splines).
 //! * [`interpolate_surface`] — global surface interpolation through a grid (A9.4).
 //! * [`skin`] — lofting a surface through section curves (§10.3).
@@ -11,6 +13,7 @@
 //! Dense linear algebra is done with `faer` (column-pivoted QR, rank-revealing, so a singular
 //! system is reported as [`FitError::SingularSystem`] instead of producing garbage).
 
+mod adaptive;
 mod curve_approx;
 mod curve_interp;
 mod error;
@@ -20,6 +23,7 @@ mod skin;
 mod solve;
 mod surface_interp;
 
+pub use adaptive::{approximate_compatible, CompatibleFit, FitMiss, DEFAULT_KINK_ANGLE};
 pub use curve_approx::{
     approximate_curve, approximate_curve_to_tolerance, smooth_curve, CurveFit, Energy,
 };
