@@ -1,0 +1,7 @@
+//! Channel roughing by depth levels with triangle path planning (paper 001 §3; channel areas
+//! around the splitter of paper 003).
+//!
+//! [`plan2d`]: isoparametric and triangle planning of one area on one level in the level's
+//! developed plane.
+
+pub mod plan2d;
