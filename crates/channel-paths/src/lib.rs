@@ -4,3 +4,5 @@
 //! of the hub's and the blade's offset surfaces (paper 004 §2–3).
 
 pub mod roughing;
+
+pub use roughing::{build_channel_roughing, CHANNEL_ROUGHING};
