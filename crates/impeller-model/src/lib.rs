@@ -15,7 +15,8 @@
 //! NURBS), [`law`] and [`thickness`] (design laws), [`meridional`] and [`revolved`] (hub and
 //! shroud), [`blade`] (sides, camber, rows), [`impeller`], [`stock`], [`channel`] (edges on
 //! hub/shroud, channels, widths), [`query`] (closest points, signed distances), [`summary`],
-//! [`ruled`] (ruled and sub-ruled approximation), [`fit`] (interpolation of sampled design).
+//! [`ruled`] (ruled and sub-ruled approximation), [`fit`] (interpolation of sampled design),
+//! [`levels`] (depth levels between hub and shroud, boundaries of offset surfaces on a level).
 //!
 //! Conventions: the hub's channel-side normal points into the channel, the shroud's out of
 //! it; each blade side has an outward normal ([`Blade::outward_normal`]); blade k+1 of a row
@@ -37,6 +38,7 @@ pub mod fixtures;
 pub mod impeller;
 pub mod import;
 pub mod law;
+pub mod levels;
 pub mod meridional;
 pub mod params;
 pub mod query;

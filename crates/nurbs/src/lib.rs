@@ -20,6 +20,7 @@
 //! | constructors | [`NurbsCurve::circle_arc`], [`NurbsSurface::revolution`], [`NurbsSurface::ruled`] | A7.1, A8.1, §8.4 |
 //! | iso curves, rigid motions | [`NurbsSurface::iso_curve_at_u`]/[`NurbsSurface::iso_curve_at_v`], `transformed`, `rotated_about_z` | §6.5 |
 //! | interfaces | [`ParametricCurve`], [`ParametricSurface`] | |
+//! | curve–curve intersection | [`intersect::intersect_curves`], [`intersect::closest_approach`] | §5.4 bounds, subdivision + Newton |
 //!
 //! Every shape-preserving operation (insertion, refinement, splitting, elevation,
 //! decomposition, clamping) reproduces the input to rounding; the tests check 1e-12
@@ -122,5 +123,6 @@ pub const MAX_ORDER: usize = MAX_DEGREE + 1;
 pub mod closest;
 pub mod discretise;
 pub mod fit;
+pub mod intersect;
 pub mod project;
 pub mod tessellate;
