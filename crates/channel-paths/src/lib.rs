@@ -2,3 +2,7 @@
 //! roughing by depth levels with triangle path planning (paper 001 §3, channel areas around
 //! the splitter of paper 003), hub finishing and blade-root finishing along the intersection
 //! of the hub's and the blade's offset surfaces (paper 004 §2–3).
+
+mod accessibility;
+pub mod blade_root;
+pub use blade_root::{build_blade_root_finishing, BladeRootFinishing, BLADE_ROOT_FINISHING};
