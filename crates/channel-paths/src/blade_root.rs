@@ -468,13 +468,22 @@ pub fn plan_side(
                         centre.y,
                         centre.z
                     ),
-                    format!(
-                        "no accessible tool axis up to C_max = {:.2}° (steps of {:.2}°); the largest ball radius accessible here is {:.3} mm (tool has {:.3} mm)",
-                        c_max.to_degrees(),
-                        step.to_degrees(),
-                        lo,
-                        r
-                    ),
+                    if lo >= 1e-3 * r {
+                        format!(
+                            "no accessible tool axis up to C_max = {:.2}° (steps of {:.2}°); the largest ball radius accessible here is {:.3} mm (tool has {:.3} mm)",
+                            c_max.to_degrees(),
+                            step.to_degrees(),
+                            lo,
+                            r
+                        )
+                    } else {
+                        format!(
+                            "no accessible tool axis up to C_max = {:.2}° (steps of {:.2}°); the largest ball radius accessible here is 0 mm: with this tool's shank and holder no ball fits (tool has {:.3} mm; a longer or thinner neck is needed)",
+                            c_max.to_degrees(),
+                            step.to_degrees(),
+                            r
+                        )
+                    },
                 ));
             }
         }
