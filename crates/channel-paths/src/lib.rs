@@ -3,6 +3,9 @@
 //! the splitter of paper 003), hub finishing and blade-root finishing along the intersection
 //! of the hub's and the blade's offset surfaces (paper 004 §2–3).
 
+mod accessibility;
+pub mod blade_root;
 pub mod roughing;
 
+pub use blade_root::{build_blade_root_finishing, BladeRootFinishing, BLADE_ROOT_FINISHING};
 pub use roughing::{build_channel_roughing, CHANNEL_ROUGHING};

@@ -19,6 +19,7 @@
 //! | parametrisation | `clamped`, `reverse`, `reparametrize`, [`NurbsSurface::swap_uv`] | §5.3, §6.1 |
 //! | constructors | [`NurbsCurve::circle_arc`], [`NurbsSurface::revolution`], [`NurbsSurface::ruled`] | A7.1, A8.1, §8.4 |
 //! | iso curves, rigid motions | [`NurbsSurface::iso_curve_at_u`]/[`NurbsSurface::iso_curve_at_v`], `transformed`, `rotated_about_z` | §6.5 |
+//! | surface–surface intersection, offset of a curve on a surface | [`surface_intersect`] | §5.8 of Patrikalakis & Maekawa |
 //! | interfaces | [`ParametricCurve`], [`ParametricSurface`] | |
 //! | curve–curve intersection | [`intersect::intersect_curves`], [`intersect::closest_approach`] | §5.4 bounds, subdivision + Newton |
 //!
@@ -125,4 +126,5 @@ pub mod discretise;
 pub mod fit;
 pub mod intersect;
 pub mod project;
+pub mod surface_intersect;
 pub mod tessellate;
