@@ -2,7 +2,8 @@
 //! the `cam_plan::Operation` API and prints its metrics as JSON.
 //!
 //! `cargo run -p flank-opt --example plan_narrow -- [IMPELLER.toml] [semi] [key=value ...]`
-//! (extra `key=value` pairs become the operation's TOML keys, e.g. `initial_path="mid_normal"`).
+//! (extra `key=value` pairs become the operation's TOML keys, e.g. `initial_path="mid_normal"`;
+//! `--r=MM` and `--deg=DEG` set the job tool's ball radius and half angle, default 3 mm, 3°).
 
 use cam_core::{Cutter, CutterShape, Tolerances};
 use cam_plan::{
@@ -20,16 +21,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let semi = args.iter().any(|a| a == "semi");
     let extra: String = args
         .iter()
-        .filter(|a| a.contains('='))
+        .filter(|a| a.contains('=') && !a.starts_with("--"))
         .map(|a| format!("{a}\n"))
         .collect();
+    let opt = |key: &str, default: f64| -> Result<f64, std::num::ParseFloatError> {
+        args.iter()
+            .find_map(|a| a.strip_prefix(&format!("--{key}=")))
+            .map_or(Ok(default), str::parse)
+    };
+    let (r, deg) = (opt("r", 3.0)?, opt("deg", 3.0)?);
     let impeller = impeller_model::load(&path)?;
     let shape = if semi {
-        CutterShape::BallEnd { radius: 3.0 }
+        CutterShape::BallEnd { radius: r }
     } else {
         CutterShape::TaperedBallEnd {
-            ball_radius: 3.0,
-            half_angle: 3f64.to_radians(),
+            ball_radius: r,
+            half_angle: deg.to_radians(),
         }
     };
     let cutter = Cutter::new("tbe", shape, 60.0, 8.0, 70.0)?;

@@ -53,7 +53,8 @@ pub struct FlankSide {
 impl FlankSide {
     /// Prepares `side` of the impeller's main blade: `nu × nv` accuracy samples on the design
     /// side between the hub and shroud edges (edges trimmed by [`EDGE_TRIM`] of u), and
-    /// `nu × nv` clearance samples on the nearest side of a neighbouring blade facing it.
+    /// `nu × nv` clearance samples on the nearest side of a neighbouring blade facing it (the
+    /// main blades next to it and the nearest splitters are candidates).
     /// O(nu·nv) surface evaluations.
     pub fn new(impeller: &Impeller, side: Side, nu: usize, nv: usize) -> Result<Self, FlankError> {
         if nu < 2 || nv < 2 {
@@ -90,12 +91,18 @@ impl FlankSide {
         })?;
         let probe = s.point(um, vm) + n_mid;
         let count = set.count();
+        let mut candidates: Vec<Blade> = [1, count.saturating_sub(1)]
+            .into_iter()
+            .filter(|&k| k > 0 && k < count)
+            .map(|k| set.instance(k))
+            .collect();
+        // Splitters sit between main blades: the nearest one may face the side.
+        if let Some(sp) = impeller.splitter() {
+            let n = sp.count();
+            candidates.extend([0, n.saturating_sub(1)].into_iter().map(|k| sp.instance(k)));
+        }
         let mut best: Option<(f64, Blade, Side)> = None;
-        for k in [1, count.saturating_sub(1)] {
-            if k == 0 || k >= count {
-                continue;
-            }
-            let other = set.instance(k);
+        for other in candidates {
             for os in [Side::Pressure, Side::Suction] {
                 let sp = impeller_model::query::closest_point(other.side(os), &probe, None);
                 if best.as_ref().is_none_or(|b| sp.distance < b.0) {
