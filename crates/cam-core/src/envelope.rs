@@ -78,6 +78,14 @@
 //! (one closed-form evaluation per block of far seeds, per seed near the point), each Newton
 //! iteration O(p²) for degree-p guides; no allocation.
 //!
+//! Measured (`cargo bench -p cam-core --bench envelope`, on-CPU time per query on a shared
+//! 2-core machine): warm 9.7 µs, cold 13.0 µs, against 0.61 µs and 2.5 µs before the
+//! certificate. The bench's points lie on a flank, about 23 Newton iterations per query: the
+//! seed intervals next to the minimiser fail the cone bound (the distance rises there by
+//! less than `L·h/2`) and are searched. A convexity certificate of `g` on those intervals
+//! (as `nurbs` keeps for surface leaves) would remove most of that cost;
+//! `max_certify_runs = 0` gives the uncertified cost back with `certified = false`.
+//!
 //! # First-order change (envelope theorem)
 //!
 //! At the minimiser `(s*, t*)` (bounds fixed: `s ∈ [s₀, s₁]`, `τ ∈ [0, 1]` per piece), the
