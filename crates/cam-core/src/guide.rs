@@ -257,6 +257,32 @@ impl GuideCurve {
         }
     }
 
+    /// An upper bound of `|C'(u)|` over knot span `span` (as returned by [`Self::find_span`]),
+    /// or of `|C'(u) − B'(u)|` when `minus` is a curve sharing this one's basis: the largest
+    /// norm of the hodograph control points `p·(Q_{i+1} − Q_i)/(u_{i+p+1} − u_{i+1})`,
+    /// `i = span − p … span − 1`, whose convex combination `C'` is on that span (NURBS Book
+    /// eq. 3.4). `None` for rational curves (their derivative is not such a combination).
+    /// O(p), no allocation.
+    pub fn derivative_bound(&self, span: usize, minus: Option<&GuideCurve>) -> Option<f64> {
+        if self.weights.is_some() || minus.is_some_and(|m| m.weights.is_some()) {
+            return None;
+        }
+        let p = self.degree;
+        let u = self.kv.knots();
+        let q = |i: usize| match minus {
+            Some(m) => self.ctrl[i] - m.ctrl[i],
+            None => self.ctrl[i],
+        };
+        let mut best: f64 = 0.0;
+        for i in span.saturating_sub(p)..span {
+            let du = u[i + p + 1] - u[i + 1];
+            if du > 0.0 {
+                best = best.max((q(i + 1) - q(i)).norm() * p as f64 / du);
+            }
+        }
+        Some(best)
+    }
+
     /// Distinct knot values inside the domain (span boundaries), in increasing order.
     pub fn breakpoints(&self) -> Vec<f64> {
         let (lo, hi) = self.domain();

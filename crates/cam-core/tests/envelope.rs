@@ -472,3 +472,131 @@ mod properties {
         }
     }
 }
+
+mod certified {
+    use super::*;
+    use proptest::prelude::*;
+    use rand::Rng;
+
+    /// A random wavy path: 6 random control points per guide (tip meandering with large
+    /// swings so the distance has several local minima along the path), random tilt.
+    fn random_guides(seed: u64, hg: f64) -> (GuideCurve, GuideCurve) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut p0 = Vec::new();
+        let mut p1 = Vec::new();
+        for i in 0..6 {
+            let u = i as f64 / 5.0;
+            let tip = Vector3::new(
+                40.0 * u + rng.random_range(-6.0..6.0),
+                rng.random_range(-12.0..12.0),
+                rng.random_range(-4.0..4.0),
+            );
+            let axis = Vector3::new(
+                rng.random_range(-0.5..0.5),
+                rng.random_range(-0.5..0.5),
+                1.0,
+            )
+            .normalize();
+            p0.push(tip + axis * hg);
+            p1.push(tip + axis * (hg + 20.0));
+        }
+        (cubic(&p0), cubic(&p1))
+    }
+
+    proptest! {
+        /// Hinted (with an arbitrary, possibly far hint) and cold answers are never larger
+        /// than the dense brute-force minimum by more than 1e-9 mm, and are certified.
+        #[test]
+        fn never_above_the_brute_force_minimum(
+            seed in 0u64..1_000_000,
+            r in 1.0f64..4.0, theta_deg in 0.0f64..8.0,
+            s in 0.0f64..1.0, hint_s in 0.0f64..1.0,
+            dx in -10.0f64..10.0, dy in -10.0f64..10.0, dz in -4.0f64..18.0,
+        ) {
+            let hg = r;
+            let (g0, g1) = random_guides(seed, hg);
+            let shape = CutterShape::TaperedBallEnd {
+                ball_radius: r,
+                half_angle: theta_deg.to_radians(),
+            };
+            let env = envelope(shape, 25.0, g0, g1, hg);
+            let p = env.cutter_location(s).unwrap().tip + Vector3::new(dx, dy, dz);
+            let brute = brute_force(&env, &p);
+            let cold = env.signed_distance(&p, None).unwrap();
+            let hint = EnvelopeParam { s: hint_s, t: 0.0 };
+            let warm = env.signed_distance(&p, Some(hint)).unwrap();
+            for (name, d) in [("cold", cold), ("hinted", warm)] {
+                prop_assert!(d.certified, "{name}: not certified");
+                prop_assert!(
+                    d.distance <= brute + 1e-9,
+                    "{name}: {} above brute force {brute}", d.distance
+                );
+            }
+        }
+    }
+
+    /// A hint in the wrong basin: the uncertified Newton answer would be a local minimum far
+    /// above the true one; the certified answer finds the true one.
+    #[test]
+    fn a_wrong_basin_hint_is_corrected() {
+        // A hairpin path: out along y = 0, back along y = 20; the point sits between the
+        // legs, nearer the return leg, so Newton from the start stops on the outgoing leg.
+        let ctrl = [
+            (0.0, 0.0),
+            (20.0, 0.0),
+            (40.0, 0.0),
+            (50.0, 10.0),
+            (40.0, 20.0),
+            (20.0, 20.0),
+            (0.0, 20.0),
+        ];
+        let p0: Vec<Vector3> = ctrl.iter().map(|&(x, y)| Vector3::new(x, y, 3.0)).collect();
+        let p1: Vec<Vector3> = ctrl
+            .iter()
+            .map(|&(x, y)| Vector3::new(x, y, 23.0))
+            .collect();
+        let shape = CutterShape::TaperedBallEnd {
+            ball_radius: 3.0,
+            half_angle: 0.05,
+        };
+        let env = envelope(shape, 25.0, cubic(&p0), cubic(&p1), 3.0);
+        let p = Point3::new(15.0, 14.0, 5.0);
+        let brute = brute_force(&env, &p);
+        let warm = env
+            .signed_distance(&p, Some(EnvelopeParam { s: 0.0, t: 0.0 }))
+            .unwrap();
+        assert!(warm.certified);
+        assert!(
+            warm.distance <= brute + 1e-9,
+            "{} vs {brute}",
+            warm.distance
+        );
+        // Without certification runs the hinted Newton answer is the wrong basin's.
+        let fam = SphereFamily::from_shape(&shape, 25.0).unwrap();
+        let opts = EnvelopeOptions {
+            max_certify_runs: 0,
+            ..EnvelopeOptions::default()
+        };
+        let bare = SweptEnvelope::new(fam, cubic(&p0), cubic(&p1), 3.0, opts).unwrap();
+        let local = bare
+            .signed_distance(&p, Some(EnvelopeParam { s: 0.0, t: 0.0 }))
+            .unwrap();
+        assert!(!local.certified);
+        assert!(
+            local.distance > brute + 1.0,
+            "{} vs {brute}",
+            local.distance
+        );
+    }
+
+    /// Rational guides carry no hodograph bound: the answer says it is not certified.
+    #[test]
+    fn rational_guides_are_reported_uncertified() {
+        let shape = CutterShape::BallEnd { radius: 2.0 };
+        let env = envelope(shape, 20.0, circle(30.0, 2.0), circle(30.0, 22.0), 2.0);
+        let d = env
+            .signed_distance(&Point3::new(35.0, 0.0, 5.0), None)
+            .unwrap();
+        assert!(!d.certified);
+    }
+}

@@ -15,6 +15,12 @@
 //! with `r` the bottom radius (radius at the ball-centre plane), `θ` the half taper angle and
 //! `E` Young's modulus. The stiffness indicator is `k = F / w(L)`.
 //!
+//! [`ConicalCutter`] is parametrised like the envelope in `cam-core` (ball radius, half angle
+//! in radians, length from the tool tip to the chuck face), and its gradient is taken in those
+//! parameters, so an optimiser combines stiffness and distance derivatives with no chain rule
+//! of its own; the beam quantities above (`r = r_ball / cos θ`, `L = length − r_ball`) are
+//! derived from them ([`ConicalCutter::from_load_plane`] converts from the literature's form).
+//!
 //! ## Rayleigh–Ritz
 //!
 //! The deflection minimises the potential energy
@@ -66,7 +72,8 @@
 //! ## Gradient
 //!
 //! With `F = 1`, `w = fᵀ K⁻¹ f` and `f` independent of the shape, `∂k/∂p = (cᵀ K_p c) / w²`
-//! where `K_p = ∫ E ∂I/∂p Pᵢ Pⱼ dx`, `∂I/∂r = π ρ³`, `∂I/∂θ = π ρ³ (L − x) sec² θ`. This is the
+//! where `K_p = ∫ E ∂I/∂p Pᵢ Pⱼ dx`, `∂I/∂r = π ρ³`, `∂I/∂θ = π ρ³ (L − x) sec² θ`; the beam
+//! length enters through the scaling `x = Lξ` (see [`ConicalCutter::report`]). This is the
 //! exact derivative of the Rayleigh–Ritz indicator (not a finite difference).
 //!
 //! Units: millimetres and N/mm² (MPa) give stiffness in N/mm.

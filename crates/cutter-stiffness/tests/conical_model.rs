@@ -15,7 +15,7 @@ fn deg(d: f64) -> f64 {
 #[test]
 fn cylinder_gives_three_ei_over_l_cubed_to_1e9() {
     for &(r, l) in &[(1.0, 20.0), (3.75, 40.0), (6.0, 80.0)] {
-        let c = ConicalCutter::new(r, 0.0, l, E_CARBIDE).unwrap();
+        let c = ConicalCutter::from_load_plane(r, 0.0, l, E_CARBIDE).unwrap();
         let rep = c.report(&RitzOptions::default()).unwrap();
         let k = 3.0 * E_CARBIDE * (PI * r.powi(4) / 4.0) / l.powi(3);
         assert!(
@@ -35,7 +35,7 @@ fn default_settings_are_within_0_1_percent_over_the_stated_range() {
                 let r = 1.0 + i as f64;
                 let theta = deg(j as f64);
                 let l = 20.0 + 10.0 * m as f64;
-                let c = ConicalCutter::new(r, theta, l, E_CARBIDE).unwrap();
+                let c = ConicalCutter::from_load_plane(r, theta, l, E_CARBIDE).unwrap();
                 let rep = c.report(&RitzOptions::default()).unwrap();
                 let rel = (rep.stiffness_n_per_mm / rep.exact_n_per_mm - 1.0).abs();
                 worst = worst.max(rel);
@@ -51,8 +51,8 @@ fn default_settings_are_within_0_1_percent_over_the_stated_range() {
 fn published_comparison_taper_more_than_doubles_stiffness() {
     // Conical ball end r = 3.14 mm, θ = 3° vs cylindrical r = 3.75 mm, both L = 40 mm:
     // about 2.28 times as stiff.
-    let cone = ConicalCutter::new(3.14, deg(3.0), 40.0, E_CARBIDE).unwrap();
-    let cyl = ConicalCutter::new(3.75, 0.0, 40.0, E_CARBIDE).unwrap();
+    let cone = ConicalCutter::from_load_plane(3.14, deg(3.0), 40.0, E_CARBIDE).unwrap();
+    let cyl = ConicalCutter::from_load_plane(3.75, 0.0, 40.0, E_CARBIDE).unwrap();
     let opts = RitzOptions::default();
     let ratio = cone.report(&opts).unwrap().stiffness_n_per_mm
         / cyl.report(&opts).unwrap().stiffness_n_per_mm;
@@ -65,30 +65,52 @@ fn ritz_gradient_matches_finite_differences_and_closed_form() {
         terms: Some(14),
         ..Default::default()
     };
-    let base = ConicalCutter::new(3.0, deg(5.0), 45.0, E_CARBIDE).unwrap();
+    let base = ConicalCutter::new(3.0, deg(5.0), 48.0, E_CARBIDE).unwrap();
     let rep = base.report(&opts).unwrap();
-    let k = |c: ConicalCutter| c.report(&opts).unwrap().stiffness_n_per_mm;
-    let h = 1e-5;
-    let fd_r = (k(ConicalCutter {
-        bottom_radius: 3.0 + h,
-        ..base
-    }) - k(ConicalCutter {
-        bottom_radius: 3.0 - h,
-        ..base
-    })) / (2.0 * h);
-    let hd = 1e-4; // degrees
-    let fd_t = (k(ConicalCutter {
-        half_angle: base.half_angle + deg(hd),
-        ..base
-    }) - k(ConicalCutter {
-        half_angle: base.half_angle - deg(hd),
-        ..base
-    })) / (2.0 * hd);
-    assert!((rep.d_stiffness_d_radius / fd_r - 1.0).abs() < 1e-6);
-    assert!((rep.d_stiffness_d_half_angle_deg / fd_t - 1.0).abs() < 1e-6);
-    let (ex_r, ex_t) = base.exact_gradient();
-    assert!((rep.d_stiffness_d_radius / ex_r - 1.0).abs() < 1e-6);
-    assert!((rep.d_stiffness_d_half_angle_deg / (ex_t * PI / 180.0) - 1.0).abs() < 1e-6);
+    let k = |d: [f64; 3]| {
+        ConicalCutter {
+            ball_radius: base.ball_radius + d[0],
+            half_angle: base.half_angle + d[1],
+            length: base.length + d[2],
+            ..base
+        }
+        .report(&opts)
+        .unwrap()
+        .stiffness_n_per_mm
+    };
+    let an = [
+        rep.d_stiffness_d_ball_radius,
+        rep.d_stiffness_d_half_angle,
+        rep.d_stiffness_d_length,
+    ];
+    let exact = base.exact_gradient();
+    for i in 0..3 {
+        let h = 1e-5;
+        let mut e = [0.0; 3];
+        e[i] = h;
+        let fd = (k(e) - k(e.map(|x| -x))) / (2.0 * h);
+        assert!((an[i] / fd - 1.0).abs() < 1e-6, "{i}: {} vs {fd}", an[i]);
+        assert!(
+            (an[i] / exact[i] - 1.0).abs() < 1e-6,
+            "{i}: {} vs {}",
+            an[i],
+            exact[i]
+        );
+    }
+}
+
+/// The model and a catalogue cutter whose cone runs up to the holder face are the same beam.
+#[test]
+fn conical_model_is_the_catalogue_cutter_beam() {
+    let (r, t, len) = (2.5, deg(4.0), 45.0);
+    let model = ConicalCutter::new(r, t, len, E_CARBIDE).unwrap();
+    let shape = CutterShape::TaperedBallEnd {
+        ball_radius: r,
+        half_angle: t,
+    };
+    let cutter = Cutter::new("tbe", shape, len, shape.radius_at(len), len).unwrap();
+    let beam = cutter_beam(&cutter, E_CARBIDE).unwrap();
+    assert!((beam.exact_stiffness() / model.exact_stiffness() - 1.0).abs() < 1e-12);
 }
 
 #[test]
@@ -131,7 +153,7 @@ fn invalid_inputs_are_typed_errors() {
 proptest! {
     #[test]
     fn ritz_is_an_upper_bound_close_to_exact(r in 0.5f64..8.0, t in 0.0f64..10.0, l in 10.0f64..120.0) {
-        let c = ConicalCutter::new(r, deg(t), l, E_CARBIDE).unwrap();
+        let c = ConicalCutter::from_load_plane(r, deg(t), l, E_CARBIDE).unwrap();
         let rep = c.report(&RitzOptions::default()).unwrap();
         prop_assert!(rep.stiffness_n_per_mm >= rep.exact_n_per_mm * (1.0 - 1e-12));
         prop_assert!((rep.stiffness_n_per_mm / rep.exact_n_per_mm - 1.0).abs() < 1e-6);

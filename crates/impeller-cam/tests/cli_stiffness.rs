@@ -34,8 +34,15 @@ fn json_has_the_contract_fields_and_matches_the_closed_form() {
     assert!((exact / closed - 1.0).abs() < 1e-12);
     assert!((k / closed - 1.0).abs() < 1e-9);
     assert!(v["terms"].as_u64().unwrap() >= 2);
-    assert!(v["d_stiffness_d_radius"].as_f64().unwrap() > 0.0);
-    assert!(v["d_stiffness_d_half_angle_deg"].as_f64().unwrap() > 0.0);
+    // Gradient in the command's own parameters: ∂k/∂r (θ, L held), ∂k/∂θ per degree.
+    let c = 3.0 * std::f64::consts::PI * 600e3 / (4.0 * 40f64.powi(3));
+    let dk_dr = c * (r_big.powi(3) + 3.0 * 3.14 * r_big.powi(2));
+    let sec2 = 1.0 / 3f64.to_radians().cos().powi(2);
+    let dk_dt_deg = c * 3.0 * 3.14 * r_big.powi(2) * 40.0 * sec2 * std::f64::consts::PI / 180.0;
+    let gr = v["d_stiffness_d_radius"].as_f64().unwrap();
+    let gt = v["d_stiffness_d_half_angle_deg"].as_f64().unwrap();
+    assert!((gr / dk_dr - 1.0).abs() < 1e-6, "{gr} vs {dk_dr}");
+    assert!((gt / dk_dt_deg - 1.0).abs() < 1e-6, "{gt} vs {dk_dt_deg}");
 }
 
 #[test]

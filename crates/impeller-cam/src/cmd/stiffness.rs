@@ -2,6 +2,20 @@
 
 use crate::error::CliError;
 use cutter_stiffness::{ConicalCutter, RitzOptions};
+use serde::Serialize;
+
+/// What `--json` prints: the indicator and its gradient in the command's own parameters
+/// (radius at the ball-centre plane, half angle in degrees, chuck-to-ball-centre length).
+#[derive(Debug, Serialize)]
+struct Output {
+    stiffness_n_per_mm: f64,
+    exact_n_per_mm: f64,
+    terms: usize,
+    /// ∂k/∂(radius at the ball-centre plane), half angle and length held (N/mm per mm).
+    d_stiffness_d_radius: f64,
+    /// ∂k/∂θ, radius at the ball-centre plane and length held (N/mm per degree).
+    d_stiffness_d_half_angle_deg: f64,
+}
 
 /// Arguments of `impeller-cam stiffness`.
 #[derive(Debug, clap::Args)]
@@ -29,20 +43,32 @@ pub struct Args {
 
 /// Computes and prints the indicator, its exact value and gradient.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let cutter = ConicalCutter::new(
-        args.tip_radius,
-        args.half_angle.to_radians(),
-        args.length,
-        args.youngs * 1000.0,
-    )
-    .map_err(|e| CliError::Message(e.to_string()))?;
+    // The command speaks the literature's beam form; the model is parametrised by ball radius
+    // r = r_c cos θ and tip-to-chuck length L + r (see cutter_stiffness::ConicalCutter).
+    let theta = args.half_angle.to_radians();
+    let cutter =
+        ConicalCutter::from_load_plane(args.tip_radius, theta, args.length, args.youngs * 1000.0)
+            .map_err(|e| CliError::Message(e.to_string()))?;
     let options = RitzOptions {
         terms: args.terms,
         ..RitzOptions::default()
     };
-    let report = cutter
+    let rep = cutter
         .report(&options)
         .map_err(|e| CliError::Message(e.to_string()))?;
+    // Chain rule back to (r_c, θ, L): r = r_c cos θ, length = L + r_c cos θ.
+    let (sn, co) = theta.sin_cos();
+    let k_r = rep.d_stiffness_d_ball_radius;
+    let k_len = rep.d_stiffness_d_length;
+    let report = Output {
+        stiffness_n_per_mm: rep.stiffness_n_per_mm,
+        exact_n_per_mm: rep.exact_n_per_mm,
+        terms: rep.terms,
+        d_stiffness_d_radius: (k_r + k_len) * co,
+        d_stiffness_d_half_angle_deg: (rep.d_stiffness_d_half_angle
+            - (k_r + k_len) * args.tip_radius * sn)
+            * (std::f64::consts::PI / 180.0),
+    };
     if args.json {
         let text =
             serde_json::to_string_pretty(&report).map_err(|e| CliError::Message(e.to_string()))?;

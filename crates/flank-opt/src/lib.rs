@@ -1,0 +1,73 @@
+//! Flank (SWARF) milling of impeller blades: the cutter's flank cuts a whole ruled blade side
+//! in one pass, the ball end finishing the hub fillet at the same time.
+//!
+//! Two operation kinds (DESIGN §4):
+//!
+//! - [`FLANK_FINISHING`] ([`finishing`]): paper 002. Initial cutter locations by two-point
+//!   tangency with the ball lowered onto the hub; then the cutter shape (ball radius, half
+//!   taper angle) and the path (the control points of the two guide curves of the tool-axis
+//!   trajectory surface) optimised together for the Rayleigh–Ritz stiffness under accuracy,
+//!   hub-tangency and clearance constraints by SLP ([`slp`], LPs by clarabel); the catalogue
+//!   cutter just below the optimum ([`catalogue`]); the path of the job's tool optimised as a
+//!   minimax problem; the best cylindrical ball end for comparison.
+//! - [`FLANK_SEMI_FINISHING`] ([`semi`]): paper 001 §4. Each free-form blade side split into
+//!   sub-ruled strips within the semi-finish tolerance, one flank pass per strip from the
+//!   shroud down; compared with isoparametric point milling at the same scallop height.
+//!
+//! Why clarabel: it is the workspace's LP/QP/SOCP solver (DESIGN §2), a maintained pure-Rust
+//! interior-point code with sparse KKT factorisation, which fits LPs of a few hundred
+//! variables and a thousand rows per SLP iteration.
+//!
+//! Dependency direction: `nurbs`, `cam-core`, `impeller-model`, `cutter-stiffness`,
+//! `cam-plan` only.
+
+pub mod catalogue;
+pub mod finishing;
+pub mod geometry;
+pub mod problem;
+pub mod semi;
+pub mod slp;
+
+pub use catalogue::Catalogue;
+pub use finishing::{build_flank_finishing, FinishingParams};
+pub use geometry::{FlankSide, InitialPath};
+pub use semi::{build_flank_semi_finishing, SemiParams};
+
+/// Kind name of flank finishing in job files.
+pub const FLANK_FINISHING: &str = "flank_finishing";
+/// Kind name of sub-ruled flank semi-finishing in job files.
+pub const FLANK_SEMI_FINISHING: &str = "flank_semi_finishing";
+
+/// Errors of the flank planners (wrapped into [`cam_plan::PlanError`] with the operation's
+/// name at the operation boundary).
+#[derive(Debug, thiserror::Error)]
+pub enum FlankError {
+    /// A parameter is out of range.
+    #[error("{0}")]
+    Param(String),
+    /// The geometry defeats the method.
+    #[error("{0}")]
+    Geometry(String),
+    /// The LP solver failed.
+    #[error("LP solver: {0}")]
+    Solver(String),
+    /// An envelope or cutter error.
+    #[error(transparent)]
+    Cam(#[from] cam_core::CamError),
+    /// An impeller model error.
+    #[error(transparent)]
+    Model(#[from] impeller_model::ModelError),
+}
+
+impl FlankError {
+    /// As a planning error of operation `op`.
+    pub fn plan(self, op: &str) -> cam_plan::PlanError {
+        match self {
+            FlankError::Param(m) => cam_plan::PlanError::param(op, "parameters", m),
+            FlankError::Geometry(m) => cam_plan::PlanError::geometry(op, "blade side", m),
+            FlankError::Solver(m) => cam_plan::PlanError::geometry(op, "optimiser", m),
+            FlankError::Cam(e) => cam_plan::PlanError::cam(op, e),
+            FlankError::Model(e) => cam_plan::PlanError::model(op, e),
+        }
+    }
+}

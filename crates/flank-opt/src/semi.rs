@@ -1,0 +1,373 @@
+//! The `flank_semi_finishing` operation: sub-ruled strips (paper 001 §4, "Generation of the
+//! sub-ruled surface blades" and the semi-finishing it enables).
+//!
+//! A free-form blade side is not a ruled surface, so one flank pass cannot follow it; but a
+//! narrow strip of it between two isoparametric lines `v = a, v = b` is within a tolerance of
+//! the ruled surface through those lines. For each side:
+//!
+//! 1. strips: [`impeller_model::ruled::sub_ruled_strips`] within `strip_tol_mm` (greedy from
+//!    the shroud down; each strip's measured deviation kept);
+//! 2. one flank pass per strip, the strip nearest the shroud first: at `passes_along`
+//!    rulings the cutter axis is tangent, at the strip's two edge points, to the ruled
+//!    surface offset by the blade allowance (two-point tangency with the cutter's own radius
+//!    at each contact height), the strip's lower edge at the ball-centre height;
+//! 3. interference check: the design side below the strip (the lower strips, still carrying
+//!    their allowance) and the hub must stay at least `allowance − strip_tol` from the pass's
+//!    swept envelope ([`cam_core::SweptEnvelope`], certified distances); a pass that comes
+//!    nearer is lifted along its axes by bisection until it keeps that distance;
+//! 4. baseline: isoparametric point milling of the same side with the same tool: zig-zag
+//!    passes along u, step-over across for the scallop height `h` equal to `strip_tol_mm`
+//!    (`w = 2√(2Rh − h²)` between passes on a locally flat side, R the ball radius); its path
+//!    length is the sum of the pass lengths and step-overs (arc lengths from 200-point
+//!    polylines).
+//!
+//! Metrics: `sub_ruled_strips` (over every side), `max_deviation_mm` (largest strip
+//! deviation), `point_milling_path_length_mm`, plus `flank_path_length_mm` (cutting moves of
+//! one blade) and `interference_lifts` (passes lifted). Complexity per side: the strip
+//! search (impeller-model) plus O(strips · passes_along · samples) envelope queries.
+
+use crate::geometry::{ball_radius, guides_through, member_radius};
+use crate::{FlankError, FLANK_SEMI_FINISHING};
+use cam_core::{
+    CutterShape, EnvelopeOptions, Move, Point3, SphereFamily, SweptEnvelope, ToolPath, Vector3,
+};
+use cam_plan::{Metrics, Operation, OperationSpec, PlanContext, PlanError, PlannedOperation};
+use impeller_model::{Blade, Side};
+use serde::Deserialize;
+
+fn default_tol() -> f64 {
+    0.1
+}
+fn default_along() -> usize {
+    30
+}
+
+/// The kind's own keys (job file, `[[operations]]` of kind `flank_semi_finishing`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SemiParams {
+    /// Semi-finish tolerance: largest deviation of a strip from its ruled surface, and the
+    /// scallop height of the point-milling baseline (mm, default 0.1).
+    #[serde(default = "default_tol")]
+    pub strip_tol_mm: f64,
+    /// Cutter locations per pass (default 30).
+    #[serde(default = "default_along")]
+    pub passes_along: usize,
+}
+
+/// The operation.
+#[derive(Debug, Clone)]
+pub struct FlankSemiFinishing {
+    name: String,
+    tool: String,
+    params: SemiParams,
+}
+
+/// Builds a `flank_semi_finishing` operation from its job table.
+pub fn build_flank_semi_finishing(spec: &OperationSpec) -> Result<Box<dyn Operation>, PlanError> {
+    let params: SemiParams = cam_plan::params::parse(spec)?;
+    if !(params.strip_tol_mm.is_finite() && params.strip_tol_mm > 0.0) {
+        return Err(PlanError::param(&spec.name, "strip_tol_mm", "must be > 0"));
+    }
+    if !(4..=500).contains(&params.passes_along) {
+        return Err(PlanError::param(
+            &spec.name,
+            "passes_along",
+            "must be in 4..=500",
+        ));
+    }
+    Ok(Box::new(FlankSemiFinishing {
+        name: spec.name.clone(),
+        tool: spec.tool.clone(),
+        params,
+    }))
+}
+
+/// Bisection steps of the interference lift (the bracket is the strip height; 30 halvings
+/// leave < 1e-7 of it).
+const LIFT_BISECTIONS: usize = 30;
+/// Samples across and along the design side below a strip for the interference check.
+const CHECK_GRID: (usize, usize) = (24, 6);
+/// Points of the polylines measuring isocurve lengths for the baseline.
+const LENGTH_POINTS: usize = 200;
+
+impl Operation for FlankSemiFinishing {
+    fn kind(&self) -> &'static str {
+        FLANK_SEMI_FINISHING
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn tool(&self) -> &str {
+        &self.tool
+    }
+    fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
+        self.plan_inner(ctx).map_err(|e| e.plan(&self.name))
+    }
+}
+
+/// One flank pass over a strip.
+struct Pass {
+    locations: Vec<cam_core::CutterLocation>,
+    lifted: bool,
+}
+
+fn polyline_length(pts: &[Vector3]) -> f64 {
+    pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+/// Path length of isoparametric zig-zag point milling of `side` between `v_range` with a
+/// ball of radius `r` at scallop height `h` (module docs).
+pub fn point_milling_length(blade: &Blade, side: Side, v_range: (f64, f64), r: f64, h: f64) -> f64 {
+    let s = blade.side(side);
+    let ((u0, u1), _) = s.domain();
+    let m = LENGTH_POINTS;
+    // Widest extent across (largest v-isocurve length over u).
+    let across = (0..=10)
+        .map(|i| {
+            let u = u0 + (u1 - u0) * i as f64 / 10.0;
+            let pts: Vec<Vector3> = (0..m)
+                .map(|j| {
+                    s.point(
+                        u,
+                        v_range.0 + (v_range.1 - v_range.0) * j as f64 / (m - 1) as f64,
+                    )
+                })
+                .collect();
+            polyline_length(&pts)
+        })
+        .fold(0.0, f64::max);
+    let h = h.min(r);
+    let step = 2.0 * (2.0 * r * h - h * h).sqrt();
+    let passes = (across / step).ceil() as usize + 1;
+    let mut total = 0.0;
+    let mut prev_end: Option<Vector3> = None;
+    for k in 0..passes {
+        let v = v_range.0 + (v_range.1 - v_range.0) * k as f64 / (passes - 1).max(1) as f64;
+        let mut pts: Vec<Vector3> = (0..m)
+            .map(|j| s.point(u0 + (u1 - u0) * j as f64 / (m - 1) as f64, v))
+            .collect();
+        if k % 2 == 1 {
+            pts.reverse();
+        }
+        total += polyline_length(&pts);
+        if let (Some(e), Some(f)) = (prev_end, pts.first()) {
+            total += (f - e).norm();
+        }
+        prev_end = pts.last().copied();
+    }
+    total
+}
+
+impl FlankSemiFinishing {
+    fn plan_inner(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, FlankError> {
+        let p = &self.params;
+        let cutter = &ctx.tool.cutter;
+        let shape = cutter.shape;
+        let r = ball_radius(&shape);
+        if !matches!(
+            shape,
+            CutterShape::BallEnd { .. } | CutterShape::TaperedBallEnd { .. }
+        ) {
+            return Err(FlankError::Param(format!(
+                "flank semi-finishing needs a ball or tapered ball end, not {shape:?}"
+            )));
+        }
+        let allowance = ctx.process.blade_allowance_mm;
+        let blade = ctx.impeller.main().blade().clone();
+        let mut strips_total = 0;
+        let mut max_dev = 0.0f64;
+        let mut baseline = 0.0;
+        let mut lifts = 0;
+        let mut path = ToolPath::new(&self.name, &self.tool);
+        for side in [Side::Pressure, Side::Suction] {
+            let v_range = match blade.design() {
+                Some(_) => blade.hub_shroud_v(side),
+                None => ctx.impeller.span_v_range(&blade, side).ok_or_else(|| {
+                    FlankError::Geometry(format!("{side:?} side: hub or shroud edge not found"))
+                })?,
+            };
+            let strips =
+                impeller_model::ruled::sub_ruled_strips(&blade, side, v_range, p.strip_tol_mm)?;
+            strips_total += strips.len();
+            baseline += point_milling_length(&blade, side, v_range, r, p.strip_tol_mm);
+            for strip in &strips {
+                max_dev = max_dev.max(strip.max_deviation_mm);
+                let pass = self.strip_pass(ctx, &blade, side, strip, v_range, allowance)?;
+                lifts += usize::from(pass.lifted);
+                let moves: Vec<Move> = pass.locations.iter().map(|cl| Move::feed(*cl)).collect();
+                if let (Some(last), Some(first)) = (path.moves.last(), moves.first()) {
+                    let link = ctx
+                        .linker
+                        .link(&last.cl, &first.cl, 5.0)
+                        .map_err(|e| FlankError::Geometry(e.to_string()))?;
+                    path.moves.extend(link);
+                }
+                path.moves.extend(moves);
+            }
+        }
+        let flank_len = path.cutting_length_mm();
+        ctx.linker
+            .close(&mut path, 5.0)
+            .map_err(|e| FlankError::Geometry(e.to_string()))?;
+        let count = ctx.impeller.main().count();
+        let order: Vec<usize> = (0..count).collect();
+        let mut out = PlannedOperation {
+            paths: cam_plan::pattern::copy_to(&path, ctx.impeller.main().pitch_rad(), &order),
+            ..Default::default()
+        };
+        let mut m = Metrics::new();
+        m.count("sub_ruled_strips", strips_total);
+        m.number("max_deviation_mm", max_dev);
+        m.number("point_milling_path_length_mm", baseline);
+        m.number("flank_path_length_mm", flank_len);
+        m.count("interference_lifts", lifts);
+        out.metrics = m;
+        if lifts > 0 {
+            out.notes.push(format!(
+                "{lifts} pass(es) lifted along the axis to keep the allowance on the strips \
+                 below and the hub"
+            ));
+        }
+        Ok(out)
+    }
+
+    /// The flank pass of one strip (module docs, steps 2–3).
+    fn strip_pass(
+        &self,
+        ctx: &PlanContext<'_>,
+        blade: &Blade,
+        side: Side,
+        strip: &impeller_model::ruled::RuledStrip,
+        v_range: (f64, f64),
+        allowance: f64,
+    ) -> Result<Pass, FlankError> {
+        let cutter = &ctx.tool.cutter;
+        let shape = cutter.shape;
+        let r = ball_radius(&shape);
+        let n = self.params.passes_along;
+        let s = blade.side(side);
+        let ((u0, u1), _) = s.domain();
+        let (a, b) = strip.v_range;
+        let mut centres = Vec::with_capacity(n);
+        let mut tops = Vec::with_capacity(n);
+        let mut upper: f64 = 0.0;
+        let mut axes = Vec::with_capacity(n);
+        for i in 0..n {
+            let u = u0 + (u1 - u0) * i as f64 / (n - 1) as f64;
+            let (pa, pb) = (s.point(u, a), s.point(u, b));
+            let na = blade
+                .outward_normal(side, u, a)
+                .ok_or_else(|| FlankError::Geometry(format!("{side:?}: no normal at u = {u}")))?;
+            let nb = blade
+                .outward_normal(side, u, b)
+                .ok_or_else(|| FlankError::Geometry(format!("{side:?}: no normal at u = {u}")))?;
+            // Two-point tangency with the lower edge at the ball-centre height.
+            let (mut ha, mut hb) = (r, r + (pb - pa).norm());
+            let mut axis = (pb - pa).normalize();
+            let mut tip = pa;
+            for _ in 0..4 {
+                let qa = pa + na * (member_radius(&shape, ha) + allowance);
+                let qb = pb + nb * (member_radius(&shape, hb) + allowance);
+                axis = (qb - qa).normalize();
+                tip = qa - axis * r;
+                ha = r;
+                hb = (qb - tip).dot(&axis);
+            }
+            upper = upper.max(hb - r);
+            centres.push(tip + axis * r);
+            axes.push(axis);
+        }
+        let upper = upper.max(r);
+        for (c, ax) in centres.iter().zip(&axes) {
+            tops.push(c + ax * upper);
+        }
+        // Interference check points: the side below the strip and the hub under the pass.
+        let mut checks: Vec<(Point3, f64)> = Vec::new();
+        let (cu, cv) = CHECK_GRID;
+        if a > v_range.0 + 1e-9 {
+            for i in 0..cu {
+                let u = u0 + (u1 - u0) * i as f64 / (cu - 1) as f64;
+                for j in 0..cv {
+                    let v = v_range.0 + (a - v_range.0) * j as f64 / (cv - 1) as f64;
+                    let q = s.point(u, v);
+                    if ctx.impeller.hub().signed_distance(&q) > r {
+                        checks.push((Point3::from(q), allowance));
+                    }
+                }
+            }
+        }
+        for c in &centres {
+            // The hub point below each ball centre.
+            let hub = ctx.impeller.hub();
+            let (t, phi, _) = hub.closest(c);
+            checks.push((
+                Point3::from(hub.point(t, phi)),
+                ctx.process.hub_allowance_mm,
+            ));
+        }
+        let tol = self.params.strip_tol_mm;
+        let family = SphereFamily::from_shape(&shape, cutter.flute_length)?;
+        let fits = |lift: f64| -> Result<bool, FlankError> {
+            let c: Vec<Vector3> = centres
+                .iter()
+                .zip(&axes)
+                .map(|(c, ax)| c + ax * lift)
+                .collect();
+            let t: Vec<Vector3> = tops
+                .iter()
+                .zip(&axes)
+                .map(|(c, ax)| c + ax * lift)
+                .collect();
+            let (g0, g1) = guides_through(&c, &t)?;
+            let env = SweptEnvelope::new(family.clone(), g0, g1, r, EnvelopeOptions::default())?;
+            let mut hint = None;
+            for (q, keep) in &checks {
+                let d = env.signed_distance(q, hint)?;
+                hint = Some(d.param);
+                if d.distance < keep - tol {
+                    return Ok(false);
+                }
+            }
+            Ok(true)
+        };
+        let mut lift = 0.0;
+        let mut lifted = false;
+        if !fits(0.0)? {
+            lifted = true;
+            let (mut lo, mut hi) = (0.0, upper);
+            if !fits(hi)? {
+                return Err(FlankError::Geometry(format!(
+                    "{side:?} side: the pass of strip v ∈ [{a:.4}, {b:.4}] interferes below \
+                     even when lifted by the strip height"
+                )));
+            }
+            for _ in 0..LIFT_BISECTIONS {
+                let mid = 0.5 * (lo + hi);
+                if fits(mid)? {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            lift = hi;
+        }
+        let c: Vec<Vector3> = centres
+            .iter()
+            .zip(&axes)
+            .map(|(c, ax)| c + ax * lift)
+            .collect();
+        let t: Vec<Vector3> = tops
+            .iter()
+            .zip(&axes)
+            .map(|(c, ax)| c + ax * lift)
+            .collect();
+        let (g0, g1) = guides_through(&c, &t)?;
+        let env = SweptEnvelope::new(family, g0, g1, r, EnvelopeOptions::default())?;
+        let (lo, hi) = env.domain();
+        let locations = (0..n)
+            .map(|i| env.cutter_location(lo + (hi - lo) * i as f64 / (n - 1) as f64))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Pass { locations, lifted })
+    }
+}
