@@ -1,0 +1,2 @@
+//! Variable-axis plunge roughing (WIP).
+pub mod axial_depth;
