@@ -57,6 +57,9 @@ pub const PARALLEL_TOL: f64 = 1e-12;
 /// Rim points tried for the seed: 16 directions put a sample within 11.25° of the contact.
 pub const SEED_RIM_SAMPLES: usize = 16;
 
+/// Warm start of a contact solve: floor parameters `(u, v)` and axial position `t`.
+pub type ContactSeed = ((f64, f64), f64);
+
 /// A floor point with its first derivatives and unit normal toward the cutter's side.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FloorPoint {
@@ -304,9 +307,8 @@ pub fn solve_contact<F: Floor + ?Sized>(
     seed: Option<((f64, f64), f64)>,
 ) -> Result<Contact, DepthError> {
     let pv = p.coords;
-    if !(pv.iter().all(|c| c.is_finite()) && q.iter().all(|c| c.is_finite()))
-        || !(radius.is_finite() && radius >= 0.0)
-    {
+    let finite = pv.iter().all(|c| c.is_finite()) && q.iter().all(|c| c.is_finite());
+    if !(finite && radius.is_finite() && radius >= 0.0) {
         return Err(DepthError::NonFinite);
     }
     let q = q.normalize();
