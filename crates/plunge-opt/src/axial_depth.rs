@@ -444,7 +444,7 @@ mod tests {
     /// (root along the axis), maximised, then refined by golden section around the best
     /// angle — an answer independent of the Newton iteration.
     fn brute(floor: &dyn Floor, p: &Point3, q: &Vector3, r: f64) -> f64 {
-        depth_by_projection(floor, p, q, r, 4, 720).unwrap()
+        depth_by_projection(floor, p, q, r, 3, 180).unwrap()
     }
 
     fn check(floor: &dyn Floor, p: Point3, q: Vector3, r: f64) -> Contact {

@@ -110,7 +110,7 @@ fn alpha_of(
     seed: Option<((f64, f64), f64)>,
 ) -> Option<(f64, ContactSeed)> {
     let (q, c) = builder.contact(centre, w, seed).ok()?;
-    Some((PostureBuilder::alpha(&q, &c), (c.uv, c.t)))
+    Some((builder.alpha(&q, &c), (c.uv, c.t)))
 }
 
 /// Optimises one row's axes (outlet → inlet) with W-curve parameter step `step`.

@@ -15,7 +15,8 @@
 //!   the higher of that and the height where the bottom disk leaves the blank, plus the start
 //!   clearance — the plunge starts in air.
 //!
-//! `α`, the angle between the hub normal at the contact point and the axis, is what the
+//! `α`, the angle between the hub normal at the
+//! contact point and the axis, is what the
 //! optimisation of [`crate::axis_optimisation`] makes increase along a row.
 
 use crate::axial_depth::{solve_contact, Contact, DepthError, RevolvedFloor};
@@ -123,8 +124,12 @@ impl<'a> PostureBuilder<'a> {
         Ok((q, c))
     }
 
-    /// α of a contact: the angle between the hub normal there and the axis `q`.
-    pub fn alpha(q: &Vector3, c: &Contact) -> f64 {
+    /// α of a contact: the angle between the hub normal there and the axis `q` (paper 000
+    /// §3, unsigned as the paper defines it). `self` is kept so a signed variant (lean toward
+    /// the inlet) can replace it without changing callers; see the crate docs for why the
+    /// unsigned angle is used.
+    pub fn alpha(&self, q: &Vector3, c: &Contact) -> f64 {
+        let _ = &self.hub;
         c.normal.dot(q).clamp(-1.0, 1.0).acos()
     }
 
@@ -168,7 +173,7 @@ impl<'a> PostureBuilder<'a> {
                 axis,
             },
             contact,
-            alpha: Self::alpha(&q, &contact),
+            alpha: self.alpha(&q, &contact),
         })
     }
 
