@@ -2,7 +2,9 @@
 //! collision-ready frusta), cutter locations, moves, tool paths, named tolerances — and the
 //! distance-function core of flank milling: a cutter as an exact family of spheres
 //! ([`sphere_family`]) and the signed distance from a point to the envelope it sweeps along a
-//! two-guide tool-axis trajectory, with closed-form derivatives ([`envelope`]).
+//! two-guide tool-axis trajectory, with closed-form derivatives ([`envelope`]); cutter-to-surface
+//! contact: the cutter location touching a surface point for every cutter shape and the
+//! scallop height between neighbouring passes ([`contact`]).
 //!
 //! Conventions (see the workspace `DESIGN.md` §3): lengths in millimetres, angles in radians,
 //! `f64` throughout. A cutter location is the tool *tip* (lowest point of the cutter on its
@@ -10,6 +12,7 @@
 
 pub mod apt;
 pub mod assembly;
+pub mod contact;
 pub mod cutter;
 pub mod envelope;
 pub mod error;
@@ -21,6 +24,11 @@ pub mod tolerance;
 
 pub use apt::{AptCutter, APT_CONSISTENCY_TOL};
 pub use assembly::Frustum;
+pub use contact::{
+    ball_scallop, ball_step_over, bull_nose_effective_radius, bull_nose_scallop,
+    bull_nose_step_over, contact_location, contact_location_at_height, scallop_approx,
+    step_over_approx, Contact, ContactError, ContactPart,
+};
 pub use cutter::{Cutter, CutterShape, HolderSegment};
 pub use envelope::{
     ControlPointGradient, EnvelopeDistance, EnvelopeGradient, EnvelopeOptions, EnvelopeParam,
