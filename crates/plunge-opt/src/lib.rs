@@ -47,6 +47,16 @@
 //! (both default to 0.8 × the cutting-edge length and must stay below it),
 //! `blade_allowance_mm`, `hub_allowance_mm`, the plunge feed.
 //!
+//! # α: unsigned, as the paper defines it
+//! α is the (unsigned) angle between the hub normal at the contact point and the axis. A
+//! signed variant (lean toward the inlet positive) was tried: on hubs that turn from axial at
+//! the inlet to radial at the outlet the hub normal turns toward the inlet faster than the
+//! channel rulings, so a signed α falls steadily along every conventional row and "strictly
+//! increasing" would need W points beyond the W curve's inlet end. With the unsigned angle,
+//! conventional rows of such hubs already have increasing α where their axes lean back, and
+//! the walk only lifts local dips (`tests/optimisation.rs` builds such dips). When the W
+//! curve ends before α can rise, the plunge keeps its axis and `alpha_monotone` is false.
+//!
 //! # Metrics
 //! `interference_positions_before` / `_after` (all channels), `alpha_monotone`,
 //! `hub_allowance_max_mm` / `_mean_mm` (final axes; `_before_` versions for the conventional
