@@ -1,0 +1,109 @@
+//! Criterion benchmarks: the axial-depth solve of one plunge (goal ≤ 2 µs) and planning one
+//! whole channel section of `fixtures/impeller-plunge-400` with the Ø30 cutter.
+//!
+//! `cargo bench -p plunge-opt --bench plunge -- --warm-up-time 1 --measurement-time 3`
+
+#![allow(clippy::expect_used, clippy::unwrap_used)]
+
+use cam_core::{Cutter, CutterShape, HolderSegment, Point3, Tolerances, Vector3};
+use cam_plan::{
+    ClearanceOptions, DesignClearance, Linker, OperationSpec, PlanContext, Process, SafetySurface,
+    Tool,
+};
+use criterion::{criterion_group, criterion_main, Criterion};
+use plunge_opt::axial_depth::{solve_contact, Floor, RevolvedFloor};
+use std::hint::black_box;
+use std::path::PathBuf;
+
+fn depth(c: &mut Criterion) {
+    let hub = impeller_model::MeridionalCurve::quarter_ellipse([125.0, 40.0], [20.0, 200.0])
+        .expect("contour");
+    let floor = RevolvedFloor::offset(&hub, 0.5);
+    let t = hub.param_at_fraction(0.6);
+    let fp = floor.eval(t, 0.2);
+    let q: Vector3 = (fp.n + fp.su.normalize() * 0.15).normalize();
+    let p = Point3::from(fp.p + fp.n * 30.0);
+    let cold = solve_contact(&floor, &p, &q, 15.0, None).expect("contact");
+    c.bench_function("depth_solve_cold_seed", |b| {
+        b.iter(|| solve_contact(&floor, black_box(&p), black_box(&q), 15.0, None))
+    });
+    // Warm start from the neighbouring plunge, as the optimisation walk and rows do.
+    let q2: Vector3 = (fp.n + fp.su.normalize() * 0.16).normalize();
+    c.bench_function("depth_solve_warm", |b| {
+        b.iter(|| {
+            solve_contact(
+                &floor,
+                black_box(&p),
+                black_box(&q2),
+                15.0,
+                Some((cold.uv, cold.t)),
+            )
+        })
+    });
+}
+
+fn channel(c: &mut Criterion) {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/impeller-plunge-400");
+    let impeller = impeller_model::load(root.join("impeller.toml")).expect("fixture");
+    let stock = impeller.stock().clone();
+    let mut cutter = Cutter::new(
+        "plunge-d30",
+        CutterShape::FlatEnd { radius: 15.0 },
+        45.0,
+        14.0,
+        140.0,
+    )
+    .expect("cutter");
+    cutter.holder = vec![HolderSegment {
+        bottom_radius: 25.0,
+        top_radius: 25.0,
+        length: 45.0,
+    }];
+    let tool = Tool {
+        number: 31,
+        cutter,
+        teeth: 3,
+        tool_length_mm: 210.0,
+        plunge_edge_length_mm: Some(8.0),
+    };
+    let process = Process {
+        spindle_rpm: 3000.0,
+        feed_per_tooth_mm: 0.1,
+        plunge_feed_per_tooth_mm: Some(0.06),
+        depth_of_cut_mm: None,
+        width_of_cut_mm: None,
+        blade_allowance_mm: 1.0,
+        hub_allowance_mm: 0.5,
+        rapid_mm_per_min: 10_000.0,
+    };
+    let spec = OperationSpec {
+        name: "plunge-d30".into(),
+        kind: plunge_opt::KIND.into(),
+        tool: "plunge-d30".into(),
+        process,
+        params: toml::Table::new(),
+    };
+    let op = plunge_opt::PlungeRoughing::from_spec(&spec).expect("op");
+    let clearance =
+        DesignClearance::new(&impeller, &tool, ClearanceOptions::default()).expect("clearance");
+    let linker = Linker::new(SafetySurface::around_stock(&stock, 10.0).expect("safety"));
+    let tolerances = Tolerances::default();
+    let ctx = PlanContext {
+        impeller: &impeller,
+        stock: &stock,
+        tool: &tool,
+        tolerances: &tolerances,
+        process: &process,
+        clearance: &clearance,
+        linker: &linker,
+    };
+    let mut g = c.benchmark_group("plan");
+    g.sample_size(10);
+    g.bench_function("channel_section_d30", |b| {
+        b.iter(|| op.plan_section(black_box(&ctx)).expect("plan"))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, depth, channel);
+criterion_main!(benches);

@@ -1,0 +1,500 @@
+//! The `plunge_roughing` operation: its job keys, planning of one section of every channel,
+//! metrics and plots.
+
+use crate::allowance::{hub_allowance, HubAllowance};
+use crate::axis_optimisation::{optimise_row, OptimisedRow, DEFAULT_W_STEP};
+use crate::conventional_axes::{Posture, PostureBuilder};
+use crate::interference::{core_travel, interfering_count, ClearedRegion, Material, Stroke};
+use crate::rows::{plan_rows, stations, ChannelFrame, RowSettings};
+use crate::toolpath::channel_path;
+use crate::KIND;
+use cam_core::CutterShape;
+use cam_plan::{
+    order, pattern, ClearanceOptions, DesignClearance, Metrics, Operation, OperationSpec, PartSet,
+    PlanContext, PlanError, PlannedOperation, Plot, PlotKind, PlotSeries,
+};
+use rayon::prelude::*;
+use serde::Deserialize;
+
+/// Default fraction of the cutting-edge length used as width of cut and plunge step when the
+/// process row gives none: 80 % keeps the centre disk inside the previous holes with a margin.
+pub const DEFAULT_ENGAGEMENT_FRACTION: f64 = 0.8;
+/// Default clearance (mm) of the plunge start over the shroud and the blank.
+pub const DEFAULT_START_CLEARANCE_MM: f64 = 2.0;
+/// Default number of table stations for the side rows and the section-end search.
+pub const DEFAULT_ROW_TABLE_STATIONS: usize = 12;
+
+fn one() -> f64 {
+    1.0
+}
+fn w_step() -> f64 {
+    DEFAULT_W_STEP
+}
+fn yes() -> bool {
+    true
+}
+fn start_clearance() -> f64 {
+    DEFAULT_START_CLEARANCE_MM
+}
+fn table_stations() -> usize {
+    DEFAULT_ROW_TABLE_STATIONS
+}
+
+/// The kind's own keys (see the crate docs and docs/job.md).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlungeParams {
+    /// Meridional fraction of the hub contour where the section begins on its outlet side
+    /// (1 = the outlet; the rows then start with a lead-in plunge off the blank). A section
+    /// that starts inside the channel treats everything toward the outlet from here as
+    /// cleared by the previous section's operation.
+    #[serde(default = "one")]
+    pub start_fraction: f64,
+    /// Where the section ends on its inlet side; default: where the cutter no longer fits
+    /// between the blades with the blade allowance.
+    #[serde(default)]
+    pub end_fraction: Option<f64>,
+    /// Parameter step of the discretised W curve (paper 000: 1e-5).
+    #[serde(default = "w_step")]
+    pub w_curve_step: f64,
+    /// Optimise the axes (paper 000 §3); `false` plans the conventional axes.
+    #[serde(default = "yes")]
+    pub optimise_axes: bool,
+    /// Clearance (mm) of the plunge start over the shroud and the blank.
+    #[serde(default = "start_clearance")]
+    pub start_clearance_mm: f64,
+    /// Stations of the side-row table and the section-end search.
+    #[serde(default = "table_stations")]
+    pub row_table_stations: usize,
+    /// First channel machined (the others follow in +θ order).
+    #[serde(default)]
+    pub first_channel: usize,
+}
+
+/// A plunge-roughing operation (one section of every channel).
+#[derive(Debug, Clone)]
+pub struct PlungeRoughing {
+    name: String,
+    tool: String,
+    params: PlungeParams,
+}
+
+impl PlungeRoughing {
+    /// From a job's operation table.
+    pub fn from_spec(spec: &OperationSpec) -> Result<Self, PlanError> {
+        let params: PlungeParams = cam_plan::params::parse(spec)?;
+        let bad = |key: &str, reason: String| Err(PlanError::param(&spec.name, key, reason));
+        let p = &params;
+        if !(p.start_fraction.is_finite() && p.start_fraction > 0.0 && p.start_fraction <= 1.0) {
+            return bad(
+                "start_fraction",
+                format!("{} must be in (0, 1]", p.start_fraction),
+            );
+        }
+        if let Some(e) = p.end_fraction {
+            if !(e.is_finite() && (0.0..p.start_fraction).contains(&e)) {
+                return bad(
+                    "end_fraction",
+                    format!("{e} must be in [0, start_fraction = {})", p.start_fraction),
+                );
+            }
+        }
+        if !(p.w_curve_step.is_finite() && p.w_curve_step > 0.0 && p.w_curve_step <= 0.01) {
+            return bad(
+                "w_curve_step",
+                format!("{} must be in (0, 0.01]", p.w_curve_step),
+            );
+        }
+        if !(p.start_clearance_mm.is_finite() && p.start_clearance_mm > 0.0) {
+            return bad(
+                "start_clearance_mm",
+                format!("{} must be finite and > 0", p.start_clearance_mm),
+            );
+        }
+        if p.row_table_stations < 2 {
+            return bad(
+                "row_table_stations",
+                format!("{} must be at least 2", p.row_table_stations),
+            );
+        }
+        Ok(Self {
+            name: spec.name.clone(),
+            tool: spec.tool.clone(),
+            params,
+        })
+    }
+
+    /// The parsed keys.
+    pub fn params(&self) -> &PlungeParams {
+        &self.params
+    }
+}
+
+/// Everything planned for channel 0 of one section (before the rotational copy).
+#[derive(Debug, Clone)]
+pub struct SectionPlan {
+    /// Conventional postures per row (outlet → inlet), rows suction → pressure side.
+    pub conventional: Vec<Vec<Posture>>,
+    /// Optimised rows (same order); equal to the conventional ones when optimisation is off.
+    pub optimised: Vec<OptimisedRow>,
+    /// Section ends (meridional fractions): outlet side, inlet side.
+    pub range: (f64, f64),
+    /// Centre-disk travel through uncut material per plunge, conventional axes (mm).
+    pub travel_before: Vec<f64>,
+    /// The same with the final axes (mm).
+    pub travel_after: Vec<f64>,
+    /// Hub allowance with conventional axes.
+    pub allowance_before: HubAllowance,
+    /// Hub allowance with the final axes.
+    pub allowance_after: HubAllowance,
+    /// Smallest blade clearance (cutter, shank, holder) of the final postures (mm).
+    pub min_blade_clearance_mm: f64,
+    /// Wall-clock time of each planning stage (ms).
+    pub timings_ms: Vec<(&'static str, f64)>,
+}
+
+impl SectionPlan {
+    /// The final postures per row.
+    pub fn final_rows(&self) -> Vec<Vec<Posture>> {
+        self.optimised.iter().map(|r| r.postures.clone()).collect()
+    }
+}
+
+fn strokes(rows: &[Vec<Posture>], radius: f64, core: f64) -> Vec<Stroke> {
+    rows.iter()
+        .flatten()
+        .map(|p| Stroke {
+            start: p.start.tip,
+            end: p.cl.tip,
+            axis: p.cl.axis.into_inner(),
+            radius,
+            core_radius: core,
+        })
+        .collect()
+}
+
+impl PlungeRoughing {
+    /// Plans channel 0 of the section (the geometry behind [`Operation::plan`]).
+    pub fn plan_section(&self, ctx: &PlanContext<'_>) -> Result<SectionPlan, PlanError> {
+        let op = self.name.as_str();
+        let tool = ctx.tool;
+        ctx.process.validate(op)?;
+        let (radius, corner) = match tool.cutter.shape {
+            CutterShape::FlatEnd { radius } => (radius, 0.0),
+            CutterShape::BullNose {
+                radius,
+                corner_radius,
+            } => (radius, corner_radius),
+            _ => {
+                return Err(PlanError::tool(
+                    op,
+                    tool.name(),
+                    "plunge roughing needs a flat-end (or bull-nose) plunge cutter",
+                ))
+            }
+        };
+        let edge = tool.plunge_edge_length_mm.ok_or_else(|| {
+            PlanError::tool(
+                op,
+                tool.name(),
+                "plunge_edge_length_mm is required (it defines the non-cutting centre disk)",
+            )
+        })?;
+        let core = tool.core_radius().unwrap_or(0.0);
+        let engagement = |key: &str, v: Option<f64>| -> Result<f64, PlanError> {
+            let v = v.unwrap_or(DEFAULT_ENGAGEMENT_FRACTION * edge);
+            if v < edge {
+                Ok(v)
+            } else {
+                Err(PlanError::param(
+                    op,
+                    format!("process.{key}"),
+                    format!("{v} must be below the cutting-edge length {edge} mm"),
+                ))
+            }
+        };
+        let width = engagement("width_of_cut_mm", ctx.process.width_of_cut_mm)?;
+        let step = engagement("depth_of_cut_mm", ctx.process.depth_of_cut_mm)?;
+        let impeller = ctx.impeller;
+        let mut clock = std::time::Instant::now();
+        let mut timings_ms = Vec::new();
+        let mut lap = |stage: &'static str| {
+            timings_ms.push((stage, clock.elapsed().as_secs_f64() * 1e3));
+            clock = std::time::Instant::now();
+        };
+        let frame = ChannelFrame::new(impeller, op)?;
+        lap("channel_frame");
+        let blades = DesignClearance::new(
+            impeller,
+            tool,
+            ClearanceOptions {
+                parts: PartSet::BLADES,
+                sample_tol_mm: crate::rows::FINAL_CHECK_SAMPLE_TOL_MM,
+            },
+        )?;
+        let required =
+            ctx.process.blade_allowance_mm + 0.5 * crate::rows::FINAL_CHECK_SAMPLE_TOL_MM;
+        let builder = PostureBuilder::new(
+            impeller,
+            ctx.stock,
+            radius,
+            corner,
+            ctx.process.hub_allowance_mm,
+            self.params.start_clearance_mm,
+            op,
+        );
+        let search = DesignClearance::new(
+            impeller,
+            tool,
+            ClearanceOptions {
+                parts: PartSet::BLADES,
+                sample_tol_mm: crate::rows::ROW_SEARCH_SAMPLE_TOL_MM,
+            },
+        )?;
+        let settings = RowSettings {
+            blades: &search,
+            posture: &builder,
+            blade_allowance_mm: ctx.process.blade_allowance_mm,
+            width_of_cut_mm: width,
+            stations: self.params.row_table_stations,
+            operation: op,
+        };
+        let rows = plan_rows(
+            &frame,
+            &settings,
+            self.params.start_fraction,
+            self.params.end_fraction,
+        )?;
+        lap("rows");
+        let lead_in = (self.params.start_fraction >= 1.0).then(|| (ctx.stock.max_radius(), core));
+        let ms = stations(&frame, &rows, step, lead_in);
+        let conventional: Vec<Vec<Posture>> = (0..rows.count)
+            .into_par_iter()
+            .map(|j| {
+                ms.iter()
+                    .map(|&m| builder.conventional(&frame, m, rows.s(j, m)))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .collect::<Result<_, _>>()?;
+        lap("conventional_axes");
+        let optimised: Vec<OptimisedRow> = if self.params.optimise_axes {
+            conventional
+                .par_iter()
+                .map(|row| optimise_row(&builder, row, self.params.w_curve_step, op))
+                .collect::<Result<_, _>>()?
+        } else {
+            conventional
+                .iter()
+                .map(|row| OptimisedRow {
+                    postures: row.clone(),
+                    alpha_before: row.iter().map(|p| p.alpha).collect(),
+                    alpha_after: row.iter().map(|p| p.alpha).collect(),
+                    moves: vec![None; row.len()],
+                    monotone: row.windows(2).all(|w| w[1].alpha > w[0].alpha),
+                    w_curve: None,
+                    step: self.params.w_curve_step,
+                })
+                .collect()
+        };
+        lap("axis_optimisation");
+        // Every final position keeps the blade allowance (cutter, shank, holder).
+        let finals: Vec<&Posture> = optimised.iter().flat_map(|r| &r.postures).collect();
+        let clear: Vec<f64> = finals
+            .par_iter()
+            .map(|p| blades.clearance(&p.cl).distance_mm)
+            .collect();
+        let mut min_clear = f64::INFINITY;
+        for (p, c) in finals.iter().zip(&clear) {
+            if *c < required {
+                return Err(PlanError::geometry(
+                    op,
+                    format!(
+                        "channel 0, plunge at meridional fraction {:.4}, row fraction {:.4}",
+                        p.m, p.s
+                    ),
+                    format!(
+                        "blade clearance {c:.4} mm is below the blade allowance plus the query's \
+                         sampling band, {required} mm"
+                    ),
+                ));
+            }
+            min_clear = min_clear.min(*c);
+        }
+        lap("blade_clearance_check");
+        let material = Material {
+            stock: ctx.stock,
+            cleared: (self.params.start_fraction < 1.0).then(|| ClearedRegion {
+                hub: impeller.hub().meridional(),
+                fraction: self.params.start_fraction,
+            }),
+        };
+        let before = strokes(&conventional, radius, core);
+        let final_rows: Vec<Vec<Posture>> = optimised.iter().map(|r| r.postures.clone()).collect();
+        let after = strokes(&final_rows, radius, core);
+        let travel_before = core_travel(&before, &material);
+        let travel_after = core_travel(&after, &material);
+        lap("interference");
+        let m_hi = rows.start.min(1.0);
+        let allowance_before = hub_allowance(&frame, &before, rows.end, m_hi);
+        let allowance_after = hub_allowance(&frame, &after, rows.end, m_hi);
+        lap("hub_allowance");
+        Ok(SectionPlan {
+            conventional,
+            optimised,
+            range: (rows.start, rows.end),
+            travel_before,
+            travel_after,
+            allowance_before,
+            allowance_after,
+            min_blade_clearance_mm: min_clear,
+            timings_ms,
+        })
+    }
+}
+
+impl Operation for PlungeRoughing {
+    fn kind(&self) -> &'static str {
+        KIND
+    }
+
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn tool(&self) -> &str {
+        &self.tool
+    }
+
+    fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
+        let plan = self.plan_section(ctx)?;
+        let rows = plan.final_rows();
+        let path = channel_path(
+            &self.name,
+            ctx.tool.name(),
+            &rows,
+            ctx.linker,
+            ctx.rates().plunge_mm_per_min,
+        )
+        .map_err(|e| match e {
+            PlanError::Geometry { place, reason, .. } => {
+                PlanError::geometry(&self.name, place, reason)
+            }
+            other => other,
+        })?;
+        let set = ctx.impeller.main();
+        let channels = set.count();
+        let order = order::angular_sequence(channels, self.params.first_channel % channels.max(1));
+        let paths = pattern::copy_to(&path, set.pitch_rad(), &order);
+
+        let per_channel = plan.travel_after.len();
+        let mut m = Metrics::new();
+        let before = interfering_count(&plan.travel_before);
+        let after = interfering_count(&plan.travel_after);
+        m.count("interference_positions_before", before * channels);
+        m.count("interference_positions_after", after * channels);
+        m.count("plunges", per_channel * channels);
+        m.count("plunges_per_channel", per_channel);
+        m.count("rows", rows.len());
+        m.count("stations", rows.first().map_or(0, Vec::len));
+        m.number(
+            "interference_share_before",
+            before as f64 / per_channel.max(1) as f64,
+        );
+        m.number(
+            "interference_share_after",
+            after as f64 / per_channel.max(1) as f64,
+        );
+        m.number(
+            "max_core_travel_before_mm",
+            plan.travel_before.iter().copied().fold(0.0, f64::max),
+        );
+        m.number(
+            "max_core_travel_after_mm",
+            plan.travel_after.iter().copied().fold(0.0, f64::max),
+        );
+        let monotone = plan.optimised.iter().all(|r| r.monotone);
+        m.flag("alpha_monotone", monotone);
+        m.flag(
+            "alpha_monotone_before",
+            plan.optimised
+                .iter()
+                .all(|r| r.alpha_before.windows(2).all(|w| w[1] > w[0])),
+        );
+        m.number("hub_allowance_max_mm", plan.allowance_after.max_mm);
+        m.number("hub_allowance_mean_mm", plan.allowance_after.mean_mm);
+        m.number("hub_allowance_max_before_mm", plan.allowance_before.max_mm);
+        m.number(
+            "hub_allowance_mean_before_mm",
+            plan.allowance_before.mean_mm,
+        );
+        m.number("min_blade_clearance_mm", plan.min_blade_clearance_mm);
+        m.number("section_start_fraction", plan.range.0);
+        m.number("section_end_fraction", plan.range.1);
+        let moved = plan
+            .optimised
+            .iter()
+            .flat_map(|r| &r.moves)
+            .filter(|x| x.is_some())
+            .count();
+        m.count("axes_moved_per_channel", moved);
+
+        let mut series = Vec::new();
+        for (j, r) in plan.optimised.iter().enumerate() {
+            let xs: Vec<f64> = r.postures.iter().map(|p| p.m).collect();
+            let pts = |a: &[f64]| -> Vec<[f64; 2]> {
+                xs.iter()
+                    .zip(a)
+                    .map(|(x, y)| [*x, y.to_degrees()])
+                    .collect()
+            };
+            series.push(PlotSeries {
+                label: format!("row {j} conventional"),
+                points: pts(&r.alpha_before),
+            });
+            series.push(PlotSeries {
+                label: format!("row {j} optimised"),
+                points: pts(&r.alpha_after),
+            });
+        }
+        let plots = vec![Plot {
+            title: format!(
+                "{}: α (hub normal at the contact vs cutter axis) along each row, outlet → inlet",
+                self.name
+            ),
+            kind: PlotKind::Lines {
+                x_label: "meridional fraction (1 = outlet)".into(),
+                y_label: "α (deg)".into(),
+                series,
+                equal_aspect: false,
+            },
+        }];
+        let mut notes = vec![format!(
+            "section from meridional fraction {:.4} to {:.4}: {} rows × {} stations per channel; \
+             interference and hub allowance measured on channel 0 (every channel is its rotated copy)",
+            plan.range.0,
+            plan.range.1,
+            rows.len(),
+            rows.first().map_or(0, Vec::len)
+        )];
+        notes.push(format!(
+            "planning stages (ms): {}",
+            plan.timings_ms
+                .iter()
+                .map(|(k, v)| format!("{k} {v:.0}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        if !monotone {
+            notes.push(
+                "alpha_monotone = false: on some row the W curve ended before α could increase"
+                    .into(),
+            );
+        }
+        Ok(PlannedOperation {
+            paths,
+            metrics: m,
+            plots,
+            notes,
+        })
+    }
+}
