@@ -107,7 +107,11 @@ pub fn run(args: Args) -> Result<bool, String> {
     );
     for fixture in fixtures {
         let name = fixture.name.clone();
-        let dir = fixture.job.parent().map(Path::to_path_buf).unwrap_or_default();
+        let dir = fixture
+            .job
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
         if let Some(file) = missing_import(&dir) {
             let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
             println!(

@@ -119,7 +119,7 @@ impl RitzSolution {
     /// Rayleigh–Ritz stiffness indicator of `beam`.
     ///
     /// With `options.terms = Some(n)` it uses `n ≥ 2` terms per section; otherwise it adds
-    /// terms until two successive indicators differ by less than `rel_tol` relative (the
+    /// terms until two successive changes of the indicator are both below `rel_tol` relative (the
     /// convergence is geometric, typically 6–15 terms for taper ratios up to 12), and
     /// returns [`StiffnessError::NotConverged`] if `max_terms` is reached first.
     pub fn solve(beam: &Beam, options: &RitzOptions) -> Result<Self, StiffnessError> {
@@ -133,13 +133,22 @@ impl RitzSolution {
             }
             return solve_fixed(beam, n);
         }
+        // A single added term can be (nearly) orthogonal to the remaining error, so one small
+        // change is not convergence: two successive changes below `rel_tol` are required
+        // (e.g. r_c = 4.153, θ = 4.60°, L = 91.2 mm stalled 1.2 % above the exact value).
         let mut prev = solve_fixed(beam, 2)?;
         let mut change = f64::INFINITY;
-        for n in 3..=options.max_terms.max(3) {
+        let mut small = 0;
+        for n in 3..=options.max_terms.max(4) {
             let next = solve_fixed(beam, n)?;
             change = (next.stiffness - prev.stiffness).abs() / next.stiffness;
             prev = next;
-            if change < options.rel_tol {
+            small = if change < options.rel_tol {
+                small + 1
+            } else {
+                0
+            };
+            if small >= 2 {
                 return Ok(prev);
             }
         }

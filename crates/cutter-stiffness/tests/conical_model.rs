@@ -160,3 +160,17 @@ proptest! {
         prop_assert!((c.exact_stiffness() / rep.exact_n_per_mm - 1.0).abs() < 1e-12);
     }
 }
+/// A case where one added Legendre term barely changed the indicator while it was still
+/// 1.2 % above the exact value: the convergence test must not stop there (tolerance 1e-9).
+#[test]
+fn ritz_does_not_stop_on_a_stalled_term() {
+    let c = ConicalCutter::from_load_plane(
+        4.153028956617287,
+        deg(4.603356824017242),
+        91.22089828762456,
+        E_CARBIDE,
+    )
+    .unwrap();
+    let rep = c.report(&RitzOptions::default()).unwrap();
+    assert!((rep.stiffness_n_per_mm / rep.exact_n_per_mm - 1.0).abs() < 1e-9);
+}

@@ -11,13 +11,26 @@ use cam_plan::{Builder, Operation, OperationSpec, PlanError};
 /// A registry: `(kind name, builder)` rows.
 pub type Registry = [(&'static str, Builder)];
 
-/// The registered operation kinds of this release.
+/// The registered operation kinds of this release, in the order a process plan uses them.
 ///
-/// Kinds whose crate has not landed yet are absent (never replaced by a stand-in):
-/// `plunge_roughing` (plunge-opt), `channel_roughing`, `hub_finishing`,
-/// `blade_root_finishing` (channel-paths), `flank_semi_finishing`, `flank_finishing`
-/// (flank-opt).
-pub static OPERATIONS: &Registry = &[];
+/// `hub_finishing` (channel-paths) is not built yet and therefore absent (never replaced by a
+/// stand-in): a job naming it is rejected with the list below.
+pub static OPERATIONS: &Registry = &[
+    (plunge_opt::KIND, plunge_opt::build),
+    (
+        channel_paths::CHANNEL_ROUGHING,
+        channel_paths::build_channel_roughing,
+    ),
+    (
+        flank_opt::FLANK_SEMI_FINISHING,
+        flank_opt::build_flank_semi_finishing,
+    ),
+    (
+        channel_paths::BLADE_ROOT_FINISHING,
+        channel_paths::build_blade_root_finishing,
+    ),
+    (flank_opt::FLANK_FINISHING, flank_opt::build_flank_finishing),
+];
 
 /// The builder of `kind`, if registered.
 pub fn builder(registry: &Registry, kind: &str) -> Option<Builder> {
