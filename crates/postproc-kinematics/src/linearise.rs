@@ -95,6 +95,47 @@ pub fn segment_deviation(
     worst
 }
 
+/// Extra rotary travel (rad) of an exact midpoint posture, beyond the direct travel between
+/// the segment's end postures, above which [`midpoint_posture`] interpolates the angles.
+const EXCESS_ROTARY_TRAVEL: f64 = 1e-2;
+
+/// The posture inserted halfway along a block.
+///
+/// Normally the exact inverse of the intended midpoint (tip halfway on the chord, axis halfway
+/// on the great circle). Where the intended axis sweep passes near the singular direction
+/// (tool axis along the rotary table's axis) the exact inverse swings the rotate axis by up to
+/// 180° within the block while the end postures differ by a few degrees; interpolating those
+/// postures would then never converge (each half keeps a swing). In that case — the exact
+/// midpoint adds more than [`EXCESS_ROTARY_TRAVEL`] of rotary travel to the direct travel
+/// `|ΔT| + |ΔR|` between the ends — the rotary angles are interpolated linearly and the
+/// linear axes recomputed so the tip still lies halfway on the chord: the tip path stays
+/// exact, the axis deviates from the great circle by at most the ends' own angular distance
+/// near the singular direction (where the orientation a controller produces is this joint
+/// interpolation anyway).
+fn midpoint_posture(
+    machine: &Machine,
+    cl0: &CutterLocation,
+    j0: &Joints,
+    cl1: &CutterLocation,
+    j1: &Joints,
+    tool_length: f64,
+) -> Result<(CutterLocation, Joints), KinematicsError> {
+    let mid = interpolate_cl(cl0, cl1, 0.5);
+    let jm = machine.inverse(&mid, tool_length, Some(j0))?;
+    let travel = |a: &Joints, b: &Joints| (a.tilt - b.tilt).abs() + (a.rotate - b.rotate).abs();
+    if travel(j0, &jm) + travel(&jm, j1) <= travel(j0, j1) + EXCESS_ROTARY_TRAVEL {
+        return Ok((mid, jm));
+    }
+    let (t, r) = (0.5 * (j0.tilt + j1.tilt), 0.5 * (j0.rotate + j1.rotate));
+    let jl = machine.joints_for_angles(&mid.tip, tool_length, t, r);
+    machine.check_limits(&jl, crate::kinematics::LIMIT_SLACK)?;
+    let cl = CutterLocation {
+        tip: mid.tip,
+        axis: machine.tool_axis(t, r),
+    };
+    Ok((cl, jl))
+}
+
 /// Settings of [`subdivide`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearisationSettings {
@@ -141,8 +182,7 @@ fn subdivide_rec(
     if dev <= st.tol || depth >= st.max_depth {
         return Ok(dev);
     }
-    let mid = interpolate_cl(cl0, cl1, 0.5);
-    let jm = machine.inverse(&mid, tool_length, Some(j0))?;
+    let (mid, jm) = midpoint_posture(machine, cl0, j0, cl1, j1, tool_length)?;
     let d0 = subdivide_rec(machine, cl0, j0, &mid, &jm, tool_length, st, depth + 1, out)?;
     out.push((mid, jm, d0));
     subdivide_rec(machine, &mid, &jm, cl1, j1, tool_length, st, depth + 1, out)

@@ -230,7 +230,11 @@ impl ChannelRoughing {
             kappa = kappa.max(n[1] / r);
         }
         let step = match ctx.tool.cutter.shape {
-            CutterShape::BallEnd { radius } => cam_core::ball_step_over(radius, kappa, h),
+            CutterShape::BallEnd { radius }
+            | CutterShape::TaperedBallEnd {
+                ball_radius: radius,
+                ..
+            } => cam_core::ball_step_over(radius, kappa, h),
             CutterShape::BullNose {
                 radius,
                 corner_radius,
@@ -252,16 +256,6 @@ impl ChannelRoughing {
 
     fn plan_inner(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
         let shape = ctx.tool.cutter.shape;
-        let radius = match shape {
-            CutterShape::BallEnd { radius } | CutterShape::BullNose { radius, .. } => radius,
-            _ => {
-                return Err(PlanError::tool(
-                    &self.name,
-                    &self.tool,
-                    "channel roughing needs a ball-end or bull-nose cutter",
-                ))
-            }
-        };
         let doc = ctx
             .process
             .depth_of_cut_mm
@@ -273,6 +267,22 @@ impl ChannelRoughing {
                     "needed (> 0) for levels",
                 )
             })?;
+        // The blade offset is the cutter's largest radius within one level's slab: the
+        // radius for ball and bull-nose ends; for a tapered ball end the ball radius or, when
+        // the depth of cut reaches the cone, the cone's radius at that height.
+        let radius = match shape {
+            CutterShape::BallEnd { radius } | CutterShape::BullNose { radius, .. } => radius,
+            CutterShape::TaperedBallEnd { ball_radius, .. } => {
+                ball_radius.max(shape.radius_at(doc))
+            }
+            _ => {
+                return Err(PlanError::tool(
+                    &self.name,
+                    &self.tool,
+                    "channel roughing needs a ball-end, tapered ball-end or bull-nose cutter",
+                ))
+            }
+        };
         let imp = ctx.impeller;
         let hub_allow = ctx.process.hub_allowance_mm;
         let ch = imp.channel(0);
@@ -529,7 +539,7 @@ fn unreachable_shape() -> Result<f64, cam_core::ContactError> {
     Err(cam_core::ContactError::Invalid {
         field: "shape",
         value: f64::NAN,
-        reason: "channel roughing needs a ball-end or bull-nose cutter",
+        reason: "channel roughing needs a ball-end, tapered ball-end or bull-nose cutter",
     })
 }
 
@@ -874,7 +884,12 @@ fn measure_scallop(
         return 0.0;
     }
     let reach = match *shape {
-        CutterShape::BallEnd { radius } | CutterShape::BullNose { radius, .. } => radius,
+        CutterShape::BallEnd { radius }
+        | CutterShape::BullNose { radius, .. }
+        | CutterShape::TaperedBallEnd {
+            ball_radius: radius,
+            ..
+        } => radius,
         _ => 0.0,
     };
     // Densify consecutive locations to a quarter radius.
