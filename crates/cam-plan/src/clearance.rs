@@ -486,6 +486,9 @@ pub struct DesignClearance<'a> {
     hub_z_max: f64,
     hub_r_max: f64,
     rows: Vec<(Row, RowAngles)>,
+    /// Largest distance of a tool point from the tip (top of the holder plus its radius):
+    /// the lever arm of a change of tool axis in [`DesignClearance::segment_clearance`].
+    reach_mm: f64,
 }
 
 impl std::fmt::Debug for DesignClearance<'_> {
@@ -614,6 +617,16 @@ impl<'a> DesignClearance<'a> {
         if let Some(s) = impeller.splitter() {
             rows.push((Row::Splitter, RowAngles::new(s)));
         }
+        let widest = samples
+            .iter()
+            .chain(&upper_samples)
+            .map(|s| s.1)
+            .fold(c.shank_radius, f64::max);
+        let widest = c
+            .holder
+            .iter()
+            .map(|h| h.bottom_radius.max(h.top_radius))
+            .fold(widest, f64::max);
         Ok(Self {
             impeller,
             options,
@@ -624,6 +637,7 @@ impl<'a> DesignClearance<'a> {
             hub_z_max: a[0].max(b[0]),
             hub_r_max: a[1].max(b[1]),
             rows,
+            reach_mm: top + widest,
         })
     }
 
@@ -760,6 +774,84 @@ impl<'a> DesignClearance<'a> {
     /// the first part that fails).
     pub fn is_clear(&self, cl: &CutterLocation, min_clearance_mm: f64) -> bool {
         self.evaluate(cl, Some(min_clearance_mm)).distance_mm >= min_clearance_mm
+    }
+
+    /// Whether the whole motion from `a` to `b` keeps at least `min_clearance_mm − tol_mm` from
+    /// the design: tip on the straight line, tool axis on the great circle (the motion a
+    /// five-axis controller makes between two blocks, up to the post's linearisation
+    /// tolerance). Returns the parameter `s ∈ (0, 1)` of the first sampled posture found
+    /// below `min_clearance_mm` when the motion is not clear.
+    ///
+    /// Method: certified bisection. Between two postures `s₀ < s₁`, no tool point moves more
+    /// than `D = (|Δtip| + θ·R)(s₁ − s₀)`, with `θ` the angle between the end axes and `R` the
+    /// tool's reach (holder top plus its radius), and the clearance is 1-Lipschitz in that
+    /// displacement, so the clearance on `[s₀, s₁]` is at least `(c₀ + c₁ − D)/2`. Intervals
+    /// whose bound reaches `min_clearance_mm − tol_mm` are accepted; the others are split at
+    /// their midpoint, which is queried. The bound is as exact as [`Self::clearance`] itself.
+    ///
+    /// Cost: 2 queries when the ends are clear by more than `D/2`; about
+    /// `log₂(D/tol_mm)` more per place where the motion comes within `D/2` of the design,
+    /// at most `max_queries` (then the motion counts as not clear, at the last midpoint).
+    pub fn segment_clearance(
+        &self,
+        a: &CutterLocation,
+        b: &CutterLocation,
+        min_clearance_mm: f64,
+        tol_mm: f64,
+        max_queries: usize,
+    ) -> Result<(), f64> {
+        let ca = self.clearance(a).distance_mm;
+        let cb = self.clearance(b).distance_mm;
+        self.segment_clearance_between(
+            (a, ca),
+            (b, cb),
+            min_clearance_mm,
+            tol_mm,
+            max_queries.saturating_sub(2),
+        )
+    }
+
+    /// [`Self::segment_clearance`] when the clearances `ca`, `cb` of the end postures are
+    /// already known (from [`Self::clearance`]); `max_queries` counts the midpoints only.
+    pub fn segment_clearance_between(
+        &self,
+        (a, ca): (&CutterLocation, f64),
+        (b, cb): (&CutterLocation, f64),
+        min_clearance_mm: f64,
+        tol_mm: f64,
+        max_queries: usize,
+    ) -> Result<(), f64> {
+        if ca < min_clearance_mm {
+            return Err(0.0);
+        }
+        if cb < min_clearance_mm {
+            return Err(1.0);
+        }
+        let at = |s: f64| CutterLocation {
+            tip: a.tip + (b.tip - a.tip) * s,
+            axis: a.axis.slerp(&b.axis, s),
+        };
+        let span = (b.tip - a.tip).norm() + a.axis.angle(&b.axis) * self.reach_mm;
+        let floor = min_clearance_mm - tol_mm.max(0.0);
+        let mut stack = vec![(0.0, ca, 1.0, cb)];
+        let mut queries = 0;
+        while let Some((s0, c0, s1, c1)) = stack.pop() {
+            if 0.5 * (c0 + c1 - span * (s1 - s0)) >= floor {
+                continue;
+            }
+            let sm = 0.5 * (s0 + s1);
+            if queries >= max_queries {
+                return Err(sm);
+            }
+            let cm = self.clearance(&at(sm)).distance_mm;
+            queries += 1;
+            if cm < min_clearance_mm {
+                return Err(sm);
+            }
+            stack.push((sm, cm, s1, c1));
+            stack.push((s0, c0, sm, cm));
+        }
+        Ok(())
     }
 
     /// The clearance at `cl`; with `stop_below`, returns as soon as a part is found below it.

@@ -89,16 +89,73 @@ impl SafetySurface {
 }
 
 /// Builds linking moves over a safety surface.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Linker {
     /// The safety surface.
     pub surface: SafetySurface,
+    /// The blank: approaches are rapid only down to `approach_mm` outside it (see
+    /// [`Linker::rapid_approach_end`]).
+    blank: Option<std::sync::Arc<Stock>>,
 }
 
+/// Step (mm) at which an approach line is probed against the blank.
+const BLANK_PROBE_STEP_MM: f64 = 0.25;
+
 impl Linker {
-    /// A linker over `surface`.
+    /// A linker over `surface` (approaches rapid down to `approach_mm` above the entry).
     pub fn new(surface: SafetySurface) -> Self {
-        Self { surface }
+        Self {
+            surface,
+            blank: None,
+        }
+    }
+
+    /// A linker over `surface` whose approaches stop rapid travel `approach_mm` before the
+    /// blank and feed (plunge) the rest of the way: the material an operation meets is not
+    /// known to the linker (earlier operations may have left any part of the blank), so only
+    /// outside the blank is a rapid known to be safe.
+    pub fn with_blank(surface: SafetySurface, blank: &Stock) -> Self {
+        Self {
+            surface,
+            blank: Some(std::sync::Arc::new(blank.clone())),
+        }
+    }
+
+    /// Distance above `to` along its axis (≤ `inside`, the distance to the safety surface)
+    /// where the rapid part of an approach ends: `approach_mm` above `to`, or — with a blank
+    /// — the highest point of the axis line from which the tip comes within `approach_mm` of
+    /// the blank (probed every 0.25 mm, the tip and four lateral and one lower point at
+    /// `approach_mm`), whichever is higher. O(inside / 0.25) blank tests.
+    pub fn rapid_approach_end(&self, to: &CutterLocation, inside: f64, approach_mm: f64) -> f64 {
+        let a = approach_mm.clamp(0.0, inside);
+        let Some(blank) = &self.blank else {
+            return a;
+        };
+        let axis = to.axis.into_inner();
+        let m = approach_mm.max(0.0);
+        let probes = [
+            Vector3::zeros(),
+            Vector3::new(m, 0.0, 0.0),
+            Vector3::new(-m, 0.0, 0.0),
+            Vector3::new(0.0, m, 0.0),
+            Vector3::new(0.0, -m, 0.0),
+            Vector3::new(0.0, 0.0, -m),
+        ];
+        let near = |t: f64| {
+            let p = to.tip.coords + axis * t;
+            probes.iter().any(|d| blank.contains(&(p + d)))
+        };
+        let n = (inside / BLANK_PROBE_STEP_MM).ceil() as usize;
+        for i in 0..=n {
+            let t = (inside - i as f64 * BLANK_PROBE_STEP_MM).max(0.0);
+            if t <= a {
+                break;
+            }
+            if near(t) {
+                return (t + BLANK_PROBE_STEP_MM).min(inside);
+            }
+        }
+        a
     }
 
     /// The point where a retract from `cl` along its axis reaches the safety surface, or an
@@ -171,8 +228,9 @@ impl Linker {
             feed_mm_per_min: None,
         }];
         moves.extend(self.travel(&out, &inn));
+        let inside = (inn.tip - to.tip).norm();
         let above = CutterLocation {
-            tip: to.tip + to.axis.into_inner() * approach_mm.max(0.0),
+            tip: to.tip + to.axis.into_inner() * self.rapid_approach_end(to, inside, approach_mm),
             axis: to.axis,
         };
         moves.push(Move::rapid(above));
@@ -233,7 +291,7 @@ impl Linker {
         moves.extend(self.travel(&out, &inn));
         let inside = (inn.tip - to.tip).norm();
         if inside >= SAME_POSTURE_MM {
-            let a = approach_mm.clamp(0.0, inside);
+            let a = self.rapid_approach_end(to, inside, approach_mm);
             if a < inside {
                 moves.push(Move::rapid(CutterLocation {
                     tip: to.tip + to.axis.into_inner() * a,
@@ -303,7 +361,7 @@ impl Linker {
         let start = self.retract_point(&first.cl)?;
         let inside = (start.tip - first.cl.tip).norm();
         let mut head = vec![Move::rapid(start)];
-        let a = approach_mm.clamp(0.0, inside);
+        let a = self.rapid_approach_end(&first.cl, inside, approach_mm);
         if a < inside {
             head.push(Move::rapid(CutterLocation {
                 tip: first.cl.tip + first.cl.axis.into_inner() * a,

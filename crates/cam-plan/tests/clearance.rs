@@ -403,3 +403,80 @@ fn permute(v: &mut Vec<usize>, k: usize, f: &mut impl FnMut(&[usize])) {
         v.swap(k, i);
     }
 }
+
+#[test]
+fn segment_clearance_finds_a_blade_between_two_clear_postures() {
+    // A ball beside the main blade's pressure side, 0.5 mm off, moved along the side's normal
+    // *through* the blade to the same gap on the suction side: both ends are clear by 0.5 mm,
+    // the motion is not. A motion along the side (tip moved 2 mm along the ruling at the same
+    // gap) is clear.
+    let imp = impeller();
+    let r = 0.5;
+    let t = tool(CutterShape::BallEnd { radius: r }, 1.0, r, 1.0, &[]);
+    let q = query(&t);
+    let blade = imp.main().blade();
+    let ps = blade.side(Side::Pressure);
+    let ((u0, u1), (v0, v1)) = ps.domain();
+    let (u, v) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
+    let p = ps.point(u, v);
+    let e = 1e-5;
+    let du = (ps.point(u + e, v) - ps.point(u - e, v)) / (2.0 * e);
+    let dv = (ps.point(u, v + e) - ps.point(u, v - e)) / (2.0 * e);
+    let mut n = du.cross(&dv).normalize();
+    let probe = Point3::from(p + n * 0.05);
+    if q.blade_signed_distance(&probe).0 < 0.0 {
+        n = -n;
+    }
+    let axis = (dv - n * dv.dot(&n)).normalize();
+    let g = 0.5;
+    let a = CutterLocation::new(Point3::from(p + n * (r + g) - axis * r), axis).unwrap();
+    // the other side of the blade: thickness 0.8 mm, same gap
+    let b = CutterLocation::new(Point3::from(p - n * (0.8 + r + g) - axis * r), axis).unwrap();
+    assert!(q.clearance(&a).distance_mm > 0.4 && q.clearance(&b).distance_mm > 0.4);
+    let hit = q.segment_clearance(&a, &b, 0.0, 0.005, 200).unwrap_err();
+    assert!(hit > 0.0 && hit < 1.0, "{hit}");
+    let along = CutterLocation::new(a.tip + axis * 2.0, axis).unwrap();
+    assert!(q.segment_clearance(&a, &along, 0.0, 0.005, 200).is_ok());
+    // every sampled posture of the accepted motion is clear within the tolerance
+    for k in 0..=50 {
+        let s = k as f64 / 50.0;
+        let cl = CutterLocation::new(a.tip + (along.tip - a.tip) * s, axis).unwrap();
+        assert!(q.clearance(&cl).distance_mm >= -0.005);
+    }
+}
+
+#[test]
+fn approaches_are_rapid_only_outside_the_blank() {
+    // An entry 20 mm down in a channel: with the blank known, the approach's last rapid ends
+    // at least `approach` (2 mm) outside the blank on the entry's axis, the rest is a plunge;
+    // no rapid posture (nor any interpolated between two rapids, sampled every 0.1 mm) has
+    // its tip inside the blank.
+    let imp = impeller();
+    let surface = SafetySurface::around_stock(imp.stock(), 10.0).unwrap();
+    let linker = Linker::with_blank(surface, imp.stock());
+    let top = imp.stock().z_range().1;
+    let to = CutterLocation::new(Point3::new(25.0, 3.0, top - 20.0), Vector3::z()).unwrap();
+    let from = CutterLocation::new(Point3::new(-25.0, 3.0, top - 18.0), Vector3::z()).unwrap();
+    let moves = linker.link(&from, &to, 2.0).unwrap();
+    let last_rapid = moves
+        .iter()
+        .rev()
+        .find(|m| m.kind == cam_core::MoveKind::Rapid)
+        .unwrap();
+    assert!(last_rapid.cl.tip.z >= top + 2.0 - 1e-9, "{:?}", last_rapid.cl.tip);
+    assert_eq!(moves.last().unwrap().kind, cam_core::MoveKind::Plunge);
+    for w in moves.windows(2) {
+        if w[1].kind != cam_core::MoveKind::Rapid {
+            continue;
+        }
+        let n = (((w[1].cl.tip - w[0].cl.tip).norm() / 0.1).ceil() as usize).max(1);
+        for k in 0..=n {
+            let p = w[0].cl.tip + (w[1].cl.tip - w[0].cl.tip) * (k as f64 / n as f64);
+            assert!(!imp.stock().contains(&p.coords), "rapid inside the blank at {p:?}");
+        }
+    }
+    // without the blank the rapid goes down to 2 mm above the entry
+    let plain = Linker::new(surface).link(&from, &to, 2.0).unwrap();
+    let r = plain.iter().rev().find(|m| m.kind == cam_core::MoveKind::Rapid).unwrap();
+    assert!((r.cl.tip.z - (to.tip.z + 2.0)).abs() < 1e-9);
+}

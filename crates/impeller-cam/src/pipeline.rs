@@ -133,7 +133,11 @@ pub fn run_job_with(job: &Job, out: &Path, registry: &Registry) -> Result<Report
     let assembled = post(job, &impeller, &operations, out, &mut report)?;
     report.timings_ms.insert("post_ms".into(), ms(t));
 
-    let t = stage("verifying by stock simulation");
+    let t = stage(if job.verification.enabled {
+        "verifying by stock simulation"
+    } else {
+        "verification disabled by the job ([verification] enabled = false)"
+    });
     verify(
         job,
         &impeller,
@@ -174,7 +178,7 @@ pub fn plan(
 ) -> Result<Vec<JobOperation>, CliError> {
     let surface =
         SafetySurface::around_stock(impeller.stock(), job.safety.clearance_mm).map_err(msg)?;
-    let linker = Linker::new(surface);
+    let linker = Linker::with_blank(surface, impeller.stock());
     let mesh = if job.operations.is_empty() {
         None
     } else {

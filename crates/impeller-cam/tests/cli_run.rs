@@ -189,10 +189,18 @@ fn run_ring_job(name: &str, cl: &str, min_feeds: usize) -> (serde_json::Value, P
     // LinuxCNC's own interpreter accepts the program.
     let program = out.join("program.ngc");
     assert!(program.is_file());
+    rs274_accepts(&dir, &program, "T1 P1 Z0 D6 ;ring\n", min_feeds);
+    (r, out)
+}
+
+/// Runs LinuxCNC's `rs274` on `program` (in `dir`, with `tool_table`) and asserts that it
+/// accepts every line and makes at least `min_feeds` feed moves; skipped with a line when
+/// `rs274` is not installed (a failure under `CI=true`).
+fn rs274_accepts(dir: &Path, program: &Path, tool_table: &str, min_feeds: usize) {
     match which("rs274") {
         Some(rs) => {
             let tbl = dir.join("tool.tbl");
-            std::fs::write(&tbl, "T1 P1 Z0 D6 ;ring\n").unwrap();
+            std::fs::write(&tbl, tool_table).unwrap();
             // The machine configuration maps the kinematics switches (M428 TCP, M429
             // identity, which every program selects first) to remap subroutines.
             let subs = dir.join("subs");
@@ -221,9 +229,9 @@ fn run_ring_job(name: &str, cl: &str, min_feeds: usize) -> (serde_json::Value, P
                 .arg("-i")
                 .arg(&ini)
                 .arg("-g")
-                .arg(&program)
-                .current_dir(&dir)
-                .env("HOME", &dir)
+                .arg(program)
+                .current_dir(dir)
+                .env("HOME", dir)
                 .stdin(Stdio::null())
                 .output()
                 .unwrap();
@@ -247,7 +255,6 @@ fn run_ring_job(name: &str, cl: &str, min_feeds: usize) -> (serde_json::Value, P
              installs it)"
         ),
     }
-    (r, out)
 }
 
 fn which(name: &str) -> Option<PathBuf> {
@@ -281,4 +288,44 @@ fn bad_job_files_exit_1_with_file_and_line() {
         .output()
         .unwrap();
     assert_eq!(st.status.code(), Some(1));
+}
+
+#[test]
+fn flank_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
+    // fixtures/impeller-8+8/job-flank.toml: blade semi-finishing (T5) and flank finishing
+    // (T6) of every blade side, planned by the registered flank-opt operations.
+    let dir = scratch("flank");
+    let out = dir.join("out");
+    let st = cli()
+        .arg("run")
+        .arg(repo().join("fixtures/impeller-8+8/job-flank.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let r = report(&out);
+    let ops = r["operations"].as_array().unwrap();
+    let kinds: Vec<&str> = ops.iter().map(|o| o["kind"].as_str().unwrap()).collect();
+    assert_eq!(kinds, ["flank_semi_finishing", "flank_finishing"]);
+    for o in ops {
+        assert!(o["moves"].as_u64().unwrap() > 100, "{o}");
+        assert!(o["plan_ms"].as_f64().unwrap() > 0.0, "{o}");
+    }
+    // the finishing pass meets the job's machining tolerance (0.01 mm) on the blade sides
+    assert!(ops[1]["max_deviation_mm"].as_f64().unwrap() <= 0.01, "{}", ops[1]);
+    assert_eq!(r["post"]["limit_violations"], 0);
+    assert!(r["post"]["max_linearisation_error_mm"].as_f64().unwrap() <= 0.005 + 1e-9);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("blade-finish: top view"));
+    rs274_accepts(
+        &dir,
+        &out.join("program.ngc"),
+        "T5 P5 Z115 D3 ;T5\nT6 P6 Z115 D2 ;T6\n",
+        1000,
+    );
 }

@@ -25,7 +25,11 @@
 //!    query (cutter, shank, holder against hub and true blades) and, if not clear, retried
 //!    with the axis along the level normal; a location clear in neither posture is left
 //!    uncut (the path is split there, linked over the safety surface, and counted in
-//!    `skipped_locations`), so no emitted location gouges the design.
+//!    `skipped_locations`), so no emitted location gouges the design. The motion between two
+//!    consecutive locations (and every link move inside an area) is checked as a whole with
+//!    [`cam_plan::DesignClearance::segment_clearance_between`] (certified bisection, within
+//!    half the machining tolerance); a motion that is not clear gets one planned midpoint
+//!    and, if a half is still not clear, the path is split there (`split_motions`).
 //!
 //! Metrics: `path_length_mm` (pipeline), `triangle_path_length_mm` and
 //! `isoparametric_path_length_mm` (cutting paths of all channels, measured in space on the
@@ -55,6 +59,9 @@ pub const CHANNEL_ROUGHING: &str = "channel_roughing";
 /// handful of spans; 61 samples keep the interpolated boundary within µm of the true one
 /// (checked by the level tests of `impeller-model`).
 const BOUNDARY_SAMPLES: usize = 61;
+
+/// Midpoint queries allowed per motion check (beyond them the motion counts as not clear).
+const SEGMENT_QUERIES: usize = 24;
 
 /// Largest spacing of path points along the flow (mm) when the chord rule allows more.
 const MAX_POINT_SPACING_MM: f64 = 1.0;
@@ -345,6 +352,7 @@ impl ChannelRoughing {
         let mut max_scallop: f64 = 0.0;
         let mut n_paths = 0usize;
         let mut skipped = 0usize;
+        let mut split = 0usize;
         for lc in &per_level {
             tri_len += lc.tri_len;
             iso_len += lc.iso_len;
@@ -352,6 +360,7 @@ impl ChannelRoughing {
             max_scallop = max_scallop.max(lc.max_scallop);
             n_paths += lc.paths;
             skipped += lc.skipped;
+            split += lc.split_motions;
             for area in &lc.moves {
                 let Some(first) = area.first() else { continue };
                 if let Some(prev) = last {
@@ -385,7 +394,8 @@ impl ChannelRoughing {
             .count("levels", n_levels)
             .count("paths", n_paths * count)
             .number("min_blade_clearance_mm", min_clear)
-            .count("skipped_locations", skipped * count);
+            .count("skipped_locations", skipped * count)
+            .count("split_motions", split * count);
         let plots = self.plot(&levels);
         Ok(PlannedOperation {
             paths,
@@ -575,6 +585,9 @@ struct LevelCl {
     max_scallop: f64,
     paths: usize,
     skipped: usize,
+    /// Motions between two collision-free postures that were not clear even with a planned
+    /// midpoint (the path was split there).
+    split_motions: usize,
 }
 
 impl ChannelRoughing {
@@ -596,7 +609,11 @@ impl ChannelRoughing {
             max_scallop: 0.0,
             paths: 0,
             skipped: 0,
+            split_motions: 0,
         };
+        // Motions between postures may come this far below zero clearance (the other half
+        // of the machining tolerance is the clearance query's own sampling error).
+        let seg_tol = 0.5 * ctx.tolerances.machining_tol;
         for area in &lp.areas {
             let lv = &lp.level;
             let point_of = |q: [f64; 2]| {
@@ -638,22 +655,76 @@ impl ChannelRoughing {
                     .map(|(&q, (_, n))| axis_at(q, n))
                     .collect();
                 let smooth = smooth_axes(&raw, self.params.axis_smoothing);
-                let mut cls: Vec<Option<CutterLocation>> = Vec::with_capacity(path.len());
-                for ((&q, (p, n)), a) in path.iter().zip(&pts).zip(&smooth) {
+                // A collision-free posture at planar point `q` (wanted axis `a`, else the
+                // level normal) with its clearance, or `None`.
+                let posture = |q: [f64; 2],
+                               p: &Vector3<f64>,
+                               n: &Vector3<f64>,
+                               a: &Vector3<f64>|
+                 -> Result<Option<(CutterLocation, cam_plan::Clearance)>, PlanError> {
                     let a = limit_tilt(*a, n, max_tilt);
                     let cl = self.touch(&shape, p, n, &a, q, &place)?;
                     let c = ctx.clearance.clearance(&cl);
-                    let found = if c.distance_mm >= 0.0 {
-                        Some((cl, c))
-                    } else {
-                        let alt = self.touch(&shape, p, n, n, q, &place)?;
-                        let ca = ctx.clearance.clearance(&alt);
-                        (ca.distance_mm >= 0.0).then_some((alt, ca))
-                    };
-                    let Some((cl, c)) = found else {
+                    if c.distance_mm >= 0.0 {
+                        return Ok(Some((cl, c)));
+                    }
+                    let alt = self.touch(&shape, p, n, n, q, &place)?;
+                    let ca = ctx.clearance.clearance(&alt);
+                    Ok((ca.distance_mm >= 0.0).then_some((alt, ca)))
+                };
+                let mut found: Vec<Option<(CutterLocation, cam_plan::Clearance)>> =
+                    Vec::with_capacity(path.len());
+                for ((&q, (p, n)), a) in path.iter().zip(&pts).zip(&smooth) {
+                    let f = posture(q, p, n, a)?;
+                    if f.is_none() {
                         // Neither posture is collision-free: the point is left uncut (the
                         // path is split there and the measured scallop shows the residue).
                         out.skipped += 1;
+                    }
+                    found.push(f);
+                }
+                // The motions between consecutive postures are checked too (the axis may
+                // change between them): a motion that is not clear gets one planned
+                // midpoint; when a half is still not clear the path is split there (the
+                // linker retracts and approaches around the gap).
+                let seg_ok = |a: &(CutterLocation, cam_plan::Clearance),
+                              b: &(CutterLocation, cam_plan::Clearance)| {
+                    ctx.clearance
+                        .segment_clearance_between(
+                            (&a.0, a.1.distance_mm),
+                            (&b.0, b.1.distance_mm),
+                            0.0,
+                            seg_tol,
+                            SEGMENT_QUERIES,
+                        )
+                        .is_ok()
+                };
+                let mut checked: Vec<Option<(CutterLocation, cam_plan::Clearance)>> =
+                    Vec::with_capacity(found.len());
+                for k in 0..found.len() {
+                    if k > 0 {
+                        if let (Some(a), Some(b)) = (&found[k - 1], &found[k]) {
+                            if !seg_ok(a, b) {
+                                let qm = [
+                                    0.5 * (path[k - 1][0] + path[k][0]),
+                                    0.5 * (path[k - 1][1] + path[k][1]),
+                                ];
+                                let (pm, nm) = point_of(qm);
+                                let am = smooth[k - 1] + smooth[k];
+                                let mid = posture(qm, &pm, &nm, &am)?
+                                    .filter(|m| seg_ok(a, m) && seg_ok(m, b));
+                                if mid.is_none() {
+                                    out.split_motions += 1;
+                                }
+                                checked.push(mid);
+                            }
+                        }
+                    }
+                    checked.push(found[k]);
+                }
+                let mut cls: Vec<Option<CutterLocation>> = Vec::with_capacity(checked.len());
+                for f in checked {
+                    let Some((cl, c)) = f else {
                         cls.push(None);
                         continue;
                     };
@@ -685,8 +756,9 @@ impl ChannelRoughing {
                         } else {
                             MoveKind::Feed
                         };
-                        let mut moves = Vec::new();
+                        let mut moves: Vec<Move> = Vec::new();
                         let mut clear = true;
+                        let mut prev = cur.last().map(|m| m.cl);
                         for &q in link.iter().skip(1).take(link.len().saturating_sub(2)) {
                             let (p, n) = point_of(q);
                             let a = axis_at(q, &n);
@@ -695,16 +767,28 @@ impl ChannelRoughing {
                                 tip: cl.tip + n * lift,
                                 axis: cl.axis,
                             };
-                            if !ctx.clearance.is_clear(&cl, 0.0) {
+                            let motion_clear = prev.is_none_or(|from| {
+                                ctx.clearance
+                                    .segment_clearance(&from, &cl, 0.0, seg_tol, SEGMENT_QUERIES)
+                                    .is_ok()
+                            });
+                            if !motion_clear {
                                 clear = false;
                                 break;
                             }
+                            prev = Some(cl);
                             moves.push(Move {
                                 kind,
                                 cl,
                                 feed_mm_per_min: None,
                             });
                         }
+                        clear = clear
+                            && prev.is_none_or(|from| {
+                                ctx.clearance
+                                    .segment_clearance(&from, &first, 0.0, seg_tol, SEGMENT_QUERIES)
+                                    .is_ok()
+                            });
                         if clear {
                             cur.extend(moves);
                             cur.push(Move {
