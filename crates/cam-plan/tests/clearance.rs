@@ -463,7 +463,11 @@ fn approaches_are_rapid_only_outside_the_blank() {
         .rev()
         .find(|m| m.kind == cam_core::MoveKind::Rapid)
         .unwrap();
-    assert!(last_rapid.cl.tip.z >= top + 2.0 - 1e-9, "{:?}", last_rapid.cl.tip);
+    assert!(
+        last_rapid.cl.tip.z >= top + 2.0 - 1e-9,
+        "{:?}",
+        last_rapid.cl.tip
+    );
     assert_eq!(moves.last().unwrap().kind, cam_core::MoveKind::Plunge);
     for w in moves.windows(2) {
         if w[1].kind != cam_core::MoveKind::Rapid {
@@ -472,11 +476,18 @@ fn approaches_are_rapid_only_outside_the_blank() {
         let n = (((w[1].cl.tip - w[0].cl.tip).norm() / 0.1).ceil() as usize).max(1);
         for k in 0..=n {
             let p = w[0].cl.tip + (w[1].cl.tip - w[0].cl.tip) * (k as f64 / n as f64);
-            assert!(!imp.stock().contains(&p.coords), "rapid inside the blank at {p:?}");
+            assert!(
+                !imp.stock().contains(&p.coords),
+                "rapid inside the blank at {p:?}"
+            );
         }
     }
     // without the blank the rapid goes down to 2 mm above the entry
     let plain = Linker::new(surface).link(&from, &to, 2.0).unwrap();
-    let r = plain.iter().rev().find(|m| m.kind == cam_core::MoveKind::Rapid).unwrap();
+    let r = plain
+        .iter()
+        .rev()
+        .find(|m| m.kind == cam_core::MoveKind::Rapid)
+        .unwrap();
     assert!((r.cl.tip.z - (to.tip.z + 2.0)).abs() < 1e-9);
 }

@@ -120,6 +120,10 @@ pub struct VerificationSpec {
     pub enabled: bool,
     /// Dexel spacing (mm).
     pub resolution_mm: f64,
+    /// Keep the program when verification finds defects (`run --allow-defects`; not a
+    /// job-file key).
+    #[serde(skip)]
+    pub allow_defects: bool,
 }
 
 impl Default for VerificationSpec {
@@ -127,6 +131,7 @@ impl Default for VerificationSpec {
         Self {
             enabled: true,
             resolution_mm: 0.1,
+            allow_defects: false,
         }
     }
 }

@@ -23,3 +23,8 @@ pub use error::CliError;
 pub use job::Job;
 pub use pipeline::{run_job, run_job_with};
 pub use report::Report;
+
+/// Exit code of `impeller-cam run` when verification finds an overcut beyond the tolerance
+/// (`machining_tol` plus the simulation's error bound) or a collision: the report is written
+/// and shows where, the program is withheld (`--allow-defects` keeps it and exits 0).
+pub const EXIT_DEFECTS: u8 = 3;

@@ -2,8 +2,10 @@
 //! the `impeller_cam` library.
 //!
 //! Every subcommand exits 0 on success and 1 on a user error with one clear line on stderr
-//! (see `../shared/DESIGN.md` §4). Subcommands live in the library's `cmd` module, one module
-//! each.
+//! (see `../shared/DESIGN.md` §4); `run` exits [`impeller_cam::EXIT_DEFECTS`] (3) when
+//! verification finds an overcut beyond tolerance or a collision (the report is written, the
+//! program withheld; `--allow-defects` keeps the program and exits 0). Subcommands live in the library's `cmd` module, one
+//! module each.
 
 use clap::{Parser, Subcommand};
 use impeller_cam::cmd;
@@ -56,7 +58,13 @@ fn main() -> ExitCode {
         }
     };
     let result = match cli.command {
-        Command::Run(args) => cmd::run::run(args),
+        Command::Run(args) => match cmd::run::run(args) {
+            Ok(cmd::run::Outcome::Clean) => Ok(()),
+            Ok(cmd::run::Outcome::Defects) => {
+                return ExitCode::from(impeller_cam::EXIT_DEFECTS);
+            }
+            Err(e) => Err(e),
+        },
         Command::Stiffness(args) => cmd::stiffness::run(args),
         Command::Model(args) => cmd::model::run(args),
         Command::Post(args) => cmd::post::run(args),

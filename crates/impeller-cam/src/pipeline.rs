@@ -147,12 +147,49 @@ pub fn run_job_with(job: &Job, out: &Path, registry: &Registry) -> Result<Report
         &mut report,
     )?;
     report.timings_ms.insert("verify_ms".into(), ms(t));
+    withhold_defective_program(job, out, &mut report)?;
     report
         .timings_ms
         .insert("total_ms".into(), total.elapsed().as_secs_f64() * 1e3);
 
     report.write(out)?;
     Ok(report)
+}
+
+/// The verification gate: a program whose verification found defects is removed (the report
+/// still shows where), unless the job allows defects (`run --allow-defects`), which keeps it
+/// and says so in the notes. The command line exits with [`crate::EXIT_DEFECTS`] either way.
+fn withhold_defective_program(job: &Job, out: &Path, report: &mut Report) -> Result<(), CliError> {
+    let Some(defects) = report.verification.as_ref().map(|v| v.defects.clone()) else {
+        return Ok(());
+    };
+    if defects.is_empty() || !report.post.written {
+        return Ok(());
+    }
+    if job.verification.allow_defects {
+        report.notes.push(format!(
+            "program {} written although verification found defects (--allow-defects): {}",
+            report.post.program,
+            defects.join("; ")
+        ));
+        return Ok(());
+    }
+    let program = Path::new(&report.post.program);
+    if program.exists() {
+        std::fs::remove_file(program).map_err(|source| CliError::Io {
+            path: report.post.program.clone(),
+            source,
+        })?;
+    }
+    report.post.written = false;
+    report.notes.push(format!(
+        "program {} withheld: verification found defects ({}); see the verification section, \
+         or run with --allow-defects to keep it",
+        report.post.program,
+        defects.join("; ")
+    ));
+    let _ = out;
+    Ok(())
 }
 
 /// Stage 1: the job's impeller (the embedded default when it names none).
@@ -511,11 +548,49 @@ pub fn verify(
     let rep = machining_sim::simulate(&mut stock, &design, &verifiable, &options).map_err(msg)?;
     let maps = serde_json::to_string(&rep.maps).map_err(msg)?;
     gcode_emit::write_atomic(&out.join("verification_maps.json"), maps.as_bytes()).map_err(msg)?;
+    let limit = job.tolerances.machining_tol
+        + machining_sim::overcut_error_bound(
+            job.verification.resolution_mm,
+            rep.stats.sweep_tol_mm,
+            verifiable.iter().map(|(c, _)| c),
+        );
+    let mut defects = Vec::new();
+    if rep.metrics.max_overcut_mm > limit {
+        let at = rep
+            .max_overcut
+            .as_ref()
+            .map(|e| {
+                format!(
+                    " on {} at ({:.3}, {:.3}, {:.3})",
+                    e.surface, e.point[0], e.point[1], e.point[2]
+                )
+            })
+            .unwrap_or_default();
+        defects.push(format!(
+            "overcut {:.4} mm{at} exceeds {:.4} mm (machining_tol {} + simulation error bound)",
+            rep.metrics.max_overcut_mm, limit, job.tolerances.machining_tol
+        ));
+    }
+    if rep.metrics.collisions > 0 {
+        let first = rep
+            .collisions
+            .first()
+            .map(|c| {
+                format!(
+                    "; first: move {} of {} ({:?} {:?} into the {:?}, {:.3} mm deep)",
+                    c.move_index, c.operation, c.part, c.move_kind, c.target, c.depth_mm
+                )
+            })
+            .unwrap_or_default();
+        defects.push(format!("{} collision(s){first}", rep.metrics.collisions));
+    }
     report.verification = Some(VerificationReport {
         max_overcut_mm: rep.metrics.max_overcut_mm,
         max_residual_mm: rep.metrics.max_residual_mm,
         collisions: rep.metrics.collisions,
         resolution_mm: job.verification.resolution_mm,
+        overcut_limit_mm: limit,
+        defects,
         details: serde_json::json!({
             "max_overcut": rep.max_overcut,
             "max_residual": rep.max_residual,

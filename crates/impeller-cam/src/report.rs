@@ -132,6 +132,13 @@ pub struct VerificationReport {
     pub collisions: usize,
     /// Dexel spacing used (mm).
     pub resolution_mm: f64,
+    /// The overcut a correct program may show: the job's `machining_tol` plus the
+    /// simulation's own overcut error bound at this resolution
+    /// ([`machining_sim::overcut_error_bound`]) (mm).
+    pub overcut_limit_mm: f64,
+    /// What makes the program defective (overcut above the limit, collisions), one line each;
+    /// empty when the program passed.
+    pub defects: Vec<String>,
     /// Locations of the extrema, collision list, simulation statistics.
     pub details: serde_json::Value,
 }

@@ -149,24 +149,12 @@ fn c_axis_swing_is_removed_checked_posted_and_verified() {
 /// CL file written back, and rs274 accepting the program. Returns the report and the output
 /// folder.
 fn run_ring_job(name: &str, cl: &str, min_feeds: usize) -> (serde_json::Value, PathBuf) {
-    let dir = scratch(name);
-    std::fs::write(dir.join("ring.cls"), cl).unwrap();
-    let imp = repo().join("fixtures/impeller-8+8/impeller.toml");
-    let machine = repo().join("fixtures/machines/xyzac-trt.toml");
-    std::fs::write(
-        dir.join("job.toml"),
-        format!(
-            "name = \"ring\"\nimpeller = {:?}\nmachine = {:?}\ndialect = \"linuxcnc\"\n\
-             [verification]\nresolution_mm = 0.5\n[[cl_files]]\npath = \"ring.cls\"\n",
-            imp.display().to_string(),
-            machine.display().to_string()
-        ),
-    )
-    .unwrap();
+    let job = ring_job(name, cl);
+    let dir = job.parent().unwrap().to_path_buf();
     let out = dir.join("out");
     let st = cli()
         .arg("run")
-        .arg(dir.join("job.toml"))
+        .arg(&job)
         .arg("--out")
         .arg(&out)
         .output()
@@ -317,7 +305,11 @@ fn flank_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
         assert!(o["plan_ms"].as_f64().unwrap() > 0.0, "{o}");
     }
     // the finishing pass meets the job's machining tolerance (0.01 mm) on the blade sides
-    assert!(ops[1]["max_deviation_mm"].as_f64().unwrap() <= 0.01, "{}", ops[1]);
+    assert!(
+        ops[1]["max_deviation_mm"].as_f64().unwrap() <= 0.01,
+        "{}",
+        ops[1]
+    );
     assert_eq!(r["post"]["limit_violations"], 0);
     assert!(r["post"]["max_linearisation_error_mm"].as_f64().unwrap() <= 0.005 + 1e-9);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
@@ -328,4 +320,80 @@ fn flank_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
         "T5 P5 Z115 D3 ;T5\nT6 P6 Z115 D2 ;T6\n",
         1000,
     );
+}
+
+/// Writes a ring job (CL file `cl`, verified at 0.5 mm) into a fresh folder and returns the
+/// job file.
+fn ring_job(name: &str, cl: &str) -> PathBuf {
+    let dir = scratch(name);
+    std::fs::write(dir.join("ring.cls"), cl).unwrap();
+    let imp = repo().join("fixtures/impeller-8+8/impeller.toml");
+    let machine = repo().join("fixtures/machines/xyzac-trt.toml");
+    let job = dir.join("job.toml");
+    std::fs::write(
+        &job,
+        format!(
+            "name = \"ring\"\nimpeller = {:?}\nmachine = {:?}\ndialect = \"linuxcnc\"\n\
+             [verification]\nresolution_mm = 0.5\n[[cl_files]]\npath = \"ring.cls\"\n",
+            imp.display().to_string(),
+            machine.display().to_string()
+        ),
+    )
+    .unwrap();
+    job
+}
+
+#[test]
+fn gouging_program_is_withheld_with_exit_3_unless_defects_are_allowed() {
+    // The ring at z = 12 mm on r = 30 mm runs between hub (z = 6.6 mm there) and shroud
+    // contour (z = 15.6 mm): through every blade it passes. Verification must find the
+    // overcut, `run` exit 3 with the report written and no program; with --allow-defects
+    // exit 0 and the program written.
+    let job = ring_job("gouge", &swing_ring_cl(0.0, 12.0, true));
+    let out = job.parent().unwrap().join("out");
+    let st = cli()
+        .arg("run")
+        .arg(&job)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        st.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&st.stderr);
+    assert!(stderr.contains("DEFECT: overcut"), "{stderr}");
+    let r = report(&out);
+    let v = &r["verification"];
+    assert!(
+        v["max_overcut_mm"].as_f64().unwrap() > v["overcut_limit_mm"].as_f64().unwrap(),
+        "{v}"
+    );
+    assert!(!v["defects"].as_array().unwrap().is_empty(), "{v}");
+    assert_eq!(r["post"]["written"], false);
+    assert!(!out.join("program.ngc").exists());
+    assert!(out.join("report.html").is_file());
+
+    let out2 = job.parent().unwrap().join("out2");
+    let st = cli()
+        .arg("run")
+        .arg(&job)
+        .arg("--out")
+        .arg(&out2)
+        .arg("--allow-defects")
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    assert!(out2.join("program.ngc").is_file());
+    let r = report(&out2);
+    assert_eq!(r["post"]["written"], true);
+    let notes = r["notes"].to_string();
+    assert!(notes.contains("--allow-defects"), "{notes}");
 }

@@ -661,7 +661,10 @@ impl ChannelRoughing {
                                p: &Vector3<f64>,
                                n: &Vector3<f64>,
                                a: &Vector3<f64>|
-                 -> Result<Option<(CutterLocation, cam_plan::Clearance)>, PlanError> {
+                 -> Result<
+                    Option<(CutterLocation, cam_plan::Clearance)>,
+                    PlanError,
+                > {
                     let a = limit_tilt(*a, n, max_tilt);
                     let cl = self.touch(&shape, p, n, &a, q, &place)?;
                     let c = ctx.clearance.clearance(&cl);
@@ -687,18 +690,19 @@ impl ChannelRoughing {
                 // change between them): a motion that is not clear gets one planned
                 // midpoint; when a half is still not clear the path is split there (the
                 // linker retracts and approaches around the gap).
-                let seg_ok = |a: &(CutterLocation, cam_plan::Clearance),
-                              b: &(CutterLocation, cam_plan::Clearance)| {
-                    ctx.clearance
-                        .segment_clearance_between(
-                            (&a.0, a.1.distance_mm),
-                            (&b.0, b.1.distance_mm),
-                            0.0,
-                            seg_tol,
-                            SEGMENT_QUERIES,
-                        )
-                        .is_ok()
-                };
+                let seg_ok =
+                    |a: &(CutterLocation, cam_plan::Clearance),
+                     b: &(CutterLocation, cam_plan::Clearance)| {
+                        ctx.clearance
+                            .segment_clearance_between(
+                                (&a.0, a.1.distance_mm),
+                                (&b.0, b.1.distance_mm),
+                                0.0,
+                                seg_tol,
+                                SEGMENT_QUERIES,
+                            )
+                            .is_ok()
+                    };
                 let mut checked: Vec<Option<(CutterLocation, cam_plan::Clearance)>> =
                     Vec::with_capacity(found.len());
                 for k in 0..found.len() {

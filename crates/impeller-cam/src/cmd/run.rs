@@ -13,14 +13,29 @@ pub struct Args {
     /// Output directory (created if missing).
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
+    /// Keep the program (and exit 0) when verification finds an overcut beyond tolerance or a
+    /// collision; the defects are still printed and reported.
+    #[arg(long)]
+    pub allow_defects: bool,
+}
+
+/// What `impeller-cam run` ended with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// The program passed verification (or was not verified).
+    Clean,
+    /// Verification found defects (see the report) and the program was withheld (no
+    /// `--allow-defects`).
+    Defects,
 }
 
 /// Runs the job and prints where its outputs are.
-pub fn run(args: Args) -> Result<(), CliError> {
-    let job = match &args.job {
+pub fn run(args: Args) -> Result<Outcome, CliError> {
+    let mut job = match &args.job {
         Some(p) => Job::from_file(p)?,
         None => Job::default_job()?,
     };
+    job.verification.allow_defects = args.allow_defects;
     let report = crate::pipeline::run_job(&job, &args.out)?;
     eprintln!(
         "[impeller-cam] {}: {} operation(s), program {}, report {}",
@@ -36,5 +51,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
     for n in &report.notes {
         eprintln!("[impeller-cam] note: {n}");
     }
-    Ok(())
+    let defects = report
+        .verification
+        .as_ref()
+        .map(|v| v.defects.clone())
+        .unwrap_or_default();
+    if defects.is_empty() {
+        return Ok(Outcome::Clean);
+    }
+    for d in &defects {
+        eprintln!("[impeller-cam] DEFECT: {d}");
+    }
+    if args.allow_defects {
+        eprintln!("[impeller-cam] the program was written anyway (--allow-defects)");
+        return Ok(Outcome::Clean);
+    }
+    Ok(Outcome::Defects)
 }
