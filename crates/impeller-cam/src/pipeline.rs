@@ -192,6 +192,85 @@ fn withhold_defective_program(job: &Job, out: &Path, report: &mut Report) -> Res
     Ok(())
 }
 
+/// The job's machine (the embedded xyzac-trt when it names none).
+fn load_machine(job: &Job) -> Result<Machine, CliError> {
+    match &job.machine {
+        Some(p) => Machine::from_toml_str(&job.read_text(p)?, &p.display().to_string()),
+        None => Machine::from_toml_str(DEFAULT_MACHINE, "embedded xyzac-trt.toml"),
+    }
+    .map_err(msg)
+}
+
+/// Largest deviation (mm) of the read-back chords from the controller's motion.
+const READBACK_PATH_TOL_MM: f64 = 0.001;
+
+/// The emitted program read back (`gcode_emit::read_back`) into the tool paths the machine
+/// really moves: LinuxCNC joint output, every block (rapids, approach, retract, tool-change
+/// moves, linearisation blocks) through the forward kinematics with joint interpolation,
+/// cut into chords within 1 µm of that motion. Operation `k` is the program from its `k`-th
+/// tool change (`M6`) to the next. `None` (the posted cutter locations are verified instead)
+/// for other dialects and output modes, whose syntax the reader does not cover, or when the
+/// tool changes do not match the operations.
+fn read_back_program(
+    job: &Job,
+    program: &Path,
+    operations: &[JobOperation],
+) -> Result<Option<Vec<Option<ToolPath>>>, CliError> {
+    if job.dialect != "linuxcnc" {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(program).map_err(|source| CliError::Io {
+        path: program.display().to_string(),
+        source,
+    })?;
+    let file = program.display().to_string();
+    let starts: Vec<usize> = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| {
+            l.split(['(', ';'])
+                .next()
+                .is_some_and(|code| code.split_whitespace().any(|w| w == "M6" || w == "M06"))
+        })
+        .map(|(i, _)| i + 1)
+        .collect();
+    if starts.len() != operations.len() {
+        return Ok(None);
+    }
+    let machine = load_machine(job)?;
+    let blocks = gcode_emit::read_gcode(&text, &file).map_err(msg)?;
+    let mut paths = Vec::with_capacity(operations.len());
+    for (k, op) in operations.iter().enumerate() {
+        let Some(cutter) = &op.cl.cutter else {
+            paths.push(None);
+            continue;
+        };
+        let (from, to) = (starts[k], starts.get(k + 1).copied().unwrap_or(usize::MAX));
+        let slice: Vec<_> = blocks
+            .iter()
+            .filter(|b| b.line >= from && b.line < to)
+            .copied()
+            .collect();
+        let options = gcode_emit::ReadbackOptions {
+            mode: gcode_emit::ReadbackMode::Joint,
+            tool_length_mm: 0.0,
+            path_tol_mm: READBACK_PATH_TOL_MM,
+            reach_mm: cutter.overall_length,
+        };
+        let rb = gcode_emit::read_back(
+            &slice,
+            &machine,
+            &options,
+            &file,
+            &op.cl.path.name,
+            &op.cl.path.tool,
+        )
+        .map_err(msg)?;
+        paths.push(Some(rb.path));
+    }
+    Ok(Some(paths))
+}
+
 /// Stage 1: the job's impeller (the embedded default when it names none).
 pub fn model(job: &Job) -> Result<Impeller, CliError> {
     match &job.impeller {
@@ -402,11 +481,7 @@ pub fn post(
     )
     .map_err(msg)?;
 
-    let machine = match &job.machine {
-        Some(p) => Machine::from_toml_str(&job.read_text(p)?, &p.display().to_string()),
-        None => Machine::from_toml_str(DEFAULT_MACHINE, "embedded xyzac-trt.toml"),
-    }
-    .map_err(msg)?;
+    let machine = load_machine(job)?;
     let dialect = dialect_by_name(&job.dialect).map_err(msg)?;
     let mode = match dialect.name() {
         "linuxcnc" | "fanuc" => OutputMode::Joint,
@@ -518,14 +593,30 @@ pub fn verify(
     out: &Path,
     report: &mut Report,
 ) -> Result<(), CliError> {
+    // What the machine really does: the written program read back; otherwise the posted
+    // cutter locations (or the CL path itself when nothing was posted).
+    let read_back = match (job.verification.enabled, assembled, report.post.written) {
+        (true, Some(_), true) => {
+            read_back_program(job, Path::new(&report.post.program), operations)?
+        }
+        _ => None,
+    };
+    let source = if read_back.is_some() {
+        "program"
+    } else {
+        "cutter_locations"
+    };
     let verifiable: Vec<(Cutter, ToolPath)> = operations
         .iter()
         .enumerate()
         .filter_map(|(i, op)| {
-            let path = assembled
-                .and_then(|a| a.operations.iter().find(|p| p.index == i))
-                .map(|p| posted_path(&op.cl.path, &p.blocks))
-                .unwrap_or_else(|| op.cl.path.clone());
+            let path = match &read_back {
+                Some(paths) => paths.get(i).cloned().flatten()?,
+                None => assembled
+                    .and_then(|a| a.operations.iter().find(|p| p.index == i))
+                    .map(|p| posted_path(&op.cl.path, &p.blocks))
+                    .unwrap_or_else(|| op.cl.path.clone()),
+            };
             op.cl.cutter.clone().map(|c| (c, path))
         })
         .collect();
@@ -591,6 +682,7 @@ pub fn verify(
         resolution_mm: job.verification.resolution_mm,
         overcut_limit_mm: limit,
         defects,
+        source: source.into(),
         details: serde_json::json!({
             "max_overcut": rep.max_overcut,
             "max_residual": rep.max_residual,

@@ -139,6 +139,10 @@ pub struct VerificationReport {
     /// What makes the program defective (overcut above the limit, collisions), one line each;
     /// empty when the program passed.
     pub defects: Vec<String>,
+    /// What was simulated: `program` (the written LinuxCNC program read back through the
+    /// machine's kinematics with joint interpolation, every block) or `cutter_locations`
+    /// (the posted cutter locations, for dialects the reader does not cover).
+    pub source: String,
     /// Locations of the extrema, collision list, simulation statistics.
     pub details: serde_json::Value,
 }
