@@ -279,14 +279,15 @@ fn bad_job_files_exit_1_with_file_and_line() {
 }
 
 #[test]
-fn flank_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
-    // fixtures/impeller-8+8/job-flank.toml: blade semi-finishing (T5) and flank finishing
-    // (T6) of every blade side, planned by the registered flank-opt operations.
-    let dir = scratch("flank");
+fn finishing_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
+    // fixtures/impeller-8+8/job-finishing.toml: blade semi-finishing (T5), flank finishing
+    // (T6) and blade-root finishing (T7) of every blade side, planned by the registered
+    // flank-opt and channel-paths operations.
+    let dir = scratch("finishing");
     let out = dir.join("out");
     let st = cli()
         .arg("run")
-        .arg(repo().join("fixtures/impeller-8+8/job-flank.toml"))
+        .arg(repo().join("fixtures/impeller-8+8/job-finishing.toml"))
         .arg("--out")
         .arg(&out)
         .output()
@@ -299,7 +300,14 @@ fn flank_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
     let r = report(&out);
     let ops = r["operations"].as_array().unwrap();
     let kinds: Vec<&str> = ops.iter().map(|o| o["kind"].as_str().unwrap()).collect();
-    assert_eq!(kinds, ["flank_semi_finishing", "flank_finishing"]);
+    assert_eq!(
+        kinds,
+        [
+            "flank_semi_finishing",
+            "flank_finishing",
+            "blade_root_finishing"
+        ]
+    );
     for o in ops {
         assert!(o["moves"].as_u64().unwrap() > 100, "{o}");
         assert!(o["plan_ms"].as_f64().unwrap() > 0.0, "{o}");
@@ -317,7 +325,7 @@ fn flank_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
     rs274_accepts(
         &dir,
         &out.join("program.ngc"),
-        "T5 P5 Z115 D3 ;T5\nT6 P6 Z115 D2 ;T6\n",
+        "T5 P5 Z115 D3 ;T5\nT6 P6 Z115 D2 ;T6\nT7 P7 Z110 D2 ;T7\n",
         1000,
     );
 }
