@@ -608,6 +608,32 @@ impl FlankFinishing {
         ctx.linker
             .close(&mut one_path, APPROACH_MM)
             .map_err(|e| FlankError::Geometry(e.to_string()))?;
+        // The accuracy gate: a finishing pass that misses its tolerances is not emitted.
+        let pr = &run.problem;
+        let misses: Vec<String> = [
+            ("overcut", over, pr.overcut_tol, "mm"),
+            ("undercut", under, pr.undercut_tol, "mm"),
+            ("hub tangency error", hub, pr.hub_tol, "mm"),
+        ]
+        .iter()
+        .filter(|(_, v, t, _)| !(*v <= t * (1.0 + 1e-9) + 1e-12))
+        .map(|(what, v, t, u)| format!("{what} {v:.4} {u} > {t} {u}"))
+        .chain((clear < pr.min_clearance - 1e-9).then(|| {
+            format!(
+                "clearance to the next blade {clear:.4} mm < {} mm",
+                pr.min_clearance
+            )
+        }))
+        .collect();
+        if !misses.is_empty() {
+            return Err(FlankError::NotAccurate(format!(
+                "the optimised path misses its tolerances after {iterations} SLP iteration(s) \
+                 ({}): {}; try more iterations (max_slp_iterations), a larger trust region \
+                 (trust_radius_mm) or another initial path (initial_path)",
+                termination.as_str(),
+                misses.join(", ")
+            )));
+        }
         let order: Vec<usize> = (0..count).collect();
         out.paths = cam_plan::pattern::copy_to(&one_path, ctx.impeller.main().pitch_rad(), &order);
         metrics.number("max_overcut_mm", over);

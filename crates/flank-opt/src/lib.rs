@@ -51,6 +51,10 @@ pub enum FlankError {
     /// The LP solver failed.
     #[error("LP solver: {0}")]
     Solver(String),
+    /// The optimised path misses a tolerance the operation was asked to meet (no path is
+    /// emitted: a finishing pass outside its tolerance is not machined).
+    #[error("{0}")]
+    NotAccurate(String),
     /// An envelope or cutter error.
     #[error(transparent)]
     Cam(#[from] cam_core::CamError),
@@ -66,6 +70,7 @@ impl FlankError {
             FlankError::Param(m) => cam_plan::PlanError::param(op, "parameters", m),
             FlankError::Geometry(m) => cam_plan::PlanError::geometry(op, "blade side", m),
             FlankError::Solver(m) => cam_plan::PlanError::geometry(op, "optimiser", m),
+            FlankError::NotAccurate(m) => cam_plan::PlanError::geometry(op, "accuracy", m),
             FlankError::Cam(e) => cam_plan::PlanError::cam(op, e),
             FlankError::Model(e) => cam_plan::PlanError::model(op, e),
         }

@@ -405,3 +405,41 @@ fn gouging_program_is_withheld_with_exit_3_unless_defects_are_allowed() {
     let notes = r["notes"].to_string();
     assert!(notes.contains("--allow-defects"), "{notes}");
 }
+
+#[test]
+fn flank_finishing_refuses_a_path_outside_its_tolerance() {
+    // The fixture's finishing pass reaches about 0.003 mm; asked for 0.0001 mm it must fail
+    // with the measured figures instead of emitting the pass.
+    let dir = scratch("flank-tol");
+    let fx = repo().join("fixtures");
+    let job = dir.join("job.toml");
+    std::fs::write(
+        &job,
+        format!(
+            "name = \"tight\"\nimpeller = {:?}\nmachine = {:?}\ntools = {:?}\n\
+             [verification]\nenabled = false\n\
+             [[operations]]\nname = \"finish\"\nkind = \"flank_finishing\"\n\
+             tool = \"T6-taper-ball-r1\"\noptimise_shape = false\ncompare_cylindrical = false\n\
+             sides = \"pressure\"\novercut_tol_mm = 0.0001\n\
+             [operations.process]\nspindle_rpm = 6000.0\nfeed_per_tooth_mm = 0.1\n",
+            fx.join("impeller-8+8/impeller.toml").display().to_string(),
+            fx.join("machines/xyzac-trt.toml").display().to_string(),
+            fx.join("tools/impeller-8+8.toml").display().to_string(),
+        ),
+    )
+    .unwrap();
+    let st = cli()
+        .arg("run")
+        .arg(&job)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        stderr.contains("misses its tolerances") && stderr.contains("overcut"),
+        "{stderr}"
+    );
+    assert!(!dir.join("out/program.ngc").exists());
+}
