@@ -616,7 +616,7 @@ impl FlankFinishing {
             ("hub tangency error", hub, pr.hub_tol, "mm"),
         ]
         .iter()
-        .filter(|(_, v, t, _)| !(*v <= t * (1.0 + 1e-9) + 1e-12))
+        .filter(|(_, v, t, _)| v.is_nan() || *v > t * (1.0 + 1e-9) + 1e-12)
         .map(|(what, v, t, u)| format!("{what} {v:.4} {u} > {t} {u}"))
         .chain((clear < pr.min_clearance - 1e-9).then(|| {
             format!(
