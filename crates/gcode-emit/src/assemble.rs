@@ -228,6 +228,9 @@ pub fn assemble_program_with_access(
             .all(|w| w[0].cl.axis.angle(&w[1].cl.axis) <= options.fixed_axis_tol_rad);
         let mut post = options.post.clone();
         post.initial = posture;
+        if let Some(tl) = op.tool_length_mm {
+            post.tool_length = tl;
+        }
         if fixed && indexed_ok {
             // Post the moves anyway: checks every block against the axis limits and gives
             // the machine angles of the plane.

@@ -243,3 +243,47 @@ fn tilted_plane_operations_are_checked_against_the_axis_limits() {
         other => panic!("{other:?}"),
     }
 }
+
+#[test]
+fn the_operations_tool_length_reaches_the_kinematics_of_a_head_machine() {
+    // On the head-head machine the joints depend on the gauge length: a program posted with
+    // the operation's 120 mm tool, read back through the forward kinematics with 120 mm,
+    // reproduces the cutter locations; posted with the options' default (0 mm) it does not.
+    let machine = Machine::from_file(support::fixture("headhead-ac.toml")).unwrap();
+    let dialect = LinuxCnc::default();
+    let tip_error = |op: &gcode_emit::ClOperation| {
+        let a = assemble_program(
+            "tl",
+            std::slice::from_ref(op),
+            &machine,
+            &dialect,
+            &AssembleOptions::default(),
+        )
+        .unwrap();
+        let text = dialect
+            .write(&a.program, &ProgramOptions::default())
+            .unwrap();
+        let blocks = read_gcode(&text, "tl.ngc").unwrap();
+        let cls: Vec<CutterLocation> = blocks
+            .iter()
+            .filter(|b| !b.machine_coordinates)
+            .filter_map(|b| gcode_emit::gcode_read::joints_of(b, &machine))
+            .map(|j| machine.forward(&j, 120.0))
+            .collect();
+        op.path
+            .moves
+            .iter()
+            .map(|m| {
+                cls.iter()
+                    .map(|c| (c.tip - m.cl.tip).norm())
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max)
+    };
+    let mut op = support::five_axis_op("flank", 3, 15);
+    op.tool_length_mm = Some(120.0);
+    // 4-decimal angles on a 120 mm lever (≈ 1e-4 mm each) plus 4-decimal lengths: 5e-4 mm
+    assert!(tip_error(&op) < 5e-4, "{}", tip_error(&op));
+    op.tool_length_mm = None;
+    assert!(tip_error(&op) > 1.0, "{}", tip_error(&op));
+}

@@ -253,7 +253,7 @@ fn read_back_program(
             .collect();
         let options = gcode_emit::ReadbackOptions {
             mode: gcode_emit::ReadbackMode::Joint,
-            tool_length_mm: 0.0,
+            tool_length_mm: op.cl.tool_length_mm.unwrap_or(0.0),
             path_tol_mm: READBACK_PATH_TOL_MM,
             reach_mm: cutter.overall_length,
         };
@@ -340,6 +340,7 @@ pub fn plan(
             let mut cl = ClOperation::new(path);
             cl.tool_number = Some(tool.number);
             cl.cutter = Some(tool.cutter.clone());
+            cl.tool_length_mm = Some(tool.tool_length_mm);
             cl.spindle = Some(Spindle {
                 rpm: spec.process.spindle_rpm,
                 clockwise: true,

@@ -59,6 +59,9 @@ pub struct ClOperation {
     pub multax: bool,
     /// `PPRINT` texts met inside the operation, in order.
     pub comments: Vec<String>,
+    /// Gauge length of the tool (spindle gauge line to tip, mm) for the kinematics of head
+    /// machines; `None`: the post options' tool length. Not read from or written to APT files.
+    pub tool_length_mm: Option<f64>,
 }
 
 impl ClOperation {
@@ -73,6 +76,7 @@ impl ClOperation {
             coolant: Coolant::Off,
             multax: true,
             comments: Vec::new(),
+            tool_length_mm: None,
         }
     }
 }
