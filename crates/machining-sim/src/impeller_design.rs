@@ -484,16 +484,56 @@ impl DesignModel for ImpellerDesign {
         out
     }
 
+    /// The collision mesh: blade sides trimmed at the shroud contour (each column of the
+    /// side grid ends where the side crosses the contour, found by bisection to 1e-12 of the
+    /// parameter range; the blades' span extension beyond the contour, there only to be
+    /// trimmed, is not design) and the hub as a revolved grid.
     fn triangle_mesh(&self) -> TriangleMesh {
         let mut m = TriangleMesh {
-            vertices: self
-                .sides_mesh
-                .vertices()
-                .iter()
-                .map(|v| [v.x, v.y, v.z])
-                .collect(),
-            triangles: self.sides_mesh.indices().to_vec(),
+            vertices: Vec::new(),
+            triangles: Vec::new(),
         };
+        let (mu, mv) = (self.sampling.mesh_u.max(2), self.sampling.mesh_v.max(2));
+        for (_, blade) in &self.blades {
+            for side in [Side::Pressure, Side::Suction] {
+                let s = blade.side(side);
+                let ((u0, u1), (v0, v1)) = s.domain();
+                let above = |u: f64, v: f64| {
+                    self.shroud_sd.signed_distance(&Point3::from(s.point(u, v))) > 0.0
+                };
+                let top: Vec<f64> = (0..=mu)
+                    .map(|i| {
+                        let u = u0 + (u1 - u0) * i as f64 / mu as f64;
+                        if !above(u, v1) {
+                            return v1;
+                        }
+                        if above(u, v0) {
+                            return v0;
+                        }
+                        let (mut a, mut b) = (v0, v1);
+                        for _ in 0..40 {
+                            let c = 0.5 * (a + b);
+                            if above(u, c) {
+                                b = c;
+                            } else {
+                                a = c;
+                            }
+                        }
+                        0.5 * (a + b)
+                    })
+                    .collect();
+                let base = m.vertices.len() as u32;
+                for j in 0..=mv {
+                    for (i, &vt) in top.iter().enumerate() {
+                        let u = u0 + (u1 - u0) * i as f64 / mu as f64;
+                        let v = v0 + (vt - v0) * j as f64 / mv as f64;
+                        let p = s.point(u, v);
+                        m.vertices.push([p.x, p.y, p.z]);
+                    }
+                }
+                grid_tris(mu, mv, base, &mut m.triangles);
+            }
+        }
         // Hub as a revolved grid.
         let hub = self.impeller.hub();
         let (t0, t1) = hub.meridional().domain();

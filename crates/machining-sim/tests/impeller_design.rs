@@ -171,3 +171,34 @@ fn untouched_channels_read_full_residual_on_blade_sides() {
         "{full} of {total} blade samples read the full residual depth"
     );
 }
+
+/// The collision mesh is the design: blade sides end at the shroud contour (the span
+/// extension beyond it is not part), and they still reach it (no gap under the contour
+/// where a shank could pass unseen). Tolerance: 1e-6 mm on the contour distance of the
+/// bisected top row; the top row lies within 0.05 mm of the contour wherever the blade
+/// crosses it.
+#[test]
+fn collision_mesh_blades_end_at_the_shroud_contour() {
+    let imp = default_impeller().unwrap();
+    let d = ImpellerDesign::new(&imp, coarse()).unwrap();
+    let m = d.triangle_mesh();
+    assert!(!m.triangles.is_empty());
+    let mut near_contour = 0;
+    for v in &m.vertices {
+        let p = nalgebra::Vector3::new(v[0], v[1], v[2]);
+        let ds = imp.shroud().signed_distance(&p);
+        assert!(
+            ds < 1e-6,
+            "mesh vertex {v:?} is {ds} mm outside the shroud contour"
+        );
+        if ds > -0.05 {
+            near_contour += 1;
+        }
+    }
+    // Every blade side's top row (33 vertices with mesh_u = 32) meets the contour.
+    let sides = 2 * (imp.main().count() + imp.splitter().map_or(0, |s| s.count()));
+    assert!(
+        near_contour >= sides * 33,
+        "{near_contour} vertices on the contour, {sides} sides"
+    );
+}
