@@ -153,6 +153,11 @@ pub struct ClearanceOptions {
     pub parts: PartSet,
     /// Sampling tolerance of the swept balls (mm, > 0).
     pub sample_tol_mm: f64,
+    /// Tool samples at heights up to this (mm above the tip) are left out of the query: the
+    /// part of the tool a contact planner places exactly itself (a ball end touching the
+    /// surface it finishes, whose samples near the tip are conservative spheres that would
+    /// read a false penetration). 0 (the default) queries the whole tool.
+    pub above_mm: f64,
 }
 
 impl Default for ClearanceOptions {
@@ -160,6 +165,7 @@ impl Default for ClearanceOptions {
         Self {
             parts: PartSet::MATERIAL,
             sample_tol_mm: DEFAULT_SAMPLE_TOL_MM,
+            above_mm: 0.0,
         }
     }
 }
@@ -865,6 +871,9 @@ impl<'a> DesignClearance<'a> {
         };
         let failed = |b: &Clearance| stop_below.is_some_and(|m| b.distance_mm < m);
         for &(h, rho, part) in &self.samples {
+            if h <= self.options.above_mm {
+                continue;
+            }
             // Exact only where this sample could lower the answer (or fail the check).
             let need = stop_below.map_or(best.distance_mm, |m| m.min(best.distance_mm));
             let (d, dp) = self.design_distance_below(&(cl.tip + axis * h), rho, need);

@@ -5,7 +5,9 @@
 
 mod accessibility;
 pub mod blade_root;
+pub mod hub_finishing;
 pub mod roughing;
 
 pub use blade_root::{build_blade_root_finishing, BladeRootFinishing, BLADE_ROOT_FINISHING};
+pub use hub_finishing::{build_hub_finishing, HubFinishing, HUB_FINISHING};
 pub use roughing::{build_channel_roughing, CHANNEL_ROUGHING};

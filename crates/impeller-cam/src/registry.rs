@@ -12,14 +12,15 @@ use cam_plan::{Builder, Operation, OperationSpec, PlanError};
 pub type Registry = [(&'static str, Builder)];
 
 /// The registered operation kinds of this release, in the order a process plan uses them.
-///
-/// `hub_finishing` (channel-paths) is not built yet and therefore absent (never replaced by a
-/// stand-in): a job naming it is rejected with the list below.
 pub static OPERATIONS: &Registry = &[
     (plunge_opt::KIND, plunge_opt::build),
     (
         channel_paths::CHANNEL_ROUGHING,
         channel_paths::build_channel_roughing,
+    ),
+    (
+        channel_paths::HUB_FINISHING,
+        channel_paths::build_hub_finishing,
     ),
     (
         flank_opt::FLANK_SEMI_FINISHING,

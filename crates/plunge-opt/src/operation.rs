@@ -230,6 +230,7 @@ impl PlungeRoughing {
             ClearanceOptions {
                 parts: PartSet::BLADES,
                 sample_tol_mm: crate::rows::FINAL_CHECK_SAMPLE_TOL_MM,
+                above_mm: 0.0,
             },
         )?;
         let required =
@@ -249,6 +250,7 @@ impl PlungeRoughing {
             ClearanceOptions {
                 parts: PartSet::BLADES,
                 sample_tol_mm: crate::rows::ROW_SEARCH_SAMPLE_TOL_MM,
+                above_mm: 0.0,
             },
         )?;
         let settings = RowSettings {

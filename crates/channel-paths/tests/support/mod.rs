@@ -37,6 +37,41 @@ pub fn ball_tool(r: f64) -> Tool {
     }
 }
 
+/// The impeller-8+8 fixture's T6: tapered ball r1, 3° half angle, 20 mm flutes, Ø6 shank,
+/// 35 mm stick-out, shrink-fit chuck.
+pub fn tapered_t6() -> Tool {
+    let mut cutter = Cutter::new(
+        "T6-taper-ball-r1",
+        CutterShape::TaperedBallEnd {
+            ball_radius: 1.0,
+            half_angle: 3f64.to_radians(),
+        },
+        20.0,
+        3.0,
+        35.0,
+    )
+    .unwrap();
+    cutter.holder = vec![
+        HolderSegment {
+            bottom_radius: 10.5,
+            top_radius: 13.5,
+            length: 38.0,
+        },
+        HolderSegment {
+            bottom_radius: 13.5,
+            top_radius: 13.5,
+            length: 42.0,
+        },
+    ];
+    Tool {
+        number: 6,
+        cutter,
+        teeth: 3,
+        tool_length_mm: 115.0,
+        plunge_edge_length_mm: None,
+    }
+}
+
 pub fn process() -> Process {
     Process {
         spindle_rpm: 6000.0,

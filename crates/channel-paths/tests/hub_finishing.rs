@@ -1,0 +1,67 @@
+//! Hub finishing on impeller-8+8 (coarse settings to keep the debug-profile test short):
+//! every ball centre on the hub's offset surface (1e-6 mm) and at least `max(r, 2R_f − r)`
+//! from the blades, no overcut, every channel machined, the residual measured.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod support;
+
+use cam_core::MoveKind;
+use cam_plan::OperationSpec;
+
+fn spec(params: &str) -> OperationSpec {
+    OperationSpec {
+        name: "hub".into(),
+        kind: channel_paths::HUB_FINISHING.into(),
+        tool: "ball-r1".into(),
+        process: support::process(),
+        params: toml::from_str(params).unwrap(),
+    }
+}
+
+fn metric(p: &cam_plan::PlannedOperation, name: &str) -> f64 {
+    p.metrics.get(name).unwrap().as_f64().unwrap()
+}
+
+#[test]
+fn impeller_8_8_hub_balls_sit_on_the_offset_hub_clear_of_the_blades() {
+    let mut c = support::Ctx::new("impeller-8+8", 1.0);
+    c.tool = support::tapered_t6();
+    c.process.width_of_cut_mm = None;
+    let cl = c.clearance();
+    let ctx = plan_ctx!(c, cl);
+    let op = channel_paths::build_hub_finishing(&spec("scallop_mm = 0.5\nstations = 4")).unwrap();
+    let planned = op.plan(&ctx).unwrap();
+    for (k, v) in planned.metrics.0.iter() {
+        eprintln!("{k} = {v:?}");
+    }
+    for n in &planned.notes {
+        eprintln!("{n}");
+    }
+    assert_eq!(planned.paths.len(), 8);
+    let feeds = planned
+        .paths
+        .iter()
+        .map(|p| p.moves.iter().filter(|m| m.kind == MoveKind::Feed).count())
+        .sum::<usize>();
+    assert!(feeds > 8 * 20, "{feeds} feed moves");
+    let r = 1.0;
+    let rf = c.imp.fillet_radius_mm();
+    for path in &planned.paths {
+        for m in path.moves.iter().filter(|m| m.kind == MoveKind::Feed) {
+            let centre = m.cl.tip.coords + m.cl.axis.into_inner() * r;
+            let dh = c.imp.hub().signed_distance(&centre);
+            assert!((dh - r).abs() < 1e-6, "hub distance {dh}");
+            let db = cl.blade_signed_distance(&nalgebra::Point3::from(centre)).0;
+            assert!(db >= r.max(2.0 * rf - r) - 1e-9, "blade distance {db}");
+        }
+    }
+    // Exact ball placement: no penetration of hub or blades (1e-6 mm).
+    assert!(metric(&planned, "max_overcut_mm") < 1e-6);
+    // The tool above the ball keeps the certified clearance (−tol/2).
+    assert!(metric(&planned, "min_blade_clearance_mm") >= -0.5 * c.tol.machining_tol - 1e-9);
+    // Upstream of the splitter one lane, beside it two.
+    assert_eq!(metric(&planned, "lanes"), 3.0);
+    // The residual is measured (finite, at most the ball radius where points are uncut).
+    let h = metric(&planned, "max_scallop_mm");
+    assert!(h.is_finite() && h > 0.0 && h <= r + 1e-12, "{h}");
+}
