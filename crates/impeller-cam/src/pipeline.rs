@@ -565,7 +565,13 @@ pub fn post(
         &program_options,
     )
     .map_err(msg)?;
-    for (_, m) in &assembled.metrics {
+    for (name, m) in &assembled.metrics {
+        if m.max_linearisation_error_mm > job.tolerances.linearisation_tol {
+            report.notes.push(format!(
+                "post: {name}: the largest linearisation error {:.4} mm exceeds linearisation_tol {} mm (subdivision exhausted, typically where the tool axis passes near the rotary axis' singular direction); the verification of the written program measures what the machine's motion does to the part",
+                m.max_linearisation_error_mm, job.tolerances.linearisation_tol
+            ));
+        }
         post.reverse_motions_before += m.reverse_motions_before;
         post.reverse_motions_after += m.reverse_motions_after;
         post.max_linearisation_error_mm = post
