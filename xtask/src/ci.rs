@@ -22,6 +22,10 @@ pub struct Args {
     /// Do not try to install missing packages.
     #[arg(long)]
     pub no_install: bool,
+    /// Only the set-up and the static checks (install, fmt, clippy): `.ci/run` then runs the
+    /// README's test command and the regressions itself.
+    #[arg(long)]
+    pub checks_only: bool,
 }
 
 /// Debian packages providing the external programs the tests use: (program, package).
@@ -119,6 +123,9 @@ pub fn run(args: Args) -> Result<bool, String> {
         "-D",
         "warnings",
     ]))?;
+    if args.checks_only {
+        return Ok(true);
+    }
     // The tests: stream both outputs through, keep them for the totals.
     let mut child = cargo()
         .args(["test", "--workspace"])

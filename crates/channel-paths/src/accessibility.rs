@@ -1,7 +1,39 @@
 //! Accessibility of a ball-end position: clearance of the tool above its ball.
 
-use cam_plan::{PlanContext, Point3};
+use cam_core::CutterShape;
+use cam_plan::{PlanContext, PlanError, Point3};
 use nalgebra::Vector3;
+
+/// The ball radius of the context's tool (ball end or tapered ball end); otherwise a tool
+/// error saying that `what` needs one.
+pub(crate) fn ball_radius(
+    ctx: &PlanContext<'_>,
+    operation: &str,
+    what: &str,
+) -> Result<f64, PlanError> {
+    match ctx.tool.cutter.shape {
+        CutterShape::BallEnd { radius } => Ok(radius),
+        CutterShape::TaperedBallEnd { ball_radius, .. } => Ok(ball_radius),
+        _ => Err(PlanError::tool(
+            operation,
+            ctx.tool.name(),
+            format!("{what} needs a ball-end or tapered ball-end cutter"),
+        )),
+    }
+}
+
+/// `a` turned toward the unit normal `n` (in their common plane) until their angle is at most
+/// `max` (rad); unchanged when it already is. O(1).
+pub(crate) fn limit_tilt(a: Vector3<f64>, n: &Vector3<f64>, max: f64) -> Vector3<f64> {
+    let c = a.dot(n).clamp(-1.0, 1.0);
+    if c.acos() <= max {
+        return a;
+    }
+    let perp = (a - n * c)
+        .try_normalize(1e-12)
+        .unwrap_or_else(|| n.cross(&Vector3::x()));
+    (n * max.cos() + perp * max.sin()).normalize()
+}
 
 /// Smallest signed clearance (mm) of the tool samples above the ball — flutes, shank and
 /// holder from [`cam_plan::DesignClearance::samples`] — with the ball centre at `centre` and

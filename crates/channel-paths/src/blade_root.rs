@@ -34,7 +34,7 @@
 //!
 //! Cost: O(stations · (regula-falsi iterations + steps · tool samples · design distance)).
 
-use cam_core::{CutterLocation, CutterShape, Move, ToolPath};
+use cam_core::{CutterLocation, Move, ToolPath};
 use cam_plan::{
     pattern, Metrics, Operation, OperationSpec, PlanContext, PlanError, PlannedOperation, Plot,
     PlotKind, PlotSeries, Point3,
@@ -43,7 +43,7 @@ use impeller_model::{channel::edge_v, Blade, Impeller, Side};
 use nalgebra::{Rotation3, Vector3};
 use serde::Deserialize;
 
-use crate::accessibility::upper_clearance;
+use crate::accessibility::{ball_radius, upper_clearance};
 
 /// Kind key of blade-root finishing in job files.
 pub const BLADE_ROOT_FINISHING: &str = "blade_root_finishing";
@@ -406,7 +406,7 @@ pub fn plan_side(
     stations: usize,
     step: f64,
 ) -> Result<Vec<RootPosition>, PlanError> {
-    let r = ball_radius(ctx, operation)?;
+    let r = ball_radius(ctx, operation, "blade-root finishing")?;
     let imp = ctx.impeller;
     let s = blade.side(side);
     let ((u0, u1), _) = s.domain();
@@ -491,18 +491,6 @@ pub fn plan_side(
     Ok(out)
 }
 
-fn ball_radius(ctx: &PlanContext<'_>, operation: &str) -> Result<f64, PlanError> {
-    match ctx.tool.cutter.shape {
-        CutterShape::BallEnd { radius } => Ok(radius),
-        CutterShape::TaperedBallEnd { ball_radius, .. } => Ok(ball_radius),
-        _ => Err(PlanError::tool(
-            operation,
-            ctx.tool.name(),
-            "blade-root finishing needs a ball-end cutter",
-        )),
-    }
-}
-
 impl Operation for BladeRootFinishing {
     fn kind(&self) -> &'static str {
         BLADE_ROOT_FINISHING
@@ -514,7 +502,7 @@ impl Operation for BladeRootFinishing {
         &self.tool
     }
     fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
-        let r = ball_radius(ctx, &self.name)?;
+        let r = ball_radius(ctx, &self.name, "blade-root finishing")?;
         let imp = ctx.impeller;
         let mut paths = Vec::new();
         let mut metrics = Metrics::new();

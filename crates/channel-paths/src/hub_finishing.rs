@@ -69,7 +69,9 @@
 //! clearance query) for the postures, O(grid · 4 lines · dense centres) for the scallop.
 //! Lines run in parallel (rayon).
 
-use cam_core::{CutterLocation, CutterShape, Move, ToolPath};
+use cam_core::{CutterLocation, Move, ToolPath};
+
+use crate::accessibility::{ball_radius, limit_tilt};
 use cam_plan::{
     pattern, ClearanceOptions, Metrics, Operation, OperationSpec, PartSet, PlanContext, PlanError,
     PlannedOperation, Plot, PlotKind, PlotSeries, Point3,
@@ -609,31 +611,27 @@ impl Planner<'_> {
                 .0
                 - self.r
         };
-        let ball_ok = certify_line(&ball, &ca, &cb, ball(&ca), ball(&cb), min, BALL_BISECTIONS);
         if !hub_ok {
             return Err(0);
         }
+        let ball_ok = certify_line(&ball, &ca, &cb, ball(&ca), ball(&cb), min, BALL_BISECTIONS);
         if !ball_ok {
             return Err(1);
         }
-        self.upper
-            .segment_clearance_between(
-                (&a.cl, a.clearance),
-                (&b.cl, b.clearance),
+        for (q, ca, cb) in [
+            (&self.upper, a.clearance, b.clearance),
+            (&self.blades_only, a.blade_clearance, b.blade_clearance),
+        ] {
+            q.segment_clearance_between(
+                (&a.cl, ca),
+                (&b.cl, cb),
                 min,
                 0.25 * self.tol,
                 SEGMENT_QUERIES,
             )
-            .map_err(|_: f64| 2usize)?;
-        self.blades_only
-            .segment_clearance_between(
-                (&a.cl, a.blade_clearance),
-                (&b.cl, b.blade_clearance),
-                min,
-                0.25 * self.tol,
-                SEGMENT_QUERIES,
-            )
-            .map_err(|_| 2)
+            .map_err(|_| 2usize)?;
+        }
+        Ok(())
     }
 
     fn centre_of(&self, cl: &CutterLocation) -> Vector3<f64> {
@@ -676,29 +674,6 @@ fn certify_line(
     let m = 0.5 * (a + b);
     let fm = f(&m);
     certify_line(f, a, &m, fa, fm, min, depth - 1) && certify_line(f, &m, b, fm, fb, min, depth - 1)
-}
-
-fn limit_tilt(a: Vector3<f64>, n: &Vector3<f64>, max: f64) -> Vector3<f64> {
-    let c = a.dot(n).clamp(-1.0, 1.0);
-    if c.acos() <= max {
-        return a;
-    }
-    let perp = (a - n * c)
-        .try_normalize(1e-12)
-        .unwrap_or_else(|| n.cross(&Vector3::x()));
-    (n * max.cos() + perp * max.sin()).normalize()
-}
-
-fn ball_radius(ctx: &PlanContext<'_>, operation: &str) -> Result<f64, PlanError> {
-    match ctx.tool.cutter.shape {
-        CutterShape::BallEnd { radius } => Ok(radius),
-        CutterShape::TaperedBallEnd { ball_radius, .. } => Ok(ball_radius),
-        _ => Err(PlanError::tool(
-            operation,
-            ctx.tool.name(),
-            "hub finishing needs a ball-end or tapered ball-end cutter",
-        )),
-    }
 }
 
 /// The free arcs at station `t` (module docs): `None` where the channel's bounding sides do
@@ -942,7 +917,7 @@ impl Operation for HubFinishing {
         &self.tool
     }
     fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
-        let r = ball_radius(ctx, &self.name)?;
+        let r = ball_radius(ctx, &self.name, "hub finishing")?;
         let imp = ctx.impeller;
         let tol = ctx.tolerances.machining_tol;
         let rf = imp.fillet_radius_mm();

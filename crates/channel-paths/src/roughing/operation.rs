@@ -39,6 +39,7 @@
 //! `paths`, `min_blade_clearance_mm` (clearance query against the true blades).
 
 use super::plan2d::{self, Linking, Path2, Region};
+use crate::accessibility::limit_tilt;
 use cam_core::{contact_location, CutterLocation, CutterShape, Move, MoveKind, ToolPath};
 use cam_plan::{
     ClearanceOptions, Metrics, Operation, OperationSpec, PartSet, PlanContext, PlanError,
@@ -907,19 +908,6 @@ fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
     let k = xs.partition_point(|&v| v <= x).clamp(1, xs.len() - 1);
     let t = ((x - xs[k - 1]) / (xs[k] - xs[k - 1])).clamp(0.0, 1.0);
     ys[k - 1] + t * (ys[k] - ys[k - 1])
-}
-
-/// `a` turned toward `n` until their angle is at most `max` (rad).
-fn limit_tilt(a: Vector3<f64>, n: &Vector3<f64>, max: f64) -> Vector3<f64> {
-    let c = a.dot(n).clamp(-1.0, 1.0);
-    let ang = c.acos();
-    if ang <= max {
-        return a;
-    }
-    let perp = (a - n * c)
-        .try_normalize(1e-12)
-        .unwrap_or_else(|| n.cross(&Vector3::x()));
-    (n * max.cos() + perp * max.sin()).normalize()
 }
 
 /// Moving average of unit axes over `w` neighbours (renormalised).
