@@ -273,7 +273,9 @@ pub fn assemble_program_with_access(
             continue;
         }
         if options.mode != OutputMode::Joint {
+            // The controller interpolates the tip on the line (TCP): nothing to linearise.
             post.linearisation_tol = None;
+            post.tool_centre_point = true;
         }
         let checker = match op_access {
             OperationAccess::Checked(c) => Some(*c),

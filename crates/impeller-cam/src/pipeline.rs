@@ -577,7 +577,16 @@ pub fn post(
         post.max_linearisation_error_mm = post
             .max_linearisation_error_mm
             .max(m.max_linearisation_error_mm);
+        if m.reconfigurations > 0 {
+            report.notes.push(format!(
+                "post: {name}: {} cutting move(s) change the rotary solution branch (no posture \
+                 choice keeps this machine on one branch through the cut within its limits): \
+                 the tool swings away from the planned orientations there",
+                m.reconfigurations
+            ));
+        }
         post.limit_violations += m.limit_violations;
+        post.reconfigurations += m.reconfigurations;
         post.blocks += m.blocks;
     }
     for p in &assembled.operations {

@@ -57,6 +57,10 @@ pub struct PostReport {
     pub max_linearisation_error_mm: f64,
     /// Blocks outside the machine limits.
     pub limit_violations: usize,
+    /// Cutting moves between which the rotary axes change solution branch (e.g. the tilt sign)
+    /// instead of following the intended tool-axis sweep: the tool swings away from the
+    /// planned orientations there (a retract and re-approach is needed).
+    pub reconfigurations: usize,
     /// The same figures per simultaneous operation, with the reverse-motion removal details.
     pub operations: Vec<PostOperationReport>,
 }
@@ -76,6 +80,8 @@ pub struct PostOperationReport {
     pub max_linearisation_error_mm: f64,
     /// Blocks outside the machine limits.
     pub limit_violations: usize,
+    /// Cutting moves with a change of solution branch (see [`PostReport::reconfigurations`]).
+    pub reconfigurations: usize,
     /// Whether reverse-motion removal ran (it does not without a cutter to check against).
     pub reverse_motion_removal: bool,
     /// Cutting runs whose rotary angles were smoothed.
@@ -102,6 +108,7 @@ impl PostOperationReport {
             reverse_motions_after: m.reverse_motions_after,
             max_linearisation_error_mm: m.max_linearisation_error_mm,
             limit_violations: m.limit_violations,
+            reconfigurations: m.reconfigurations,
             reverse_motion_removal: p.reverse_motion_removal,
             ..Self::default()
         };

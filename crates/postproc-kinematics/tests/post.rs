@@ -486,3 +486,105 @@ fn linearisation_through_the_singular_direction_converges() {
     }
     assert!(worst <= tol * 1.0001, "dense deviation {worst}");
 }
+
+/// A cut whose tool axis passes 0.06° beside the table's axis and then tilts to 55° on the far
+/// side (the hub outlet-to-channel sweep of a radial impeller). Continuity alone flips the
+/// tilt sign at the pole (the cheaper step there) and then meets the A ≤ 50° limit in the
+/// middle of the cut, where the only way on is a swing of the tool through the vertical. The
+/// group-wide choice keeps the negative branch: C swings ~180° near the pole (following the
+/// intended sweep, tracked by linearisation) and no branch change remains.
+#[test]
+fn posture_choice_keeps_one_branch_through_a_near_pole_pass() {
+    let m = fixture("xyzac-trt");
+    let tol = 0.005;
+    let mut moves = Vec::new();
+    for k in 0..67 {
+        let a_deg = k as f64 - 10.5;
+        let v = m.tool_axis(a_deg.to_radians(), 0.0).into_inner();
+        let axis = (v + Vector3::new(0.001, 0.0, 0.0)).normalize();
+        let tip = Point3::new(20.0, -5.0 + 0.1 * k as f64, 5.0);
+        let cl = CutterLocation::new(tip, axis).unwrap();
+        moves.push(if k == 0 {
+            Move::rapid(cl)
+        } else {
+            Move::feed(cl)
+        });
+    }
+    let opts = PostOptions {
+        linearisation_tol: Some(tol),
+        ..Default::default()
+    };
+    let posted = post_path(&m, &moves, &opts).unwrap();
+    assert_eq!(posted.metrics.reconfigurations, 0, "{:?}", posted.metrics);
+    assert_eq!(posted.metrics.limit_violations, 0);
+    assert!(posted.metrics.max_linearisation_error_mm <= tol);
+    // the tilt keeps one sign (beyond the pole region) on every block
+    let signs: Vec<f64> = posted
+        .blocks
+        .iter()
+        .map(|b| b.joints.tilt)
+        .filter(|t| t.abs() > 1f64.to_radians())
+        .map(f64::signum)
+        .collect();
+    assert!(signs.windows(2).all(|w| w[0] == w[1]), "tilt changes sign");
+    // joint interpolation between the blocks stays on the intended orientations (within 1°)
+    // and the intended line (within tol), by dense sampling against the source segment
+    let mut worst_axis: f64 = 0.0;
+    let mut worst_tip: f64 = 0.0;
+    for w in posted.blocks.windows(2) {
+        let src = w[1].source_index;
+        let (c0, c1) = (&moves[src - 1].cl, &moves[src].cl);
+        for k in 1..200 {
+            let s = k as f64 / 200.0;
+            let pose = m.forward(&w[0].joints.lerp(&w[1].joints, s), 0.0);
+            worst_tip = worst_tip.max(point_segment_distance(&pose.tip, &c0.tip, &c1.tip));
+            // angle to the nearest axis of the intended sweep
+            let best = (0..=400)
+                .map(|i| {
+                    let u = postproc_kinematics::linearise::slerp_axis(
+                        &c0.axis,
+                        &c1.axis,
+                        i as f64 / 400.0,
+                    );
+                    pose.axis.angle(&u)
+                })
+                .fold(f64::INFINITY, f64::min);
+            worst_axis = worst_axis.max(best);
+        }
+    }
+    assert!(worst_tip <= tol * 1.0001, "tip deviation {worst_tip}");
+    assert!(
+        worst_axis <= 1f64.to_radians(),
+        "axis leaves the intended sweep by {}°",
+        worst_axis.to_degrees()
+    );
+}
+
+/// A tool-centre-point program needs no linearisation: the controller keeps the tip on the
+/// line, so nothing is inserted and no error is reported.
+#[test]
+fn tool_centre_point_output_is_not_linearised() {
+    let m = fixture("xyzac-trt");
+    let cls = vec![
+        CutterLocation::new(
+            Point3::new(-20.0, 5.0, 10.0),
+            m.tool_axis(-0.3, 0.2).into_inner(),
+        )
+        .unwrap(),
+        CutterLocation::new(
+            Point3::new(25.0, -10.0, 20.0),
+            m.tool_axis(-0.8, 1.4).into_inner(),
+        )
+        .unwrap(),
+    ];
+    let joint = post_locations(&m, &cls, &PostOptions::default()).unwrap();
+    assert!(joint.metrics.inserted_blocks > 0);
+    let tcp = PostOptions {
+        linearisation_tol: None,
+        tool_centre_point: true,
+        ..Default::default()
+    };
+    let p = post_locations(&m, &cls, &tcp).unwrap();
+    assert_eq!(p.metrics.inserted_blocks, 0);
+    assert_eq!(p.metrics.max_linearisation_error_mm, 0.0);
+}
