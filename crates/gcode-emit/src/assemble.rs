@@ -30,7 +30,7 @@ use crate::{ClOperation, GcodeError};
 use cam_core::{CutterLocation, Move, MoveKind};
 use postproc_kinematics::{
     post_path, post_path_checked, AccessibilityChecker, AxisId, DisplacementCurves, Joints,
-    Machine, PostMetrics, PostOptions, PostedBlock, ReverseMotionReport,
+    Machine, PostMetrics, PostOptions, PostedBlock, ReverseMotionOptions, ReverseMotionReport,
 };
 
 /// Options of [`assemble_program`].
@@ -109,6 +109,10 @@ pub enum OperationAccess<'a> {
     /// the checker (gouge and collision); a run that cannot be made accessible keeps its
     /// original postures.
     Checked(&'a dyn AccessibilityChecker),
+    /// Removal with these options instead of [`PostOptions::reverse_motion`] (e.g. turning a
+    /// ball end about its centre, [`ReverseMotionOptions::keeping_contact`]), every changed
+    /// posture re-checked by the checker.
+    CheckedWith(&'a dyn AccessibilityChecker, &'a ReverseMotionOptions),
     /// No removal for this operation (reverse motions are only counted).
     CountOnly,
 }
@@ -118,6 +122,7 @@ impl std::fmt::Debug for OperationAccess<'_> {
         f.write_str(match self {
             Self::Unchecked => "Unchecked",
             Self::Checked(_) => "Checked(..)",
+            Self::CheckedWith(..) => "CheckedWith(..)",
             Self::CountOnly => "CountOnly",
         })
     }
@@ -279,6 +284,10 @@ pub fn assemble_program_with_access(
         }
         let checker = match op_access {
             OperationAccess::Checked(c) => Some(*c),
+            OperationAccess::CheckedWith(c, o) => {
+                post.reverse_motion = Some(**o);
+                Some(*c)
+            }
             OperationAccess::Unchecked => None,
             OperationAccess::CountOnly => {
                 post.reverse_motion = None;

@@ -64,6 +64,8 @@ pub struct Job {
     pub safety: SafetySpec,
     /// Verification settings.
     pub verification: VerificationSpec,
+    /// Post-processing settings (`[post]`).
+    pub post: PostSpec,
     /// The tools (inline `[[tools]]` or a tool file).
     pub tools: Vec<Tool>,
     /// The operations in machining order (kinds checked against the registry the job was
@@ -112,6 +114,17 @@ impl Default for SafetySpec {
     }
 }
 
+/// Post-processing settings of a job (`[post]`).
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PostSpec {
+    /// Remove reverse motions of the rotary axes in imported CL data too (default `false`:
+    /// they are only counted). The smoothing turns a ball end about its centre (from the
+    /// file's `CUTTER` record), which keeps the contact only where the other CAM system put
+    /// the contact on the ball; opt in when that holds.
+    pub smooth_imported_cl: bool,
+}
+
 /// Verification settings of a job.
 #[derive(Debug, Clone, Copy, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -150,6 +163,8 @@ struct RawJob {
     safety: SafetySpec,
     #[serde(default)]
     verification: VerificationSpec,
+    #[serde(default)]
+    post: PostSpec,
     #[serde(default)]
     tools: Option<ToolsField>,
     #[serde(default)]
@@ -866,6 +881,7 @@ impl Job {
             tolerances,
             safety: raw.safety,
             verification: v,
+            post: raw.post,
             tools,
             operations,
             cl_files: raw.cl_files.into_iter().map(|c| resolve(c.path)).collect(),

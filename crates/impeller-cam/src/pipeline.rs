@@ -522,11 +522,19 @@ pub fn post(
             _ => Ok(None),
         })
         .collect::<Result<_, _>>()?;
+    // Per operation, how reverse-motion smoothing may change postures without moving the
+    // cut by more than the bound (see `reverse_motion_options`); imported CL data only when
+    // the job opts in.
+    let smoothing: Vec<Option<ReverseMotionOptions>> = operations
+        .iter()
+        .map(|op| reverse_motion_options(job, op))
+        .collect();
     let access: Vec<OperationAccess<'_>> = checkers
         .iter()
-        .map(|c| match c {
-            Some(c) => OperationAccess::Checked(c),
-            None => OperationAccess::CountOnly,
+        .zip(&smoothing)
+        .map(|(c, o)| match (c, o) {
+            (Some(c), Some(o)) => OperationAccess::CheckedWith(c, o),
+            _ => OperationAccess::CountOnly,
         })
         .collect();
     let unchecked: Vec<&str> = operations
@@ -539,6 +547,18 @@ pub fn post(
             "reverse motions were counted but not removed in {}: without a CUTTER record \
              a changed tool posture cannot be checked for gouging",
             unchecked.join(", ")
+        ));
+    }
+    let not_opted: Vec<&str> = operations
+        .iter()
+        .filter(|op| op.kind == "cl_import" && op.tool.is_some() && !job.post.smooth_imported_cl)
+        .map(|op| op.cl.path.name.as_str())
+        .collect();
+    if !not_opted.is_empty() {
+        report.notes.push(format!(
+            "reverse motions were counted but not removed in the imported CL data {} \
+             (opt in with [post] smooth_imported_cl = true)",
+            not_opted.join(", ")
         ));
     }
     let assembled = assemble_program_with_access(
@@ -597,6 +617,26 @@ pub fn post(
     post.written = true;
     report.post = post;
     Ok(Some(assembled))
+}
+
+/// The reverse-motion smoothing an operation allows, or `None` (only counted): turning
+/// about the ball centre for ball ends in point contact, about the middle of the flutes with
+/// the contact line `(0, flute length)` for flank operations, about the tip with the contact
+/// on the bottom rim for cutters in bottom contact
+/// ([`ReverseMotionOptions::keeping_contact`]); the contact may move at most the job's
+/// `machining_tol` (and the post's default bound); imported CL data only with
+/// `[post] smooth_imported_cl`.
+fn reverse_motion_options(job: &Job, op: &JobOperation) -> Option<ReverseMotionOptions> {
+    let tool = op.tool.as_ref()?;
+    if op.kind == "cl_import" && !job.post.smooth_imported_cl {
+        return None;
+    }
+    let cutter = &tool.cutter;
+    let flank = matches!(op.kind.as_str(), "flank_finishing" | "flank_semi_finishing");
+    let mut o =
+        ReverseMotionOptions::keeping_contact(cutter, flank.then_some((0.0, cutter.flute_length)));
+    o.max_contact_shift_mm = o.max_contact_shift_mm.min(job.tolerances.machining_tol);
+    Some(o)
 }
 
 /// Stage 4: simulates the operations as posted (smoothed tool axes) on the blank and fills

@@ -95,6 +95,12 @@ pub struct PostOperationReport {
     pub inaccessible_blocks: Vec<usize>,
     /// Largest change of a rotary angle by the smoothing (deg).
     pub max_angle_change_deg: f64,
+    /// Largest movement of the cutter's contact caused by the smoothed postures (mm): the
+    /// bound of the surface deviation the smoothing introduces (ball ends turn about their
+    /// centre: 0).
+    pub max_contact_shift_mm: f64,
+    /// Runs kept unsmoothed because the contact would have moved more than allowed.
+    pub runs_kept_for_contact: usize,
 }
 
 impl PostOperationReport {
@@ -123,6 +129,8 @@ impl PostOperationReport {
                 .map(|i| i.saturating_sub(1))
                 .collect();
             r.max_angle_change_deg = rm.max_angle_change_deg;
+            r.max_contact_shift_mm = rm.max_contact_shift_mm;
+            r.runs_kept_for_contact = rm.runs_kept_for_contact;
         }
         r
     }

@@ -69,7 +69,7 @@ fn ring_cl() -> String {
 /// point.
 fn swing_ring_cl(amplitude_deg: f64, z: f64, plunge: bool) -> String {
     let mut s = String::from(
-        "PARTNO RING TEST\nUNITS/MM\nMULTAX/ON\nLOADTL/1\nCUTTER/6.0,0.0,0.0,0.0,0.0,0.0,40.0\n\
+        "PARTNO RING TEST\nUNITS/MM\nMULTAX/ON\nLOADTL/1\nCUTTER/6.0,3.0,0.0,3.0,0.0,0.0,40.0\n\
          SPINDL/RPM,10000,CLW\nRAPID\n",
     );
     if plunge {
@@ -119,7 +119,12 @@ fn c_axis_swing_is_removed_checked_posted_and_verified() {
     // (constant posture) and the sweep; the smoothing refits with more control values than
     // the paper's four (whose fit exceeds the 10° limit, so the run was kept with its two
     // reversals) and every smoothed posture still passes the design gouge check.
-    let (r, out) = run_ring_job("swing", &swing_ring_cl(10.0, 43.5, true), 73);
+    let (r, out) = run_ring_job_with(
+        "swing",
+        &swing_ring_cl(10.0, 43.5, true),
+        73,
+        "[post]\nsmooth_imported_cl = true\n",
+    );
     assert_eq!(
         r["operations"][0]["moves"], 74,
         "rapid, plunge and 72 ring chords"
@@ -135,6 +140,8 @@ fn c_axis_swing_is_removed_checked_posted_and_verified() {
     // The swing is ±4.3° about the ring's steady turn; the smoothing changes C by about that.
     let change = op["max_angle_change_deg"].as_f64().unwrap();
     assert!(change > 1.0 && change <= 10.0, "{op}");
+    // The ball (CUTTER r = 3) turns about its centre: the contact stays on the ball.
+    assert!(op["max_contact_shift_mm"].as_f64().unwrap() <= 1e-9, "{op}");
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains(&format!("reverse motions {before} → 0")));
     assert!(
@@ -143,13 +150,43 @@ fn c_axis_swing_is_removed_checked_posted_and_verified() {
     );
 }
 
+#[test]
+fn imported_cl_is_smoothed_only_when_the_job_opts_in() {
+    // The same swinging ring without `[post] smooth_imported_cl`: counted, not removed, and
+    // the report says how to opt in. The smoothing turns the tool about a point the other
+    // CAM system may not have put the contact on.
+    let (r, out) = run_ring_job("swing-default", &swing_ring_cl(10.0, 43.5, true), 73);
+    let post = &r["post"];
+    let before = post["reverse_motions_before"].as_u64().unwrap();
+    assert!(before >= 2, "{post}");
+    assert_eq!(
+        post["reverse_motions_after"].as_u64().unwrap(),
+        before,
+        "{post}"
+    );
+    assert_eq!(post["operations"][0]["reverse_motion_removal"], false);
+    let notes = r["notes"].to_string();
+    assert!(notes.contains("smooth_imported_cl = true"), "{notes}");
+    assert!(out.join("program.ngc").exists());
+}
+
 /// Runs a job with `cl` as its CL file on the fixture impeller and machine (LinuxCNC) and
 /// checks what every such job must satisfy: exit 0, no limit violation, linearisation within
 /// 0.005 mm, at least `min_feeds` feed moves in rs274's output, no overcut beyond the 0.5 mm dexel resolution, no collision, every move in the
 /// CL file written back, and rs274 accepting the program. Returns the report and the output
 /// folder.
 fn run_ring_job(name: &str, cl: &str, min_feeds: usize) -> (serde_json::Value, PathBuf) {
-    let job = ring_job(name, cl);
+    run_ring_job_with(name, cl, min_feeds, "")
+}
+
+/// [`run_ring_job`] with `extra` appended to the job file.
+fn run_ring_job_with(
+    name: &str,
+    cl: &str,
+    min_feeds: usize,
+    extra: &str,
+) -> (serde_json::Value, PathBuf) {
+    let job = ring_job_with(name, cl, extra);
     let dir = job.parent().unwrap().to_path_buf();
     let out = dir.join("out");
     let st = cli()
@@ -333,6 +370,11 @@ fn finishing_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
 /// Writes a ring job (CL file `cl`, verified at 0.5 mm) into a fresh folder and returns the
 /// job file.
 fn ring_job(name: &str, cl: &str) -> PathBuf {
+    ring_job_with(name, cl, "")
+}
+
+/// [`ring_job`] with `extra` appended to the job file (e.g. a `[post]` table).
+fn ring_job_with(name: &str, cl: &str, extra: &str) -> PathBuf {
     let dir = scratch(name);
     std::fs::write(dir.join("ring.cls"), cl).unwrap();
     let imp = repo().join("fixtures/impeller-8+8/impeller.toml");
@@ -342,7 +384,7 @@ fn ring_job(name: &str, cl: &str) -> PathBuf {
         &job,
         format!(
             "name = \"ring\"\nimpeller = {:?}\nmachine = {:?}\ndialect = \"linuxcnc\"\n\
-             [verification]\nresolution_mm = 0.5\n[[cl_files]]\npath = \"ring.cls\"\n",
+             [verification]\nresolution_mm = 0.5\n[[cl_files]]\npath = \"ring.cls\"\n{extra}",
             imp.display().to_string(),
             machine.display().to_string()
         ),

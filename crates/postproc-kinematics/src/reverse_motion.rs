@@ -123,6 +123,11 @@ pub struct ReverseMotionOptions {
     /// ball surface turns onto itself. Default `(0, 0)` (contact at the tip).
     #[serde(default)]
     pub contact_heights_mm: (f64, f64),
+    /// Largest distance (mm) of a contact point from the tool axis: the bottom rim of a flat
+    /// end or bull nose in bottom contact. Turning by δ about the pivot moves a point at
+    /// height h and distance ρ from the axis by `√((h − pivot)² + ρ²)·δ`. Default 0.
+    #[serde(default)]
+    pub contact_radius_mm: f64,
     /// Largest movement of the contact allowed by a changed posture (mm, the surface
     /// deviation bound); a run needing more keeps its original postures. Default
     /// [`DEFAULT_MAX_CONTACT_SHIFT_MM`].
@@ -142,7 +147,9 @@ impl ReverseMotionOptions {
     /// Options keeping the contact of `cutter`: for a ball end (or tapered ball end) in
     /// point contact the pivot is the ball centre and the contact `(r, r)`; with
     /// `flank = Some((lo, hi))` (contact heights along the flutes, mm) the pivot is the middle
-    /// of the contact line.
+    /// of the contact line; a flat end, bull nose or tapered flat end in bottom contact turns
+    /// about its tip with the contact on the bottom rim (`contact_radius_mm`), so only turns
+    /// that move the rim less than `max_contact_shift_mm` are allowed.
     pub fn keeping_contact(cutter: &cam_core::Cutter, flank: Option<(f64, f64)>) -> Self {
         let mut o = Self::default();
         match (flank, &cutter.shape) {
@@ -158,7 +165,14 @@ impl ReverseMotionOptions {
                 o.pivot_height_mm = *ball_radius;
                 o.contact_heights_mm = (*ball_radius, *ball_radius);
             }
-            _ => {}
+            (
+                None,
+                cam_core::CutterShape::FlatEnd { radius }
+                | cam_core::CutterShape::BullNose { radius, .. },
+            ) => o.contact_radius_mm = *radius,
+            (None, cam_core::CutterShape::TaperedFlatEnd { tip_radius, .. }) => {
+                o.contact_radius_mm = *tip_radius;
+            }
         }
         o
     }
@@ -168,7 +182,11 @@ impl ReverseMotionOptions {
     pub fn contact_shift(&self, angle: f64) -> f64 {
         let (lo, hi) = self.contact_heights_mm;
         let p = self.pivot_height_mm;
-        (lo - p).abs().max((hi - p).abs()) * angle.abs()
+        (lo - p)
+            .abs()
+            .max((hi - p).abs())
+            .hypot(self.contact_radius_mm)
+            * angle.abs()
     }
 }
 
@@ -183,6 +201,7 @@ impl Default for ReverseMotionOptions {
             c_max: 10f64.to_radians(),
             pivot_height_mm: 0.0,
             contact_heights_mm: (0.0, 0.0),
+            contact_radius_mm: 0.0,
             max_contact_shift_mm: DEFAULT_MAX_CONTACT_SHIFT_MM,
         }
     }
@@ -210,7 +229,13 @@ impl ReverseMotionOptions {
             return bad("reverse_motion.c_step", "c_step must be > 0 and c_max >= 0");
         }
         let (lo, hi) = self.contact_heights_mm;
-        if !(self.pivot_height_mm.is_finite() && lo.is_finite() && hi.is_finite() && lo <= hi) {
+        if !(self.pivot_height_mm.is_finite()
+            && lo.is_finite()
+            && hi.is_finite()
+            && lo <= hi
+            && self.contact_radius_mm.is_finite()
+            && self.contact_radius_mm >= 0.0)
+        {
             return bad(
                 "reverse_motion.pivot_height_mm",
                 "pivot and contact heights must be finite, contact low <= high",

@@ -340,4 +340,26 @@ fn smoothing_turns_a_ball_end_about_its_centre_and_bounds_flank_contact() {
     assert_eq!((rep.runs_changed, rep.runs_kept), (0, 1), "{rep:?}");
     assert_eq!(rep.runs_kept_for_contact, 1, "{rep:?}");
     assert_eq!(rep.rotate_after, rep.rotate_before);
+
+    // A flat end Ø6 in bottom contact turns about its tip: its rim moves 3 mm·δ, so the
+    // degrees this swing needs keep the run too; the bound itself is √(Δh² + ρ²)·δ.
+    let flat = cam_core::Cutter::new(
+        "f6",
+        cam_core::CutterShape::FlatEnd { radius: r },
+        20.0,
+        r,
+        50.0,
+    )
+    .unwrap();
+    let bottom = ReverseMotionOptions::keeping_contact(&flat, None);
+    assert_eq!(bottom.pivot_height_mm, 0.0);
+    assert!((bottom.contact_shift(0.01) - 0.03).abs() < 1e-12);
+    assert!((flank.contact_shift(0.01) - 0.1).abs() < 1e-12);
+    let post_opts = PostOptions {
+        reverse_motion: Some(bottom),
+        ..Default::default()
+    };
+    let posted = post_path_checked(&m, &moves, &post_opts, Some(checker)).unwrap();
+    let rep = posted.reverse_motion.as_ref().unwrap();
+    assert_eq!(rep.runs_kept_for_contact, 1, "{rep:?}");
 }
