@@ -66,6 +66,8 @@ pub struct Job {
     pub verification: VerificationSpec,
     /// Post-processing settings (`[post]`).
     pub post: PostSpec,
+    /// No progress on stderr (`run --quiet`; not a job-file key).
+    pub quiet: bool,
     /// The tools (inline `[[tools]]` or a tool file).
     pub tools: Vec<Tool>,
     /// The operations in machining order (kinds checked against the registry the job was
@@ -882,6 +884,7 @@ impl Job {
             safety: raw.safety,
             verification: v,
             post: raw.post,
+            quiet: false,
             tools,
             operations,
             cl_files: raw.cl_files.into_iter().map(|c| resolve(c.path)).collect(),

@@ -16,6 +16,7 @@ pub mod error;
 pub mod job;
 pub mod pipeline;
 pub mod plot;
+pub mod progress;
 pub mod registry;
 pub mod report;
 

@@ -14,6 +14,7 @@
 
 use crate::error::CliError;
 use crate::job::Job;
+use crate::progress::Progress;
 use crate::registry::{self, Registry};
 use crate::report::{OperationReport, PostOperationReport, PostReport, Report, VerificationReport};
 use cam_core::{Cutter, CutterLocation, MoveKind, Rates, ToolPath};
@@ -28,7 +29,9 @@ use gcode_emit::{
     ClProgram, ClReadOptions, ClWriteOptions, LineNumbers, OutputMode, ProgramOptions, Spindle,
 };
 use impeller_model::Impeller;
-use machining_sim::{ImpellerDesign, ImpellerSampling, SimOptions, TriDexel};
+use machining_sim::{
+    ImpellerDesign, ImpellerSampling, ProgressSink, SimOptions, SimProgress, TriDexel,
+};
 use postproc_kinematics::{AccessibilityChecker, Machine, PostOptions, ReverseMotionOptions};
 use rayon::prelude::*;
 use std::path::Path;
@@ -47,8 +50,8 @@ fn msg(e: impl std::fmt::Display) -> CliError {
     CliError::Message(e.to_string())
 }
 
-fn stage(name: &str) -> Instant {
-    eprintln!("[impeller-cam] {name} …");
+fn stage(progress: &Progress, name: &str) -> Instant {
+    progress.stage(name);
     Instant::now()
 }
 
@@ -109,14 +112,15 @@ pub fn run_job_with(job: &Job, out: &Path, registry: &Registry) -> Result<Report
         source,
     })?;
     let mut report = Report::new(&job.name);
+    let progress = Progress::new(job.quiet);
 
-    let t = stage("building the impeller model");
+    let t = stage(&progress, "building the impeller model");
     let impeller = model(job)?;
     report.impeller = serde_json::to_value(impeller.summary()).map_err(msg)?;
     report.set_geometry_plots(&impeller);
     report.timings_ms.insert("model_ms".into(), ms(t));
 
-    let t = stage("planning operations");
+    let t = stage(&progress, "planning operations");
     let operations = plan(job, &impeller, registry, &mut report.notes)?;
     if operations.is_empty() {
         report
@@ -129,15 +133,18 @@ pub fn run_job_with(job: &Job, out: &Path, registry: &Registry) -> Result<Report
     }
     report.timings_ms.insert("plan_ms".into(), ms(t));
 
-    let t = stage("post-processing");
+    let t = stage(&progress, "post-processing");
     let assembled = post(job, &impeller, &operations, out, &mut report)?;
     report.timings_ms.insert("post_ms".into(), ms(t));
 
-    let t = stage(if job.verification.enabled {
-        "verifying by stock simulation"
-    } else {
-        "verification disabled by the job ([verification] enabled = false)"
-    });
+    let t = stage(
+        &progress,
+        if job.verification.enabled {
+            "verifying by stock simulation"
+        } else {
+            "verification disabled by the job ([verification] enabled = false)"
+        },
+    );
     verify(
         job,
         &impeller,
@@ -300,6 +307,7 @@ pub fn plan(
     } else {
         Some(design_mesh(job, impeller)?)
     };
+    let progress = Progress::new(job.quiet);
     let planned: Vec<Result<JobOperation, CliError>> = job
         .operations
         .par_iter()
@@ -315,6 +323,7 @@ pub fn plan(
             })?;
             let op = registry::build(registry, spec).map_err(fail)?;
             let t = Instant::now();
+            let task = progress.task(format!("planning {} ({})", spec.name, spec.kind));
             let mesh = mesh
                 .clone()
                 .ok_or_else(|| fail(PlanError::geometry(&spec.name, "design mesh", "not built")))?;
@@ -337,6 +346,13 @@ pub fn plan(
             let rates = ctx.rates();
             set_feeds(&mut path, &rates);
             let plan_ms = ms(t);
+            task.done(format!(
+                "planned {} ({}): {} moves in {:.1} s",
+                spec.name,
+                spec.kind,
+                path.moves.len(),
+                plan_ms / 1e3
+            ));
             let mut cl = ClOperation::new(path);
             cl.tool_number = Some(tool.number);
             cl.cutter = Some(tool.cutter.clone());
@@ -688,11 +704,32 @@ pub fn verify(
     let design = ImpellerDesign::new(impeller, ImpellerSampling::default()).map_err(msg)?;
     let blank = design.blank().map_err(msg)?;
     let mut stock = TriDexel::from_shape(&blank, job.verification.resolution_mm).map_err(msg)?;
+    let progress = Progress::new(job.quiet);
+    let total: usize = verifiable.iter().map(|(_, p)| p.moves.len()).sum();
+    let bar = progress.bar(total as u64, "verifying");
+    let sink_bar = bar.clone();
     let options = SimOptions {
-        progress: true,
+        progress: !job.quiet && bar.is_hidden(),
+        on_progress: (!bar.is_hidden()).then(|| {
+            ProgressSink(std::sync::Arc::new(move |p: SimProgress<'_>| match p {
+                SimProgress::Cutting {
+                    operation,
+                    done_moves,
+                    ..
+                } => {
+                    sink_bar.set_message(format!("verifying {operation}"));
+                    sink_bar.set_position(done_moves as u64);
+                }
+                SimProgress::Measuring => {
+                    sink_bar.set_message("measuring overcut and residual".to_string());
+                }
+            }))
+        }),
         ..SimOptions::default()
     };
-    let rep = machining_sim::simulate(&mut stock, &design, &verifiable, &options).map_err(msg)?;
+    let rep = machining_sim::simulate(&mut stock, &design, &verifiable, &options).map_err(msg);
+    bar.finish_and_clear();
+    let rep = rep?;
     let maps = serde_json::to_string(&rep.maps).map_err(msg)?;
     gcode_emit::write_atomic(&out.join("verification_maps.json"), maps.as_bytes()).map_err(msg)?;
     let limit = job.tolerances.machining_tol

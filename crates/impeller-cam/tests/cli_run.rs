@@ -485,3 +485,34 @@ fn flank_finishing_refuses_a_path_outside_its_tolerance() {
     );
     assert!(!dir.join("out/program.ngc").exists());
 }
+
+#[test]
+fn progress_goes_to_stderr_as_lines_off_a_terminal_and_not_at_all_with_quiet() {
+    // Off a terminal (as here) the stage lines are printed and no progress bar is drawn (no
+    // cursor control); with --quiet neither, while the summary line stays.
+    let job = repo().join("fixtures/impeller-8+8/job.toml");
+    let out = scratch("progress");
+    let run = |quiet: bool| {
+        let mut c = cli();
+        c.arg("run").arg(&job).arg("--out").arg(&out);
+        if quiet {
+            c.arg("--quiet");
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let loud = run(false);
+    assert!(
+        loud.contains("[impeller-cam] planning operations"),
+        "{loud}"
+    );
+    assert!(
+        !loud.contains('\u{1b}'),
+        "escape codes off a terminal: {loud}"
+    );
+    let quiet = run(true);
+    assert!(!quiet.contains("planning operations"), "{quiet}");
+    assert!(!quiet.contains('\u{1b}'), "{quiet}");
+    assert!(quiet.contains("impeller-8+8: 1 operation(s)"), "{quiet}");
+}

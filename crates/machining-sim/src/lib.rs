@@ -75,7 +75,8 @@ pub use measure::{Extremum, Measured, SurfaceMap};
 pub use motion::Interpolation;
 pub use removal::PartKind;
 pub use simulate::{
-    cut, simulate, Collision, CollisionTarget, CutOutcome, Metrics, Report, SimOptions, SimStats,
+    cut, simulate, Collision, CollisionTarget, CutOutcome, Metrics, ProgressSink, Report,
+    SimOptions, SimProgress, SimStats,
 };
 pub use stock_shape::{BoxStock, RevolvedStock, StockShape};
 pub use surface_mesh::{extract_surface, write_stl, StockMesh};

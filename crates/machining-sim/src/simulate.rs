@@ -38,8 +38,37 @@ pub struct SimOptions {
     pub probe_depth_mm: f64,
     /// Positions per batch.
     pub batch_positions: usize,
-    /// Print progress on stderr.
+    /// Print progress on stderr (lines every 2 s; see also `on_progress`).
     pub progress: bool,
+    /// Called after every batch of positions and when the measurement starts, instead of
+    /// the stderr lines (e.g. to drive a progress bar).
+    pub on_progress: Option<ProgressSink>,
+}
+
+/// Where the simulation is (see [`SimOptions::on_progress`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SimProgress<'a> {
+    /// Removing material: moves simulated so far (of all operations) and the operation.
+    Cutting {
+        /// Operation name.
+        operation: &'a str,
+        /// Moves done (all operations).
+        done_moves: usize,
+        /// Moves in all operations.
+        total_moves: usize,
+    },
+    /// Measuring overcut and residual over the design surfaces.
+    Measuring,
+}
+
+/// A progress callback of the simulation.
+#[derive(Clone)]
+pub struct ProgressSink(pub std::sync::Arc<dyn Fn(SimProgress<'_>) + Send + Sync>);
+
+impl std::fmt::Debug for ProgressSink {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ProgressSink(..)")
+    }
 }
 
 impl Default for SimOptions {
@@ -52,6 +81,7 @@ impl Default for SimOptions {
             probe_depth_mm: 3.0,
             batch_positions: 4096,
             progress: false,
+            on_progress: None,
         }
     }
 }
@@ -318,7 +348,13 @@ pub fn cut(
                     &mut stats,
                     &mut design_ms,
                 );
-                if options.progress && last_report.elapsed().as_secs_f64() > 2.0 {
+                if let Some(sink) = &options.on_progress {
+                    (sink.0)(SimProgress::Cutting {
+                        operation: &path.name,
+                        done_moves,
+                        total_moves,
+                    });
+                } else if options.progress && last_report.elapsed().as_secs_f64() > 2.0 {
                     eprintln!(
                         "verify: {}: {done_moves}/{total_moves} moves, {} positions, {:.1} s",
                         path.name,
@@ -338,6 +374,13 @@ pub fn cut(
         &mut stats,
         &mut design_ms,
     );
+    if let (Some(sink), Some((_, last))) = (&options.on_progress, ops.last()) {
+        (sink.0)(SimProgress::Cutting {
+            operation: &last.name,
+            done_moves,
+            total_moves,
+        });
+    }
     stats.moves = done_moves;
     stats.removal_ms = start.elapsed().as_secs_f64() * 1e3 - design_ms;
     stats.design_collision_ms = design_ms;
@@ -390,7 +433,9 @@ pub fn simulate(
     let initial = stock.clone();
     let outcome = cut(stock, Some(design), ops, options)?;
     let t = Instant::now();
-    if options.progress {
+    if let Some(sink) = &options.on_progress {
+        (sink.0)(SimProgress::Measuring);
+    } else if options.progress {
         eprintln!("verify: measuring overcut and residual over the design surfaces");
     }
     let grids = design.surface_grids();

@@ -17,6 +17,10 @@ pub struct Args {
     /// collision; the defects are still printed and reported.
     #[arg(long)]
     pub allow_defects: bool,
+    /// No progress on stderr (stage lines and bars); the summary, notes and defects are
+    /// still printed. Bars are drawn only when stderr is a terminal.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 /// What `impeller-cam run` ended with.
@@ -36,6 +40,7 @@ pub fn run(args: Args) -> Result<Outcome, CliError> {
         None => Job::default_job()?,
     };
     job.verification.allow_defects = args.allow_defects;
+    job.quiet = args.quiet;
     let report = crate::pipeline::run_job(&job, &args.out)?;
     eprintln!(
         "[impeller-cam] {}: {} operation(s), program {}, report {}",

@@ -1,0 +1,85 @@
+//! Progress on stderr while `run` works: one spinner per operation being planned (operations
+//! plan in parallel) and a bar over the moves of the verification. Drawn only when stderr is
+//! a terminal (indicatif hides its bars otherwise) and not with `run --quiet`; the stage
+//! lines (`[impeller-cam] planning operations …`) are printed either way unless quiet.
+
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::time::Duration;
+
+/// The progress display of one run.
+#[derive(Debug, Clone)]
+pub struct Progress {
+    multi: MultiProgress,
+    quiet: bool,
+}
+
+impl Progress {
+    /// A display on stderr (hidden with `quiet`).
+    pub fn new(quiet: bool) -> Self {
+        let target = if quiet {
+            ProgressDrawTarget::hidden()
+        } else {
+            ProgressDrawTarget::stderr()
+        };
+        Self {
+            multi: MultiProgress::with_draw_target(target),
+            quiet,
+        }
+    }
+
+    /// Whether the display is quiet (no stage lines either).
+    pub fn quiet(&self) -> bool {
+        self.quiet
+    }
+
+    /// A stage line (`[impeller-cam] {name} …`), printed above any bar.
+    pub fn stage(&self, name: &str) {
+        if !self.quiet {
+            let line = format!("[impeller-cam] {name} …");
+            if self.multi.is_hidden() {
+                eprintln!("{line}");
+            } else {
+                let _ = self.multi.println(line);
+            }
+        }
+    }
+
+    /// A spinner for one operation being planned; finish it with [`Task::done`].
+    pub fn task(&self, what: String) -> Task {
+        let bar = self.multi.add(ProgressBar::new_spinner());
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {msg} {elapsed:>4}")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        bar.set_message(what);
+        bar.enable_steady_tick(Duration::from_millis(120));
+        Task { bar }
+    }
+
+    /// A bar over `total` units (moves) with a message.
+    pub fn bar(&self, total: u64, what: &str) -> ProgressBar {
+        let bar = self.multi.add(ProgressBar::new(total));
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{msg} [{bar:30}] {pos}/{len} moves {elapsed:>4} (eta {eta})",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        bar.set_message(what.to_string());
+        bar
+    }
+}
+
+/// A spinner of [`Progress::task`].
+#[derive(Debug)]
+pub struct Task {
+    bar: ProgressBar,
+}
+
+impl Task {
+    /// Ends the spinner, leaving `summary` in its place.
+    pub fn done(self, summary: String) {
+        self.bar.finish_with_message(summary);
+    }
+}
