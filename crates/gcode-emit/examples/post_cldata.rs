@@ -6,10 +6,12 @@
 //! The CL file holds a 6 mm ball end (`CUTTER/6,3,...`) moving along a short five-axis arc
 //! whose tool axis leans outward from 10° to 30°. `assemble_program` turns the cutter locations
 //! into joint values with the machine's inverse kinematics (solution choice, unwinding,
-//! linearisation) and each dialect writes its own program text.
+//! linearisation) and each dialect writes its own program text (Heidenhain ISO in the
+//! controller's tool-centre-point mode, which this crate writes for it instead of joints).
 
 use gcode_emit::{
-    assemble_program, dialect_by_name, read_cl, AssembleOptions, ClReadOptions, ProgramOptions,
+    assemble_program, dialect_by_name, read_cl, AssembleOptions, ClReadOptions, OutputMode,
+    ProgramOptions,
 };
 use postproc_kinematics::Machine;
 
@@ -57,15 +59,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let machine = Machine::from_toml_str(MACHINE, "trt.toml")?;
     for name in ["linuxcnc", "fanuc", "sinumerik", "heidenhain"] {
         let dialect = dialect_by_name(name)?;
+        // Heidenhain ISO programs are written for the controller's tool-centre-point mode
+        // (tip coordinates and axis angles); the others get machine joint values.
+        let mode = if name == "heidenhain" {
+            OutputMode::TcpAngles
+        } else {
+            OutputMode::Joint
+        };
+        let options = AssembleOptions {
+            mode,
+            ..AssembleOptions::default()
+        };
         let posted = assemble_program(
             "demo",
             &parsed.operations,
             &machine,
             dialect.as_ref(),
-            &AssembleOptions::default(),
+            &options,
         )?;
         let text = dialect.write(&posted.program, &ProgramOptions::default())?;
-        println!("===== {name} ({} lines)", text.lines().count());
+        println!(
+            "===== {name}, {mode:?} output ({} lines)",
+            text.lines().count()
+        );
         println!("{text}");
     }
     Ok(())
