@@ -41,6 +41,9 @@ pub struct Args {
     /// Short measurement (criterion `--quick`): for a smoke run, not for figures.
     #[arg(long)]
     pub quick: bool,
+    /// Only the benchmark targets of this crate (repeatable; default: every crate).
+    #[arg(short, long = "package", value_name = "CRATE")]
+    pub packages: Vec<String>,
 }
 
 pub fn run(args: Args) -> Result<bool, String> {
@@ -51,7 +54,18 @@ pub fn run(args: Args) -> Result<bool, String> {
     let mut export_ok = true;
     // One `cargo bench` per criterion target: `--benches` alone would also hand criterion's
     // flags to the libtest harness of every library.
-    for (package, bench) in bench_targets(&root)? {
+    let mut targets = bench_targets(&root)?;
+    if !args.packages.is_empty() {
+        for p in &args.packages {
+            if !targets.iter().any(|(package, _)| package == p) {
+                return Err(format!(
+                    "crate `{p}` has no criterion benchmark (crates/{p}/benches/)"
+                ));
+            }
+        }
+        targets.retain(|(package, _)| args.packages.contains(package));
+    }
+    for (package, bench) in targets {
         let mut cmd = Command::new(env_cargo());
         cmd.current_dir(&root)
             .env("CRITERION_HOME", &home)
