@@ -7,9 +7,11 @@
 //! - `cargo xtask ci`: what CI runs — installs the test consumers (`rs274`, `chromium`) when
 //!   missing, then fmt, clippy, the whole test suite, the regressions and a closing
 //!   `tests: N passed, N failed` line (see [`ci`]).
-//! - `cargo xtask bench`: runs the criterion benchmarks in release, collects the median of
-//!   every benchmark into `target/bench/bmf.json` (Bencher Metric Format) and writes the
-//!   closest-point query set to `target/bench/closest_point_queries.csv`.
+//! - `cargo xtask bench`: runs the criterion benchmarks in release and writes the benchmarks
+//!   that ran in this invocation to `target/bench/bmf.json` (Bencher Metric Format: `latency`
+//!   in ns per iteration with its confidence bounds, throughput as a separate measure where a
+//!   benchmark declared one; see [`bench`]), and the closest-point query set to
+//!   `target/bench/closest_point_queries.csv`.
 
 #![allow(clippy::print_stdout)]
 

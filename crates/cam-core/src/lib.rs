@@ -47,3 +47,8 @@ pub type Point3 = nalgebra::Point3<f64>;
 pub type Vector3 = nalgebra::Vector3<f64>;
 /// Unit vector (tool axes, normals).
 pub type UnitVector3 = nalgebra::Unit<nalgebra::Vector3<f64>>;
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -52,3 +52,8 @@ pub use tool::Tool;
 pub type Point3 = cam_core::Point3;
 /// Vector in the workpiece frame (mm).
 pub type Vector3 = cam_core::Vector3;
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -11,3 +11,8 @@ pub mod roughing;
 pub use blade_root::{build_blade_root_finishing, BladeRootFinishing, BLADE_ROOT_FINISHING};
 pub use hub_finishing::{build_hub_finishing, HubFinishing, HUB_FINISHING};
 pub use roughing::{build_channel_roughing, CHANNEL_ROUGHING};
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -88,3 +88,8 @@ pub use beam::{Beam, Section};
 pub use conical::{cutter_beam, ConicalCutter, StiffnessReport};
 pub use error::StiffnessError;
 pub use ritz::{RitzOptions, RitzSolution};
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -76,3 +76,8 @@ impl FlankError {
         }
     }
 }
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -421,7 +421,7 @@ mod tests {
     use std::cell::Cell;
 
     fn machine() -> Machine {
-        let text = include_str!("../../../fixtures/machines/xyzac-trt.toml");
+        let text = include_str!("../embedded/machines/xyzac-trt.toml");
         Machine::from_toml_str(text, "xyzac-trt.toml").unwrap()
     }
 

@@ -88,3 +88,8 @@ pub use program::{
 };
 pub use readback::{read_back, Readback, ReadbackMode, ReadbackOptions};
 pub use tilted_plane::TiltedPlane;
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

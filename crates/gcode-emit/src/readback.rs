@@ -301,7 +301,7 @@ mod tests {
     use crate::read_gcode;
 
     fn machine() -> Machine {
-        let text = include_str!("../../../fixtures/machines/xyzac-trt.toml");
+        let text = include_str!("../embedded/machines/xyzac-trt.toml");
         Machine::from_toml_str(text, "xyzac-trt.toml").unwrap()
     }
 

@@ -23,25 +23,25 @@ pub const DEFAULT_JOB_NAME: &str = "impeller-8+8 (embedded default)";
 const EMBEDDED_JOB_PATH: &str = "<embedded>/fixtures/impeller-8+8/job.toml";
 
 /// The embedded default job: the `impeller-8+8` fixture job.
-const DEFAULT_JOB_TOML: &str = include_str!("../../../fixtures/impeller-8+8/job.toml");
+const DEFAULT_JOB_TOML: &str = include_str!("../embedded/impeller-8+8/job.toml");
 
 /// Files the embedded default job refers to, by resolved path.
 static EMBEDDED_FILES: &[(&str, &str)] = &[
     (
         "<embedded>/fixtures/impeller-8+8/impeller.toml",
-        include_str!("../../../fixtures/impeller-8+8/impeller.toml"),
+        include_str!("../embedded/impeller-8+8/impeller.toml"),
     ),
     (
         "<embedded>/fixtures/impeller-8+8/top-ring.cls",
-        include_str!("../../../fixtures/impeller-8+8/top-ring.cls"),
+        include_str!("../embedded/impeller-8+8/top-ring.cls"),
     ),
     (
         "<embedded>/fixtures/impeller-8+8/../machines/xyzac-trt.toml",
-        include_str!("../../../fixtures/machines/xyzac-trt.toml"),
+        include_str!("../embedded/machines/xyzac-trt.toml"),
     ),
     (
         "<embedded>/fixtures/impeller-8+8/../tools/impeller-8+8.toml",
-        include_str!("../../../fixtures/tools/impeller-8+8.toml"),
+        include_str!("../embedded/tools/impeller-8+8.toml"),
     ),
 ];
 

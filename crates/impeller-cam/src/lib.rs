@@ -29,3 +29,8 @@ pub use report::Report;
 /// (`machining_tol` plus the simulation's error bound) or a collision: the report is written
 /// and shows where, the program is withheld (`--allow-defects` keeps it and exits 0).
 pub const EXIT_DEFECTS: u8 = 3;
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

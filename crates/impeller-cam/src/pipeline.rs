@@ -39,7 +39,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// The machine used when a job names none: LinuxCNC `xyzac-trt` table-table trunnion.
-const DEFAULT_MACHINE: &str = include_str!("../../../fixtures/machines/xyzac-trt.toml");
+const DEFAULT_MACHINE: &str = include_str!("../embedded/machines/xyzac-trt.toml");
 
 /// Distance above the first point of a linked path where the approach rapid stops and the
 /// plunge feed begins (mm): enough to absorb the positioning overshoot of a rapid, short

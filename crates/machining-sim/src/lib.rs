@@ -80,3 +80,8 @@ pub use simulate::{
 };
 pub use stock_shape::{BoxStock, RevolvedStock, StockShape};
 pub use surface_mesh::{extract_surface, write_stl, StockMesh};
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

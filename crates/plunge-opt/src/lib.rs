@@ -89,3 +89,8 @@ pub fn build(
 ) -> Result<Box<dyn cam_plan::Operation>, cam_plan::PlanError> {
     Ok(Box::new(PlungeRoughing::from_spec(spec)?))
 }
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

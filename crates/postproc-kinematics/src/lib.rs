@@ -82,3 +82,8 @@ pub use post::{
 pub use reverse_motion::{
     AccessibilityChecker, DisplacementCurves, ReverseMotionOptions, ReverseMotionReport,
 };
+
+// The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
