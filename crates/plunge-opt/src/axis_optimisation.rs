@@ -54,6 +54,9 @@ pub struct OptimisedRow {
     pub w_curve: Option<NurbsCurve<3>>,
     /// The discretisation step used.
     pub step: f64,
+    /// Plunges whose smallest α-raising move would break the blade allowance and that kept
+    /// their conventional axis.
+    pub kept_for_clearance: usize,
 }
 
 /// Fits the W curve of a row: the curve and the parameter of each `Wᵢ`.
@@ -120,6 +123,22 @@ pub fn optimise_row(
     step: f64,
     operation: &str,
 ) -> Result<OptimisedRow, PlanError> {
+    optimise_row_within(builder, row, step, operation, &|_| true)
+}
+
+/// [`optimise_row`] where a moved posture must also pass `admissible` (the blade allowance
+/// of cutter, shank and holder): the smallest move that makes α rise is taken only when the
+/// posture it gives is admissible; otherwise the plunge keeps its conventional axis (placed
+/// clear of the blades by the row planner), the row is not monotone there, and the position
+/// is counted in [`OptimisedRow::kept_for_clearance`]. Checks cost one clearance query per
+/// moved plunge.
+pub fn optimise_row_within(
+    builder: &PostureBuilder<'_>,
+    row: &[Posture],
+    step: f64,
+    operation: &str,
+    admissible: &(dyn Fn(&Posture) -> bool + Sync),
+) -> Result<OptimisedRow, PlanError> {
     let alpha_before: Vec<f64> = row.iter().map(|p| p.alpha).collect();
     if row.len() < 2 {
         return Ok(OptimisedRow {
@@ -130,6 +149,7 @@ pub fn optimise_row(
             monotone: true,
             w_curve: None,
             step,
+            kept_for_clearance: 0,
         });
     }
     let (curve, params) = fit_w_curve(row, operation)?;
@@ -137,6 +157,7 @@ pub fn optimise_row(
     let mut postures = row.to_vec();
     let mut moves = vec![None; row.len()];
     let mut monotone = true;
+    let mut kept_for_clearance = 0;
     for i in 1..row.len() {
         let prev = postures[i - 1].alpha;
         if postures[i].alpha > prev {
@@ -171,8 +192,14 @@ pub fn optimise_row(
         }
         match found {
             Some((k, w, s)) => {
-                postures[i] = builder.through(p.m, p.s, p.centre, w, Some(s))?;
-                moves[i] = Some((k, k0));
+                let moved = builder.through(p.m, p.s, p.centre, w, Some(s))?;
+                if admissible(&moved) {
+                    postures[i] = moved;
+                    moves[i] = Some((k, k0));
+                } else {
+                    kept_for_clearance += 1;
+                    monotone = false;
+                }
             }
             None => monotone = false,
         }
@@ -187,6 +214,7 @@ pub fn optimise_row(
         monotone,
         w_curve: Some(curve),
         step,
+        kept_for_clearance,
     })
 }
 

@@ -62,7 +62,9 @@
 //! `hub_allowance_max_mm` / `_mean_mm` (final axes; `_before_` versions for the conventional
 //! axes), `plunges`, plus `plunges_per_channel`, `rows`, `stations`, `interference_share_*`,
 //! `max_core_travel_*_mm`, `min_blade_clearance_mm`, `section_start_fraction`,
-//! `section_end_fraction`, `axes_moved_per_channel`. With one operation per section these
+//! `section_end_fraction`, `axes_moved_per_channel`, `axes_kept_for_clearance_per_channel`
+//! (plunges whose α-raising move would break the blade allowance keep their conventional
+//! axis). With one operation per section these
 //! are the per-section figures. Plot: α along every row, conventional and optimised.
 //!
 //! Dependencies: `nurbs` (W-curve interpolation), `cam-core`, `impeller-model`, `cam-plan`,

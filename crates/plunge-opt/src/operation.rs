@@ -2,7 +2,7 @@
 //! metrics and plots.
 
 use crate::allowance::{hub_allowance, HubAllowance};
-use crate::axis_optimisation::{optimise_row, OptimisedRow, DEFAULT_W_STEP};
+use crate::axis_optimisation::{optimise_row_within, OptimisedRow, DEFAULT_W_STEP};
 use crate::conventional_axes::{Posture, PostureBuilder};
 use crate::interference::{core_travel, interfering_count, ClearedRegion, Material, Stroke};
 use crate::rows::{plan_rows, stations, ChannelFrame, RowSettings};
@@ -149,6 +149,8 @@ pub struct SectionPlan {
     pub allowance_after: HubAllowance,
     /// Smallest blade clearance (cutter, shank, holder) of the final postures (mm).
     pub min_blade_clearance_mm: f64,
+    /// Positions moved across the channel toward its middle to keep the blade allowance.
+    pub shifted_for_clearance: usize,
     /// Wall-clock time of each planning stage (ms).
     pub timings_ms: Vec<(&'static str, f64)>,
 }
@@ -159,6 +161,10 @@ impl SectionPlan {
         self.optimised.iter().map(|r| r.postures.clone()).collect()
     }
 }
+
+/// A position tried by the placement: its meridional fraction and, where the cutter keeps the
+/// blade allowance somewhere across the channel, the posture and whether it was moved.
+type Tried = (f64, Option<(Posture, bool)>);
 
 fn strokes(rows: &[Vec<Posture>], radius: f64, core: f64) -> Vec<Stroke> {
     rows.iter()
@@ -270,19 +276,97 @@ impl PlungeRoughing {
         lap("rows");
         let lead_in = (self.params.start_fraction >= 1.0).then(|| (ctx.stock.max_radius(), core));
         let ms = stations(&frame, &rows, step, lead_in);
-        let conventional: Vec<Vec<Posture>> = (0..rows.count)
+        // Each position is checked with the fine query; one that misses the allowance
+        // (between the row table's stations the interpolated row may approach a blade by
+        // more than the search margin) is moved across the channel toward its middle by
+        // bisection, to the first place that keeps the allowance.
+        let clear = |p: &Posture| blades.clearance(&p.cl).distance_mm >= required;
+        let place = |m: f64, s0: f64| -> Result<Option<(Posture, bool)>, PlanError> {
+            let p = builder.conventional(&frame, m, s0)?;
+            if clear(&p) {
+                return Ok(Some((p, false)));
+            }
+            let mid = builder.conventional(&frame, m, 0.5)?;
+            if !clear(&mid) {
+                return Ok(None);
+            }
+            let (mut bad, mut good, mut best) = (s0, 0.5, mid);
+            for _ in 0..crate::rows::SIDE_BISECTIONS {
+                let s = 0.5 * (bad + good);
+                let q = builder.conventional(&frame, m, s)?;
+                if clear(&q) {
+                    good = s;
+                    best = q;
+                } else {
+                    bad = s;
+                }
+            }
+            Ok(Some((best, true)))
+        };
+        let tried: Vec<Vec<Tried>> = (0..rows.count)
             .into_par_iter()
             .map(|j| {
                 ms.iter()
-                    .map(|&m| builder.conventional(&frame, m, rows.s(j, m)))
+                    .map(|&m| place(m, rows.s(j, m)).map(|p| (m, p)))
                     .collect::<Result<Vec<_>, _>>()
             })
             .collect::<Result<_, _>>()?;
+        // Where the cutter keeps the allowance nowhere across the channel the section ends
+        // (the row planner's coarse search may place its end a little beyond): every position
+        // from the first such place toward the inlet is left to the next section.
+        let m_cut = tried
+            .iter()
+            .flatten()
+            .filter(|(_, p)| p.is_none())
+            .map(|(m, _)| *m)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let placed: Vec<Vec<(Posture, bool)>> = tried
+            .into_iter()
+            .map(|r| {
+                r.into_iter()
+                    .filter(|(m, _)| *m > m_cut)
+                    .filter_map(|(_, p)| p)
+                    .collect::<Vec<_>>()
+            })
+            .filter(|r| !r.is_empty())
+            .collect();
+        if placed.is_empty() {
+            return Err(PlanError::geometry(
+                op,
+                format!(
+                    "channel 0, section start at meridional fraction {:.4}",
+                    rows.start
+                ),
+                format!(
+                    "the cutter does not keep the blade allowance {} mm anywhere across the \
+                     channel",
+                    ctx.process.blade_allowance_mm
+                ),
+            ));
+        }
+        let section_end = if m_cut.is_finite() {
+            placed
+                .iter()
+                .flatten()
+                .map(|(p, _)| p.m)
+                .fold(f64::INFINITY, f64::min)
+        } else {
+            rows.end
+        };
+        let shifted_for_clearance = placed.iter().flatten().filter(|(_, moved)| *moved).count();
+        let conventional: Vec<Vec<Posture>> = placed
+            .into_iter()
+            .map(|r| r.into_iter().map(|(p, _)| p).collect())
+            .collect();
         lap("conventional_axes");
         let optimised: Vec<OptimisedRow> = if self.params.optimise_axes {
             conventional
                 .par_iter()
-                .map(|row| optimise_row(&builder, row, self.params.w_curve_step, op))
+                .map(|row| {
+                    optimise_row_within(&builder, row, self.params.w_curve_step, op, &|p| {
+                        blades.clearance(&p.cl).distance_mm >= required
+                    })
+                })
                 .collect::<Result<_, _>>()?
         } else {
             conventional
@@ -295,6 +379,7 @@ impl PlungeRoughing {
                     monotone: row.windows(2).all(|w| w[1].alpha > w[0].alpha),
                     w_curve: None,
                     step: self.params.w_curve_step,
+                    kept_for_clearance: 0,
                 })
                 .collect()
         };
@@ -337,18 +422,19 @@ impl PlungeRoughing {
         let travel_after = core_travel(&after, &material);
         lap("interference");
         let m_hi = rows.start.min(1.0);
-        let allowance_before = hub_allowance(&frame, &before, rows.end, m_hi);
-        let allowance_after = hub_allowance(&frame, &after, rows.end, m_hi);
+        let allowance_before = hub_allowance(&frame, &before, section_end, m_hi);
+        let allowance_after = hub_allowance(&frame, &after, section_end, m_hi);
         lap("hub_allowance");
         Ok(SectionPlan {
             conventional,
             optimised,
-            range: (rows.start, rows.end),
+            range: (rows.start, section_end),
             travel_before,
             travel_after,
             allowance_before,
             allowance_after,
             min_blade_clearance_mm: min_clear,
+            shifted_for_clearance,
             timings_ms,
         })
     }
@@ -439,6 +525,14 @@ impl Operation for PlungeRoughing {
             .filter(|x| x.is_some())
             .count();
         m.count("axes_moved_per_channel", moved);
+        m.count(
+            "positions_shifted_for_clearance_per_channel",
+            plan.shifted_for_clearance,
+        );
+        m.count(
+            "axes_kept_for_clearance_per_channel",
+            plan.optimised.iter().map(|r| r.kept_for_clearance).sum(),
+        );
 
         let mut series = Vec::new();
         for (j, r) in plan.optimised.iter().enumerate() {

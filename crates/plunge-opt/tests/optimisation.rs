@@ -6,7 +6,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::needless_range_loop)]
 
 use cam_core::Vector3;
-use plunge_opt::axis_optimisation::{alpha_at_index, optimise_row};
+use plunge_opt::axis_optimisation::{alpha_at_index, optimise_row, optimise_row_within};
 use plunge_opt::conventional_axes::{Posture, PostureBuilder};
 use std::path::PathBuf;
 
@@ -84,4 +84,20 @@ fn zigzag_row_becomes_monotone_with_smallest_moves() {
         }
     }
     assert!(moved > 0);
+
+    // With a blade-allowance check that refuses every moved posture, each plunge that would
+    // move keeps its conventional axis and is counted; one that refuses only the second
+    // moved plunge keeps the first move.
+    let none = optimise_row_within(&builder, &row, 1e-5, "test", &|_| false).unwrap();
+    assert_eq!(none.kept_for_clearance, moved);
+    assert!(none.moves.iter().all(Option::is_none));
+    for i in 0..row.len() {
+        assert_eq!(none.postures[i].cl, row[i].cl);
+    }
+    assert!(!none.monotone);
+    let first = opt.moves.iter().position(Option::is_some).unwrap();
+    let keep_first =
+        optimise_row_within(&builder, &row, 1e-5, "test", &|p| p.m == row[first].m).unwrap();
+    assert_eq!(keep_first.postures[first].cl, opt.postures[first].cl);
+    assert!(keep_first.kept_for_clearance >= 1);
 }
