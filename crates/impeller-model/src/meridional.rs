@@ -169,7 +169,13 @@ impl MeridionalCurve {
 
     /// Unit channel-side normal (see module docs) at parameter t.
     pub fn normal(&self, t: f64) -> Vector2<f64> {
-        let d = self.curve.derivs(t, 1)[1];
+        let mut d = [Vector2::zeros(); 2];
+        self.curve.derivs_into(t, &mut d);
+        Self::normal_of_tangent(&d[1])
+    }
+
+    /// The unit channel-side normal of a tangent `(t_z, t_r)`.
+    fn normal_of_tangent(d: &Vector2<f64>) -> Vector2<f64> {
         let n = Vector2::new(d[1], -d[0]);
         let l = n.norm();
         if l > 0.0 {
@@ -191,7 +197,7 @@ impl MeridionalCurve {
     /// [`Self::closest`] with the certificate: (parameter, signed distance, proven global).
     pub fn closest_point(&self, zr: Vector2<f64>) -> (f64, f64, bool) {
         let cp = self.projector.closest_point(&zr);
-        let sign = if (zr - cp.point).dot(&self.normal(cp.u)) >= 0.0 {
+        let sign = if (zr - cp.point).dot(&Self::normal_of_tangent(&cp.tangent)) >= 0.0 {
             1.0
         } else {
             -1.0
