@@ -1,12 +1,31 @@
 //! Profiling aid for the point queries of the default impeller: prints the structure of the
-//! blade-side and hub queries and times cold / warm blade-side and hub queries in a loop
-//! (run in release: `cargo run --release -p impeller-model --example query_profile`).
+//! blade-side query and times, in a loop, cold blade-side queries (no hint), warm ones (a
+//! path 1 mm off the side, each hinted with the previous answer) and hub queries. Each figure
+//! is the best of `ROUNDS` rounds (the least disturbed one on a shared machine).
+//!
+//! `cargo run --release -p impeller-model --example query_profile [REPS]`; under `perf
+//! record` it shows where a query spends its time.
 
 use impeller_model::query::blade_side_distance;
 use impeller_model::{fixtures, Side};
 use nalgebra::Vector3;
 use std::hint::black_box;
 use std::time::Instant;
+
+const ROUNDS: usize = 10;
+
+/// Best time per call (µs) of `f` run `reps` times over `n` calls per run.
+fn best_of(reps: usize, n: usize, mut f: impl FnMut()) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..ROUNDS {
+        let t = Instant::now();
+        for _ in 0..reps {
+            f();
+        }
+        best = best.min(t.elapsed().as_secs_f64() * 1e6 / (reps * n) as f64);
+    }
+    best
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let imp = fixtures::default_impeller()?;
@@ -39,39 +58,40 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             s.point(u, v) + n * (rnd() * 6.0 - 3.0)
         })
         .collect();
+    // A path 1 mm off the side, 0.2 % of u apart (as the criterion bench).
+    let path: Vec<Vector3<f64>> = (0..400)
+        .map(|k| {
+            let (u, v) = (0.1 + 0.002 * k as f64, 0.4 + 0.0005 * k as f64);
+            let n = blade
+                .outward_normal(Side::Suction, u, v)
+                .unwrap_or(Vector3::z());
+            s.point(u, v) + n
+        })
+        .collect();
     let reps = std::env::args()
         .nth(1)
         .and_then(|a| a.parse().ok())
-        .unwrap_or(200usize);
-    let only_hub = std::env::args().nth(2).is_some();
-    let t = Instant::now();
-    for _ in 0..if only_hub { 0 } else { reps } {
+        .unwrap_or(20usize);
+    let cold = best_of(reps, pts.len(), || {
         for p in &pts {
             black_box(blade_side_distance(blade, Side::Suction, p, None));
         }
-    }
-    let n = (reps * pts.len()) as f64;
-    println!("blade cold: {:.3} us", t.elapsed().as_secs_f64() * 1e6 / n);
-    let only_hub = std::env::args().nth(2).is_some();
-    let t = Instant::now();
-    for _ in 0..if only_hub { 0 } else { reps } {
+    });
+    println!("blade cold: {cold:.3} us");
+    let warm = best_of(reps, path.len(), || {
+        let mut prev = None;
+        for p in &path {
+            let (sp, d) = blade_side_distance(blade, Side::Suction, p, prev);
+            prev = Some((sp.u, sp.v));
+            black_box(d);
+        }
+    });
+    println!("blade warm: {warm:.3} us");
+    let hub = best_of(reps * 10, pts.len(), || {
         for p in &pts {
-            black_box(blade_side_distance(blade, Side::Suction, p, None));
+            black_box(imp.hub().signed_distance(p));
         }
-    }
-    let n = (reps * pts.len()) as f64;
-    println!("blade cold: {:.3} us", t.elapsed().as_secs_f64() * 1e6 / n);
-    // Best of 20 rounds (the machine is shared: the minimum is the least disturbed figure).
-    let mut best = f64::INFINITY;
-    for _ in 0..20 {
-        let t = Instant::now();
-        for _ in 0..reps {
-            for p in &pts {
-                black_box(imp.hub().signed_distance(p));
-            }
-        }
-        best = best.min(t.elapsed().as_secs_f64() * 1e6 / n);
-    }
-    println!("hub: {best:.3} us (best of 20 rounds)");
+    });
+    println!("hub: {hub:.3} us");
     Ok(())
 }

@@ -2,8 +2,10 @@
 //!
 //! [`SurfaceProjector`] precomputes a query structure from the surface's Bézier
 //! decomposition (one patch per knot-span rectangle, obtained by blossoming; patches are
-//! subdivided by de Casteljau into *leaves* where their normals turn by more than ~35° or
-//! where the convexity certificate below fails for queries about one leaf size away):
+//! subdivided by de Casteljau into *leaves* where their normals turn by more than ~35°,
+//! where the convexity certificate below fails for queries about one leaf size away, and
+//! where a piece is more than 3 times longer in one direction than in the other — on twisted
+//! ruled blades, long thin leaves defeat every pruning test):
 //!
 //! * per leaf, an oriented bounding box of its control net (convex-hull property: the leaf
 //!   lies inside; weights are positive) and an axis-aligned box; the same two boxes for every
@@ -23,7 +25,10 @@
 //!    leaf (the dot product of any vector of the box `OBB − q` with any vector of the cone is
 //!    bounded away from 0): then the distance is strictly monotone across the leaf, its
 //!    minimum lies on one edge, and if that edge is interior to the surface and the surface
-//!    is C¹ across it, the neighbour leaf sharing that edge accounts for it, or
+//!    is C¹ across it, the neighbour leaf sharing that edge accounts for it; the same
+//!    monotonicity is then tested exactly at the leaf's resolution by the signs of the
+//!    Bernstein coefficients of `(S − q)·S_u` and `(S − q)·S_v` (module `surface_grad`,
+//!    rational leaves included), or
 //! 3. the current best is a stationary point of the surface inside the leaf and the leaf is
 //!    certified convex (next paragraph).
 //!
@@ -50,7 +55,9 @@
 //!
 //! **Warm start.** With a hint `(u, v)` (typically the previous answer along a path) Newton
 //! first runs on the whole domain from the hint; the resulting `d*` is usually already the
-//! answer and the BVH walk only has to certify it.
+//! answer and the BVH walk only has to certify it. Without a hint, the start is the nearest
+//! sample of the leaf reached by a greedy descent of the hierarchy (nearest boxes first), so
+//! a cold query is a warm one plus the descent.
 //!
 //! Tolerances: Newton stops when its predicted 3D step is below `1e-13 × (1 + surface size)`
 //! mm and the angle between `S − q` and each free tangent is within `1e-11` of 90°; steps
@@ -65,6 +72,7 @@ use nalgebra::Vector3;
 
 use super::bezier::BezierPatch;
 use super::newton::{minimise, Local};
+use super::surface_grad::GradSigns;
 use crate::{NurbsSurface, SurfaceDerivs2};
 
 /// The closest point found on a surface.
@@ -247,6 +255,8 @@ pub(crate) struct Leaf {
     samples: [(f64, f64, Vector3<f64>); 9],
     /// Interval data of the Hessian certificate.
     hess: HessianBounds,
+    /// Bernstein sign certificate of the distance gradient (see `surface_grad`).
+    grad: Option<GradSigns>,
 }
 
 /// Closed interval.
@@ -538,6 +548,9 @@ const LEAF_NORMAL_COS: f64 = 0.82;
 /// Deepest leaf split per patch direction (2^3 = 8 pieces).
 const MAX_LEAF_DEPTH: usize = 3;
 
+/// Largest ratio of a leaf's chord lengths in u and v before the long direction is split.
+const LEAF_ASPECT: f64 = 3.0;
+
 impl SurfaceProjector {
     /// Builds the query structure: Bézier decomposition, leaf subdivision, bounds, cones,
     /// samples and BVH. O(number of spans × (p+1)²(q+1)²).
@@ -682,8 +695,14 @@ impl SurfaceProjector {
         let mut best: Option<(Local, bool)> = None;
         // Patch of the previous evaluation: consecutive Newton iterates usually stay in it.
         let last = std::cell::Cell::new(0usize);
-        if let Some((hu, hv)) = hint {
-            if hu.is_finite() && hv.is_finite() {
+        // Without a (finite) hint, start from the nearest sample of the leaf a greedy
+        // descent of the hierarchy reaches (nearest box first): Newton on the whole domain
+        // from there usually lands on the answer, and the walk only has to certify it.
+        let start = hint
+            .filter(|(hu, hv)| hu.is_finite() && hv.is_finite())
+            .or_else(|| self.descent_start(q));
+        if let Some((hu, hv)) = start {
+            {
                 let l = minimise(
                     |u, v| self.derivs2_cached(u, v, &last),
                     q,
@@ -732,6 +751,39 @@ impl SurfaceProjector {
             distance: l.d2.sqrt(),
             on_boundary,
         }
+    }
+
+    /// The nearest sample of the leaf reached by always entering the child with the
+    /// nearest boxes. O(depth · 4) box distances.
+    fn descent_start(&self, q: &Vector3<f64>) -> Option<(f64, f64)> {
+        let mut node = self.wide.first()?;
+        for _ in 0..64 {
+            let mut pick = None;
+            let mut pick_d = f64::INFINITY;
+            for c in 0..node.n as usize {
+                let d = node.aabb[c].dist2(q).max(node.obb[c].dist2(q));
+                if d < pick_d || pick.is_none() {
+                    pick_d = d;
+                    pick = Some(node.child[c]);
+                }
+            }
+            let child = pick?;
+            if child & LEAF_BIT != 0 {
+                let leaf = self.leaves.get((child & !LEAF_BIT) as usize)?;
+                let mut start = (leaf.samples[0].0, leaf.samples[0].1);
+                let mut d_start = f64::INFINITY;
+                for (u, v, p) in &leaf.samples {
+                    let d = (p - q).norm_squared();
+                    if d < d_start {
+                        d_start = d;
+                        start = (*u, *v);
+                    }
+                }
+                return Some(start);
+            }
+            node = self.wide.get(child as usize)?;
+        }
+        None
     }
 
     /// Walk of the hierarchy that certifies (or improves) `best`: every leaf whose boxes are
@@ -860,6 +912,19 @@ impl SurfaceProjector {
                 1 if leaf.exclude_towards[2] => return None,
                 -1 if leaf.exclude_towards[3] => return None,
                 _ => {}
+            }
+        }
+        if let Some(g) = &leaf.grad {
+            // The tighter Bernstein test of the same monotonicity, per direction.
+            let ex = &leaf.exclude_towards;
+            for dir in 0..2 {
+                if ex[2 * dir] || ex[2 * dir + 1] {
+                    match g.sign(dir, q) {
+                        1 if ex[2 * dir] => return None,
+                        -1 if ex[2 * dir + 1] => return None,
+                        _ => {}
+                    }
+                }
             }
         }
         if let Some((b, true)) = best {
@@ -1057,8 +1122,19 @@ fn leaf_split(patch: &BezierPatch) -> (usize, usize) {
             // Convexity certificate for typical queries: every piece should certify queries
             // at a distance of its own size above or below any of its corners' footprints.
             let (fail_u, fail_v) = certificate_failures(patch, su, sv);
-            split_u = fail_u;
-            split_v = fail_v;
+            // Elongated pieces defeat the pruning tests (the sign of the distance's gradient
+            // along the short direction changes along the long one on twisted surfaces)
+            // and the certificate (through the twist `S_uv` over the long extent): split
+            // the long direction until the pieces' chords are within a ratio.
+            let (cu, cv) = piece_chords(patch, su, sv);
+            if cu > LEAF_ASPECT * cv {
+                split_u = true;
+            } else if cv > LEAF_ASPECT * cu {
+                split_v = true;
+            } else {
+                split_u = fail_u;
+                split_v = fail_v;
+            }
         }
         if !split_u && !split_v {
             break;
@@ -1071,6 +1147,24 @@ fn leaf_split(patch: &BezierPatch) -> (usize, usize) {
         }
     }
     (su, sv)
+}
+
+/// Largest chord lengths `(along u, along v)` of the pieces of a `su × sv` split, measured
+/// through each piece's centre.
+fn piece_chords(patch: &BezierPatch, su: usize, sv: usize) -> (f64, f64) {
+    let (mut cu, mut cv) = (0.0f64, 0.0f64);
+    for i in 0..su {
+        for j in 0..sv {
+            let u0 = lerp(patch.u0, patch.u1, i, su);
+            let u1 = lerp(patch.u0, patch.u1, i + 1, su);
+            let v0 = lerp(patch.v0, patch.v1, j, sv);
+            let v1 = lerp(patch.v0, patch.v1, j + 1, sv);
+            let (uc, vc) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
+            cu = cu.max((patch.point(u1, vc) - patch.point(u0, vc)).norm());
+            cv = cv.max((patch.point(uc, v1) - patch.point(uc, v0)).norm());
+        }
+    }
+    (cu, cv)
 }
 
 /// Oriented frame of a piece: `S_u` direction, binormal, normal at the centre (or the
@@ -1187,6 +1281,7 @@ fn make_leaf(
         edge_neighbours: [u32::MAX; 4],
         samples,
         hess,
+        grad: GradSigns::new(sub),
     }
 }
 
