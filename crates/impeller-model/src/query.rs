@@ -162,7 +162,7 @@ impl nurbs::closest::PointQuery for BladeSideQuery<'_> {
             point: sp.point,
             signed_distance: d,
             hint: (sp.u, sp.v),
-            certified: !self.blade.side(self.side).is_rational() && d.is_finite(),
+            certified: d.is_finite(),
         }
     }
 }

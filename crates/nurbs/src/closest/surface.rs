@@ -11,8 +11,9 @@
 //!   lies inside; weights are positive) and an axis-aligned box; the same two boxes for every
 //!   node of a bounding-volume hierarchy over the leaves (median split of centroids, walked
 //!   as a 4-wide tree whose nodes store their children's boxes together);
-//! * per leaf of a polynomial surface, the *tangent cones* of `S_u` and `S_v` (cones
-//!   containing the hodograph control vectors, hence every tangent of the leaf);
+//! * per leaf, the *tangent cones* of `S_u` and `S_v` (cones containing the hodograph
+//!   control vectors, hence every tangent of the leaf; for a rational leaf the Bernstein
+//!   coefficients of `X_u W − X W_u`, which is `S_u W²`);
 //! * per leaf, interval bounds of `S_u`, `S_v`, `S_uu`, `S_uv`, `S_vv` (boxes of the hodograph
 //!   control vectors in the leaf's frame) for a *convexity certificate*;
 //! * a 3×3 grid of sample points per leaf for starting points.
@@ -46,10 +47,12 @@
 //! hodographs), so the answer is the global minimum. Where the certificate fails (queries
 //! beyond a centre of curvature), the leaf is searched by branch and bound over de Casteljau
 //! pieces (pruned by their boxes, certified pieces solved by Newton, down to 1/32 of the leaf
-//! per direction; this path allocates). Rational leaves use derivative boxes from a 5×5
-//! sample widened by 25%, so for them the certificate is a well-founded heuristic rather than
-//! a proof (rigorous rational bounds from the homogeneous net are not implemented yet; curves
-//! have them, see [`super::CurveProjector`]). The walk has no cap on leaf solves: it ends when
+//! per direction; this path allocates). Rational leaves (positive weights) get rigorous
+//! bounds from their homogeneous net: interval arithmetic on the quotient rule of
+//! `S = X / W` with the hodograph boxes of the polynomials `X` and `W` (see
+//! `rational_derivative_boxes`), and tangent cones of the Bernstein coefficients of
+//! `X_u W − X W_u` (the direction of `S_u`), so the search is certified for them too. The
+//! walk has no cap on leaf solves: it ends when
 //! every leaf is pruned or solved. A Newton run whose line search fails away from a
 //! stationary point is not reported as converged.
 //!
@@ -317,6 +320,17 @@ impl VBox {
         }
         self
     }
+    /// Componentwise difference of two boxes.
+    fn sub(&self, o: &VBox) -> VBox {
+        VBox([0, 1, 2].map(|k| Iv {
+            lo: self.0[k].lo - o.0[k].hi,
+            hi: self.0[k].hi - o.0[k].lo,
+        }))
+    }
+    /// Every component times an interval.
+    fn scale(&self, s: Iv) -> VBox {
+        VBox([0, 1, 2].map(|k| self.0[k].mul(s)))
+    }
     fn dot(&self, o: &VBox) -> Iv {
         let mut acc = Iv { lo: 0.0, hi: 0.0 };
         for k in 0..3 {
@@ -345,7 +359,8 @@ impl VBox {
 /// `H = JᵀJ + [r·S_uu, r·S_uv; r·S_uv, r·S_vv]` with `r ∈ box(leaf) − q`, is positive definite
 /// on the whole leaf (then the distance is strictly convex there and Newton's minimum is the
 /// leaf's only one). Polynomial leaves: rigorous boxes of the hodograph control vectors.
-/// Rational leaves: boxes of a 5×5 sample widened by 25% (a heuristic).
+/// Rational leaves: rigorous interval bounds from the homogeneous net
+/// (`rational_derivative_boxes`).
 #[derive(Debug, Clone, Copy)]
 struct HessianBounds {
     a: Iv,
@@ -382,24 +397,7 @@ impl HessianBounds {
         let (p, q) = (sub.p, sub.q);
         let (du, dv) = (sub.u1 - sub.u0, sub.v1 - sub.v0);
         let (su, sv, suu, suv, svv) = if sub.rational {
-            let mut d = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-            for i in 0..=4 {
-                for j in 0..=4 {
-                    let e = sub.derivs2(sub.u0 + du * i as f64 / 4.0, sub.v0 + dv * j as f64 / 4.0);
-                    d.0.push(frame(e.su));
-                    d.1.push(frame(e.sv));
-                    d.2.push(frame(e.suu));
-                    d.3.push(frame(e.suv));
-                    d.4.push(frame(e.svv));
-                }
-            }
-            (
-                VBox::of(&d.0).widen(0.25),
-                VBox::of(&d.1).widen(0.25),
-                VBox::of(&d.2).widen(0.25),
-                VBox::of(&d.3).widen(0.25),
-                VBox::of(&d.4).widen(0.25),
-            )
+            rational_derivative_boxes(sub, pts, &frame)
         } else {
             let at = |i: usize, j: usize| pts[i * (q + 1) + j];
             let (pf, qf) = (p as f64, q as f64);
@@ -450,6 +448,119 @@ impl HessianBounds {
             svv,
         }
     }
+}
+
+/// Rigorous boxes of `S_u, S_v, S_uu, S_uv, S_vv` over a rational leaf (in the leaf's frame),
+/// from its homogeneous control net: with `X = w (P − c)` (`c` the centre of the control
+/// points' box) and `W` polynomials, `Y = S − c = X / W` and
+///
+/// ```text
+/// Y_u  = (X_u − Y W_u) / W                      Y_v = (X_v − Y W_v) / W
+/// Y_uu = (X_uu − 2 Y_u W_u − Y W_uu) / W
+/// Y_uv = (X_uv − Y_u W_v − Y_v W_u − Y W_uv) / W
+/// Y_vv = (X_vv − 2 Y_v W_v − Y W_vv) / W
+/// ```
+///
+/// evaluated in interval arithmetic: the derivatives of the polynomials `X`, `W` lie in the
+/// boxes of their hodographs' Bernstein coefficients, `W` in `[min w, max w]` (positive
+/// weights), `Y` in the box of the control points (convex hull). Widened by 1e-12 for
+/// round-off. O((p+1)(q+1)).
+fn rational_derivative_boxes(
+    sub: &BezierPatch,
+    pts: &[Vector3<f64>],
+    frame: &dyn Fn(Vector3<f64>) -> Vector3<f64>,
+) -> (VBox, VBox, VBox, VBox, VBox) {
+    let (p, q) = (sub.p, sub.q);
+    let q1 = q + 1;
+    let (du, dv) = (sub.u1 - sub.u0, sub.v1 - sub.v0);
+    let local: Vec<Vector3<f64>> = pts.iter().map(|x| frame(*x)).collect();
+    let y = VBox::of(&local);
+    let c = Vector3::from_fn(|k, _| 0.5 * (y.0[k].lo + y.0[k].hi));
+    let y = VBox::of(&local.iter().map(|x| x - c).collect::<Vec<_>>());
+    let w: Vec<f64> = sub.pw.iter().map(|h| h[3]).collect();
+    let x: Vec<Vector3<f64>> = local
+        .iter()
+        .zip(&w)
+        .map(|(pt, wi)| (pt - c) * *wi)
+        .collect();
+    let (pf, qf) = (p as f64, q as f64);
+    // Hodograph coefficients of (X, W): first, second and mixed differences, scaled to the
+    // global parameters.
+    let mut d: [(Vec<Vector3<f64>>, Vec<f64>); 5] = Default::default();
+    let scales = [
+        pf / du,
+        qf / dv,
+        pf * (pf - 1.0) / (du * du),
+        pf * qf / (du * dv),
+        qf * (qf - 1.0) / (dv * dv),
+    ];
+    for i in 0..=p {
+        for j in 0..=q {
+            let k = i * q1 + j;
+            if i < p {
+                let k1 = k + q1;
+                d[0].0.push((x[k1] - x[k]) * scales[0]);
+                d[0].1.push((w[k1] - w[k]) * scales[0]);
+            }
+            if j < q {
+                d[1].0.push((x[k + 1] - x[k]) * scales[1]);
+                d[1].1.push((w[k + 1] - w[k]) * scales[1]);
+            }
+            if i + 2 <= p {
+                let (k1, k2) = (k + q1, k + 2 * q1);
+                d[2].0.push((x[k2] - x[k1] * 2.0 + x[k]) * scales[2]);
+                d[2].1.push((w[k2] - w[k1] * 2.0 + w[k]) * scales[2]);
+            }
+            if i < p && j < q {
+                let (k10, k01, k11) = (k + q1, k + 1, k + q1 + 1);
+                d[3].0.push((x[k11] - x[k10] - x[k01] + x[k]) * scales[3]);
+                d[3].1.push((w[k11] - w[k10] - w[k01] + w[k]) * scales[3]);
+            }
+            if j + 2 <= q {
+                d[4].0.push((x[k + 2] - x[k + 1] * 2.0 + x[k]) * scales[4]);
+                d[4].1.push((w[k + 2] - w[k + 1] * 2.0 + w[k]) * scales[4]);
+            }
+        }
+    }
+    let iv = |v: &[f64]| {
+        if v.is_empty() {
+            return Iv { lo: 0.0, hi: 0.0 };
+        }
+        Iv {
+            lo: v.iter().copied().fold(f64::INFINITY, f64::min),
+            hi: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        }
+    };
+    let wr = iv(&w);
+    let inv_w = Iv {
+        lo: 1.0 / wr.hi,
+        hi: 1.0 / wr.lo,
+    };
+    let [xu, xv, xuu, xuv, xvv] = [0, 1, 2, 3, 4].map(|k| VBox::of(&d[k].0));
+    let [wu, wv, wuu, wuv, wvv] = [0, 1, 2, 3, 4].map(|k| iv(&d[k].1));
+    let two = Iv { lo: 2.0, hi: 2.0 };
+    let yu = xu.sub(&y.scale(wu)).scale(inv_w);
+    let yv = xv.sub(&y.scale(wv)).scale(inv_w);
+    let yuu = xuu
+        .sub(&yu.scale(wu.mul(two)))
+        .sub(&y.scale(wuu))
+        .scale(inv_w);
+    let yuv = xuv
+        .sub(&yu.scale(wv))
+        .sub(&yv.scale(wu))
+        .sub(&y.scale(wuv))
+        .scale(inv_w);
+    let yvv = xvv
+        .sub(&yv.scale(wv.mul(two)))
+        .sub(&y.scale(wvv))
+        .scale(inv_w);
+    (
+        yu.widen(1e-12),
+        yv.widen(1e-12),
+        yuu.widen(1e-12),
+        yuv.widen(1e-12),
+        yvv.widen(1e-12),
+    )
 }
 
 /// BVH node: box plus either two children or a leaf index.
@@ -619,8 +730,8 @@ impl SurfaceProjector {
         self.domain
     }
 
-    /// Whether the surface is rational (its leaves' derivative bounds are then sampled, not
-    /// rigorous; see the module docs).
+    /// Whether the surface is rational (its leaves' bounds then come from the homogeneous
+    /// net; see the module docs).
     pub fn is_rational(&self) -> bool {
         self.patches.iter().any(|p| p.rational)
     }
@@ -1240,7 +1351,8 @@ fn make_leaf(
     let obb = Obb::from_points(&pts, axes);
     let obb_half_diag = Vector3::new(obb.h[0], obb.h[1], obb.h[2]).norm();
     let (cone_u, cone_v) = if rational {
-        (None, None)
+        let (du, dv) = super::surface_grad::rational_tangent_coefficients(sub);
+        (Cone::of(&du, &obb), Cone::of(&dv, &obb))
     } else {
         let q1 = sub.q + 1;
         let mut du = Vec::new();

@@ -147,6 +147,54 @@ fn swap_uv<T: Copy>(x: &TP<T>) -> TP<T> {
     TP { m: x.n, n: x.m, c }
 }
 
+/// `T = X_u W − X W_u` of a rational net (`x` homogeneous vector part, `w` weights).
+fn rational_tangent(x: &TP<Vector3<f64>>, w: &TP<f64>) -> TP<Vector3<f64>> {
+    let t1 = product(&diff_u(x), w, Vector3::zeros(), |a, b| a * b);
+    let t2 = product(x, &diff_u(w), Vector3::zeros(), |a, b| a * b);
+    TP {
+        m: t1.m,
+        n: t1.n,
+        c: t1.c.iter().zip(&t2.c).map(|(a, b)| a - b).collect(),
+    }
+}
+
+/// The homogeneous net of a leaf as (vector part, weights), the vector part shifted by
+/// `centre`.
+fn nets(sub: &BezierPatch, centre: &Vector3<f64>) -> (TP<Vector3<f64>>, TP<f64>) {
+    (
+        TP {
+            m: sub.p,
+            n: sub.q,
+            c: sub
+                .pw
+                .iter()
+                .map(|c| Vector3::new(c[0], c[1], c[2]) - centre * c[3])
+                .collect(),
+        },
+        TP {
+            m: sub.p,
+            n: sub.q,
+            c: sub.pw.iter().map(|c| c[3]).collect(),
+        },
+    )
+}
+
+/// Bernstein coefficients of `X_u W − X W_u` and `X_v W − X W_v` of a rational leaf: every
+/// tangent `S_u = (X_u W − X W_u) / W²` (resp. `S_v`) is a positive combination of them, so
+/// a cone containing them contains every tangent direction of the leaf. Empty for degree 0.
+pub(crate) fn rational_tangent_coefficients(
+    sub: &BezierPatch,
+) -> (Vec<Vector3<f64>>, Vec<Vector3<f64>>) {
+    if sub.p == 0 || sub.q == 0 {
+        return (Vec::new(), Vec::new());
+    }
+    let (x, w) = nets(sub, &Vector3::zeros());
+    (
+        rational_tangent(&x, &w).c,
+        swap_uv(&rational_tangent(&swap_uv(&x), &swap_uv(&w))).c,
+    )
+}
+
 impl GradSigns {
     /// The certificate of leaf `sub` (degrees ≥ 1). O((p q)²) products for polynomial
     /// leaves, O((p q)² · 4) for rational ones.
@@ -164,31 +212,12 @@ impl GradSigns {
         if !centre.iter().all(|c| c.is_finite()) {
             return None;
         }
-        let x = TP {
-            m: sub.p,
-            n: sub.q,
-            c: sub
-                .pw
-                .iter()
-                .map(|c| Vector3::new(c[0], c[1], c[2]) - centre * c[3])
-                .collect::<Vec<_>>(),
-        };
-        let w = TP {
-            m: sub.p,
-            n: sub.q,
-            c: sub.pw.iter().map(|c| c[3]).collect::<Vec<_>>(),
-        };
+        let (x, w) = nets(sub, &centre);
         let rational = sub.rational;
         let direction = |x: &TP<Vector3<f64>>, w: &TP<f64>| -> Direction {
             let (a, e) = if rational {
                 // T = X_u W − X W_u, A = X·T, E = W T.
-                let t1 = product(&diff_u(x), w, Vector3::zeros(), |a, b| a * b);
-                let t2 = product(x, &diff_u(w), Vector3::zeros(), |a, b| a * b);
-                let t = TP {
-                    m: t1.m,
-                    n: t1.n,
-                    c: t1.c.iter().zip(&t2.c).map(|(a, b)| a - b).collect(),
-                };
+                let t = rational_tangent(x, w);
                 (
                     product(x, &t, 0.0, |a, b| a.dot(&b)),
                     product(w, &t, Vector3::zeros(), |a, b| b * a),
