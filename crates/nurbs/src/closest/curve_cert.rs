@@ -89,6 +89,30 @@ const fn binom_table() -> [[f64; NC + 1]; NC + 1] {
 
 static BINOM: [[f64; NC + 1]; NC + 1] = binom_table();
 
+/// `scale · Σ_k c_k B_{k,n}(t)` for `t ∈ [0, 1]` by Horner's scheme on `c_k C(n, k)` in the
+/// ratio `t / (1 − t)` (for t ≤ ½) or `(1 − t) / t` (for t > ½), times the power of the
+/// larger of `t`, `1 − t`: O(n), every ratio ≤ 1.
+#[inline]
+fn bernstein_horner(c: &[f64], n: usize, t: f64, scale: f64) -> f64 {
+    let s = 1.0 - t;
+    let binom = &BINOM[n];
+    if t <= 0.5 {
+        let r = t / s;
+        let mut acc = c[n] * binom[n];
+        for k in (0..n).rev() {
+            acc = acc * r + c[k] * binom[k];
+        }
+        scale * acc * s.powi(n as i32)
+    } else {
+        let r = s / t;
+        let mut acc = c[0] * binom[0];
+        for k in 1..=n {
+            acc = acc * r + c[k] * binom[k];
+        }
+        scale * acc * t.powi(n as i32)
+    }
+}
+
 /// A Bernstein polynomial on a sub-interval, coefficients `c[0..=deg]`.
 #[derive(Debug, Clone, Copy)]
 struct Poly {
@@ -146,30 +170,28 @@ impl Poly {
         r
     }
 
-    /// Value at local t ∈ [0, 1] (de Casteljau).
+    /// Value at local t ∈ [0, 1]: Horner's scheme in `t / (1 − t)` (or `(1 − t) / t` for
+    /// t > ½, so the ratio stays ≤ 1) on the scaled coefficients `c_k C(n, k)`. O(n), no
+    /// copy of the coefficients.
     fn eval(&self, t: f64) -> f64 {
-        let mut b = self.c;
-        for r in 1..=self.deg {
-            for k in 0..=self.deg - r {
-                b[k] = b[k] * (1.0 - t) + b[k + 1] * t;
-            }
-        }
-        b[0]
+        bernstein_horner(&self.c[..=self.deg], self.deg, t, 1.0)
     }
 
-    /// Value and derivative (in the local parameter) at t ∈ [0, 1]: de Casteljau down to
-    /// two points `b0`, `b1`; then `f = (1 − t) b0 + t b1`, `f' = deg (b1 − b0)`.
+    /// Value and derivative (in the local parameter) at t ∈ [0, 1], both by
+    /// [`bernstein_horner`]: `f' = n Σ (c_{k+1} − c_k) B_{k,n−1}`.
     fn eval_with_deriv(&self, t: f64) -> (f64, f64) {
-        if self.deg == 0 {
+        let n = self.deg;
+        if n == 0 {
             return (self.c[0], 0.0);
         }
-        let mut b = self.c;
-        for r in 1..self.deg {
-            for k in 0..=self.deg - r {
-                b[k] = b[k] * (1.0 - t) + b[k + 1] * t;
-            }
+        let mut d = [0.0; NC];
+        for k in 0..n {
+            d[k] = self.c[k + 1] - self.c[k];
         }
-        (b[0] * (1.0 - t) + b[1] * t, self.deg as f64 * (b[1] - b[0]))
+        (
+            bernstein_horner(&self.c[..=n], n, t, 1.0),
+            bernstein_horner(&d[..n], n - 1, t, n as f64),
+        )
     }
 
     /// Halves at t = ½ (de Casteljau): (left, right).
