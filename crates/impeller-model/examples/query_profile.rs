@@ -3,8 +3,9 @@
 //! path 1 mm off the side, each hinted with the previous answer) and hub queries. Each figure
 //! is the best of `ROUNDS` rounds (the least disturbed one on a shared machine).
 //!
-//! `cargo run --release -p impeller-model --example query_profile [REPS]`; under `perf
-//! record` it shows where a query spends its time.
+//! `cargo run --release -p impeller-model --example query_profile [REPS] [warm]` (`warm`:
+//! mostly the warm blade queries); under `perf record` it shows where a query spends its
+//! time.
 
 use impeller_model::query::blade_side_distance;
 use impeller_model::{fixtures, Side};
@@ -72,7 +73,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .nth(1)
         .and_then(|a| a.parse().ok())
         .unwrap_or(20usize);
-    let cold = best_of(reps, pts.len(), || {
+    let only_warm = std::env::args().nth(2).as_deref() == Some("warm");
+    let cold = best_of(if only_warm { 1 } else { reps }, pts.len(), || {
         for p in &pts {
             black_box(blade_side_distance(blade, Side::Suction, p, None));
         }
@@ -87,6 +89,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     });
     println!("blade warm: {warm:.3} us");
+    // `query_profile REPS warm` times the warm blade queries only (for `perf record`).
+    if std::env::args().nth(2).as_deref() == Some("warm") {
+        return Ok(());
+    }
     let hub = best_of(reps * 10, pts.len(), || {
         for p in &pts {
             black_box(imp.hub().signed_distance(p));

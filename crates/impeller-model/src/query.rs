@@ -110,16 +110,21 @@ pub fn blade_side_distance(
     p: &Vector3<f64>,
     hint: Option<(f64, f64)>,
 ) -> (SurfacePoint, f64) {
-    let g = blade.projector(side).closest_point_with_hint(p, hint);
+    let proj = blade.projector(side);
+    let g = proj.closest_point_with_hint(p, hint);
     let sp = SurfacePoint {
         u: g.u,
         v: g.v,
         point: g.point,
         distance: g.distance,
     };
-    let sign = match blade.outward_normal(side, sp.u, sp.v) {
-        Some(n) if (p - sp.point).dot(&n) < 0.0 => -1.0,
-        _ => 1.0,
+    // The outward normal from the projector's Bézier patches (same surface, no knot search).
+    let d = proj.derivs2(sp.u, sp.v);
+    let n = d.su.cross(&d.sv) * blade.outward_sign(side);
+    let sign = if (p - sp.point).dot(&n) < 0.0 {
+        -1.0
+    } else {
+        1.0
     };
     (sp, sign * sp.distance)
 }
