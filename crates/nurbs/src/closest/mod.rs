@@ -15,7 +15,6 @@ pub(crate) mod decompose;
 mod newton;
 mod query;
 mod surface;
-mod surface_grad;
 
 /// Bounding volumes shared with the projection module.
 pub(crate) mod surface_bounds {

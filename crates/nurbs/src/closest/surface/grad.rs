@@ -28,7 +28,7 @@
 
 use nalgebra::Vector3;
 
-use super::bezier::BezierPatch;
+use crate::closest::bezier::BezierPatch;
 
 /// Relative margin of a coefficient's sign.
 const SIGN_MARGIN: f64 = 1e-12;
