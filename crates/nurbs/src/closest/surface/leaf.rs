@@ -89,19 +89,6 @@ impl SurfaceProjector {
                 _ => {}
             }
         }
-        if let Some(g) = &leaf.grad {
-            // The tighter Bernstein test of the same monotonicity, per direction.
-            let ex = &leaf.exclude_towards;
-            for dir in 0..2 {
-                if ex[2 * dir] || ex[2 * dir + 1] {
-                    match g.sign(dir, q) {
-                        1 if ex[2 * dir] => return None,
-                        -1 if ex[2 * dir + 1] => return None,
-                        _ => {}
-                    }
-                }
-            }
-        }
         if let Some((b, true)) = best {
             // The best is a stationary (KKT) point inside a neighbour sharing a whole edge
             // across which the surface is C¹: if both leaves are certified convex, the
@@ -120,6 +107,20 @@ impl SurfaceProjector {
                         return None;
                     }
                     break;
+                }
+            }
+        }
+        if let Some(g) = &leaf.grad {
+            // The tighter Bernstein test of the same monotonicity, per direction (after
+            // the cheaper tests above, which settle most leaves of a warm query).
+            let ex = &leaf.exclude_towards;
+            for dir in 0..2 {
+                if ex[2 * dir] || ex[2 * dir + 1] {
+                    match g.sign(dir, q) {
+                        1 if ex[2 * dir] => return None,
+                        -1 if ex[2 * dir + 1] => return None,
+                        _ => {}
+                    }
                 }
             }
         }
