@@ -5,8 +5,10 @@
 //! normalised arc length; the table from curve parameter to arc length is built once with
 //! 5-point Gauss–Legendre quadrature on 256 parameter intervals (relative error far below
 //! 1e-12 for the smooth contours used here) and inverted by bisection plus Newton steps
-//! (|dm/dt| = |C'(t)| / L). Closest points use the `nurbs` crate's global `CurveProjector`,
-//! built once per contour. The *channel-side normal* N = (t_r, −t_z)/|t| of the unit tangent
+//! (|dm/dt| = |C'(t)| / L). Closest points use the `nurbs` crate's global, certified
+//! `CurveProjector`, built once per contour (hub and shroud queries cost ≈ 0.3 µs, criterion
+//! `impeller_model/hub_signed_distance`; the quarter-ellipse contours are one rational
+//! quadratic Bézier segment). The *channel-side normal* N = (t_r, −t_z)/|t| of the unit tangent
 //! (t_z, t_r) points to +r at an axial inlet and to +z at a radial outlet: from the hub into
 //! the channel, and from the shroud out of it.
 

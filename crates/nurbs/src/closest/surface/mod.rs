@@ -64,12 +64,18 @@
 //!
 //! Tolerances: Newton stops when its predicted 3D step is below `1e-13 × (1 + surface size)`
 //! mm and the angle between `S − q` and each free tangent is within `1e-11` of 90°; steps
-//! are accepted up to the round-off of `|S − q|²`. Cost on the 12×12 bicubic reference surface
-//! (225 leaves), criterion medians per query on an idle 2-core machine: ≈ 0.83 µs cold,
-//! ≈ 0.47 µs warm (a warm query averages 1.02 Newton runs, ~4 surface evaluations and
-//! 1.5 leaf visits; see `benches/nurbs.rs`). Queries take
-//! `&self` and, outside the branch-and-bound fallback, do not allocate; the projector is
-//! `Send + Sync`.
+//! are accepted up to the round-off of `|S − q|²`. Cost, criterion medians per query
+//! (release; figures of 2026-11 on a shared 2-core machine under a load of about 3, where
+//! the code before the gradient-sign test measured 1.35 µs / 0.72 µs on the first surface):
+//! the 12×12 bicubic reference surface of `benches/nurbs.rs`, ≈ 1.04 µs cold, ≈ 0.65 µs warm
+//! (idle-machine figures of the earlier code: 0.83 / 0.47 µs); the suction side of the
+//! default impeller's main blade (ruled, 161 × 2 control points, 1260 leaves;
+//! `impeller-model/benches/queries.rs`), ≈ 1.8 µs cold, ≈ 0.75 µs warm along a path. A cold
+//! query costs a greedy descent, one Newton run and the certifying walk (about 12 nodes and
+//! 2 leaves visited on the blade). Memory: per leaf, besides its boxes and bounds, the
+//! gradient-sign coefficients (`(2p)(2q+1)` scalars and vectors per direction for a
+//! polynomial leaf). Queries take `&self` and, outside the branch-and-bound fallback, do not
+//! allocate; the projector is `Send + Sync`.
 
 //!
 //! **Modules.** `tree` (boxes and the hierarchy), `bounds` (interval bounds of the
