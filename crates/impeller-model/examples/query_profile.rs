@@ -40,8 +40,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         s.knots_v().knots().len() - s.degree_v() - 1,
         s.is_rational()
     );
-    let proj = blade.projector(Side::Suction);
-    println!("leaves {}", proj.leaf_count());
+    let t = Instant::now();
+    let built = nurbs::closest::SurfaceProjector::new(s);
+    println!(
+        "projector: {} leaves, built in {:.2} ms",
+        built.leaf_count(),
+        t.elapsed().as_secs_f64() * 1e3
+    );
+    blade.projector(Side::Suction);
     // Deterministic points within 3 mm of the side (a simple LCG).
     let mut seed = 7u64;
     let mut rnd = move || {

@@ -92,7 +92,13 @@ fn binom(n: usize, k: usize) -> f64 {
     r
 }
 
+/// Binomial coefficients `C(n, k)`, `k = 0..=n`.
+fn binom_row(n: usize) -> Vec<f64> {
+    (0..=n).map(|k| binom(n, k)).collect()
+}
+
 /// Bernstein product `a ⊗ b` with the coefficient product `f` (scalar·vector, dot, ...).
+/// O((a.m + 1)(a.n + 1)(b.m + 1)(b.n + 1)).
 fn product<A: Copy, B: Copy, C: Copy + std::ops::AddAssign + std::ops::Mul<f64, Output = C>>(
     a: &TP<A>,
     b: &TP<B>,
@@ -100,14 +106,21 @@ fn product<A: Copy, B: Copy, C: Copy + std::ops::AddAssign + std::ops::Mul<f64, 
     f: impl Fn(A, B) -> C,
 ) -> TP<C> {
     let (m, n) = (a.m + b.m, a.n + b.n);
+    let (bam, ban, bbm, bbn) = (
+        binom_row(a.m),
+        binom_row(a.n),
+        binom_row(b.m),
+        binom_row(b.n),
+    );
+    let (bm, bn) = (binom_row(m), binom_row(n));
     let mut c = vec![zero; (m + 1) * (n + 1)];
     for i1 in 0..=a.m {
         for j1 in 0..=a.n {
             let x = a.c[i1 * (a.n + 1) + j1];
-            let s1 = binom(a.m, i1) * binom(a.n, j1);
+            let s1 = bam[i1] * ban[j1];
             for i2 in 0..=b.m {
                 for j2 in 0..=b.n {
-                    let s = s1 * binom(b.m, i2) * binom(b.n, j2);
+                    let s = s1 * bbm[i2] * bbn[j2];
                     c[(i1 + i2) * (n + 1) + j1 + j2] += f(x, b.c[i2 * (b.n + 1) + j2]) * s;
                 }
             }
@@ -115,8 +128,7 @@ fn product<A: Copy, B: Copy, C: Copy + std::ops::AddAssign + std::ops::Mul<f64, 
     }
     for k in 0..=m {
         for l in 0..=n {
-            let d = binom(m, k) * binom(n, l);
-            c[k * (n + 1) + l] = c[k * (n + 1) + l] * (1.0 / d);
+            c[k * (n + 1) + l] = c[k * (n + 1) + l] * (1.0 / (bm[k] * bn[l]));
         }
     }
     TP { m, n, c }
