@@ -118,9 +118,8 @@ pub fn blade_side_distance(
         point: g.point,
         distance: g.distance,
     };
-    // The outward normal from the projector's Bézier patches (same surface, no knot search).
-    let d = proj.derivs2(sp.u, sp.v);
-    let n = d.su.cross(&d.sv) * blade.outward_sign(side);
+    // The outward normal from the natural normal the projector returns with the answer.
+    let n = g.normal * blade.outward_sign(side);
     let sign = if (p - sp.point).dot(&n) < 0.0 {
         -1.0
     } else {

@@ -71,9 +71,7 @@ impl PointQuery for super::SurfaceProjector {
     /// homogeneous net).
     fn query(&self, q: &Vector3<f64>, hint: Option<(f64, f64)>) -> PointProjection<(f64, f64)> {
         let r = self.closest_point_with_hint(q, hint);
-        let d = self.derivs2(r.u, r.v);
-        let n = d.su.cross(&d.sv);
-        let sign = if (q - r.point).dot(&n) < 0.0 {
+        let sign = if (q - r.point).dot(&r.normal) < 0.0 {
             -1.0
         } else {
             1.0

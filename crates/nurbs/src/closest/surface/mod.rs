@@ -110,6 +110,9 @@ pub struct SurfacePoint {
     pub v: f64,
     /// `S(u, v)`.
     pub point: Vector3<f64>,
+    /// The natural normal `S_u × S_v` at `(u, v)`, not normalised (zero where the surface
+    /// is singular): signs the distance without another evaluation.
+    pub normal: Vector3<f64>,
     /// Distance from the query point to `point` (mm).
     pub distance: f64,
     /// The answer lies on the boundary of the parameter domain with the distance still
@@ -268,10 +271,12 @@ impl SurfaceProjector {
         let ((ua, ub), (va, vb)) = self.domain;
         if !q.iter().all(|c| c.is_finite()) {
             // No point is closest to a non-finite query.
+            let d = self.derivs2(ua, va);
             return SurfacePoint {
                 u: ua,
                 v: va,
-                point: self.point(ua, va),
+                point: d.p,
+                normal: d.su.cross(&d.sv),
                 distance: f64::NAN,
                 on_boundary: false,
             };
@@ -332,6 +337,7 @@ impl SurfaceProjector {
             u: l.u,
             v: l.v,
             point: l.point,
+            normal: l.normal,
             distance: l.d2.sqrt(),
             on_boundary,
         }
