@@ -1,5 +1,8 @@
-//! Point queries on the default impeller: blade-side signed distance (global, cached
-//! projector), hub signed distance, local closest point with a hint, and building the model.
+//! Point queries on the default impeller, group `impeller_model`: blade-side signed distance
+//! cold (`blade_side_cold`: no hint) and warm (`blade_side_warm`: hint = the previous answer
+//! along a path), hub and shroud signed distance (meridional contour, cached certified
+//! projector), the local closest point with a hint; and building the model (group `model`).
+//! Run with a filter, e.g. `cargo bench -p impeller-model --bench queries -- hub`.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -26,7 +29,8 @@ fn queries(c: &mut Criterion) {
         .collect();
     blade.projector(Side::Suction);
     let mut i = 0;
-    c.bench_function("blade_side_signed_distance_global", |b| {
+    let mut g = c.benchmark_group("impeller_model");
+    g.bench_function("blade_side_cold", |b| {
         b.iter(|| {
             i = (i + 1) % pts.len();
             black_box(blade_side_distance(blade, Side::Suction, &pts[i].0, None))
@@ -43,7 +47,7 @@ fn queries(c: &mut Criterion) {
         .collect();
     let mut prev: Option<(f64, f64)> = None;
     let mut j = 0;
-    c.bench_function("blade_side_signed_distance_warm", |b| {
+    g.bench_function("blade_side_warm", |b| {
         b.iter(|| {
             j = (j + 1) % path.len();
             if j == 0 {
@@ -54,24 +58,25 @@ fn queries(c: &mut Criterion) {
             black_box(d)
         })
     });
-    c.bench_function("blade_side_closest_point_local_hint", |b| {
+    g.bench_function("blade_side_closest_point_local_hint", |b| {
         b.iter(|| {
             i = (i + 1) % pts.len();
             black_box(closest_point(blade.suction(), &pts[i].0, Some(pts[i].1)))
         })
     });
-    c.bench_function("hub_signed_distance", |b| {
+    g.bench_function("hub_signed_distance", |b| {
         b.iter(|| {
             i = (i + 1) % pts.len();
             black_box(imp.hub().signed_distance(&pts[i].0))
         })
     });
-    c.bench_function("shroud_signed_distance", |b| {
+    g.bench_function("shroud_signed_distance", |b| {
         b.iter(|| {
             i = (i + 1) % pts.len();
             black_box(imp.shroud().signed_distance(&pts[i].0))
         })
     });
+    g.finish();
     let mut g = c.benchmark_group("model");
     g.sample_size(10);
     g.bench_function("build_default_impeller", |b| {

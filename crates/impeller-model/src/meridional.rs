@@ -5,8 +5,10 @@
 //! normalised arc length; the table from curve parameter to arc length is built once with
 //! 5-point Gauss–Legendre quadrature on 256 parameter intervals (relative error far below
 //! 1e-12 for the smooth contours used here) and inverted by bisection plus Newton steps
-//! (|dm/dt| = |C'(t)| / L). Closest points use the `nurbs` crate's global `CurveProjector`,
-//! built once per contour. The *channel-side normal* N = (t_r, −t_z)/|t| of the unit tangent
+//! (|dm/dt| = |C'(t)| / L). Closest points use the `nurbs` crate's global, certified
+//! `CurveProjector`, built once per contour (hub and shroud queries cost ≈ 0.3 µs, criterion
+//! `impeller_model/hub_signed_distance`; the quarter-ellipse contours are one rational
+//! quadratic Bézier segment). The *channel-side normal* N = (t_r, −t_z)/|t| of the unit tangent
 //! (t_z, t_r) points to +r at an axial inlet and to +z at a radial outlet: from the hub into
 //! the channel, and from the shroud out of it.
 
@@ -169,7 +171,13 @@ impl MeridionalCurve {
 
     /// Unit channel-side normal (see module docs) at parameter t.
     pub fn normal(&self, t: f64) -> Vector2<f64> {
-        let d = self.curve.derivs(t, 1)[1];
+        let mut d = [Vector2::zeros(); 2];
+        self.curve.derivs_into(t, &mut d);
+        Self::normal_of_tangent(&d[1])
+    }
+
+    /// The unit channel-side normal of a tangent `(t_z, t_r)`.
+    fn normal_of_tangent(d: &Vector2<f64>) -> Vector2<f64> {
         let n = Vector2::new(d[1], -d[0]);
         let l = n.norm();
         if l > 0.0 {
@@ -191,7 +199,7 @@ impl MeridionalCurve {
     /// [`Self::closest`] with the certificate: (parameter, signed distance, proven global).
     pub fn closest_point(&self, zr: Vector2<f64>) -> (f64, f64, bool) {
         let cp = self.projector.closest_point(&zr);
-        let sign = if (zr - cp.point).dot(&self.normal(cp.u)) >= 0.0 {
+        let sign = if (zr - cp.point).dot(&Self::normal_of_tangent(&cp.tangent)) >= 0.0 {
             1.0
         } else {
             -1.0

@@ -110,16 +110,20 @@ pub fn blade_side_distance(
     p: &Vector3<f64>,
     hint: Option<(f64, f64)>,
 ) -> (SurfacePoint, f64) {
-    let g = blade.projector(side).closest_point_with_hint(p, hint);
+    let proj = blade.projector(side);
+    let g = proj.closest_point_with_hint(p, hint);
     let sp = SurfacePoint {
         u: g.u,
         v: g.v,
         point: g.point,
         distance: g.distance,
     };
-    let sign = match blade.outward_normal(side, sp.u, sp.v) {
-        Some(n) if (p - sp.point).dot(&n) < 0.0 => -1.0,
-        _ => 1.0,
+    // The outward normal from the natural normal the projector returns with the answer.
+    let n = g.normal * blade.outward_sign(side);
+    let sign = if (p - sp.point).dot(&n) < 0.0 {
+        -1.0
+    } else {
+        1.0
     };
     (sp, sign * sp.distance)
 }
@@ -162,7 +166,7 @@ impl nurbs::closest::PointQuery for BladeSideQuery<'_> {
             point: sp.point,
             signed_distance: d,
             hint: (sp.u, sp.v),
-            certified: !self.blade.side(self.side).is_rational() && d.is_finite(),
+            certified: d.is_finite(),
         }
     }
 }

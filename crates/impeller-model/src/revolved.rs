@@ -140,7 +140,7 @@ impl RevolvedSurface {
     /// Signed distance of `p` to the surface (positive on the channel side of the hub /
     /// outside the shroud).
     pub fn signed_distance(&self, p: &Vector3<f64>) -> f64 {
-        self.closest(p).2
+        self.meridional.closest(MeridionalCurve::zr_of(p)).1
     }
 }
 

@@ -42,6 +42,8 @@ pub struct CurvePoint<const D: usize> {
     pub u: f64,
     /// `C(u)`.
     pub point: SVector<f64, D>,
+    /// The tangent `C'(u)` (derivative in the curve's parameter), e.g. to sign the distance.
+    pub tangent: SVector<f64, D>,
     /// Distance from the query point (mm).
     pub distance: f64,
     /// The answer is a domain end where the distance still decreases outwards.
@@ -153,6 +155,9 @@ pub struct CurveProjector<const D: usize> {
     step_tol: f64,
     /// Bounding-volume tree over the Bézier segments (empty above degree 7).
     tree: Vec<super::curve_cert::Node<D>>,
+    /// Per segment, the query-independent polynomials of the certified search (empty above
+    /// degree 7).
+    polys: Vec<super::curve_cert::PiecePolys<D>>,
 }
 
 struct Local1<const D: usize> {
@@ -224,11 +229,16 @@ impl<const D: usize> CurveProjector<D> {
         }
         let diag = (hi - lo).norm();
         let step_tol = 1e-13 * (1.0 + if diag.is_finite() { diag } else { 0.0 });
-        let tree = if p <= super::curve_cert::MAX_CERT_DEGREE {
+        let (tree, polys) = if p <= super::curve_cert::MAX_CERT_DEGREE {
             let boxes: Vec<_> = segs.iter().map(super::curve_cert::control_box).collect();
-            super::curve_cert::build_tree(&boxes)
+            (
+                super::curve_cert::build_tree(&boxes),
+                segs.iter()
+                    .map(super::curve_cert::PiecePolys::new)
+                    .collect(),
+            )
         } else {
-            Vec::new()
+            (Vec::new(), Vec::new())
         };
         CurveProjector {
             segs,
@@ -237,6 +247,7 @@ impl<const D: usize> CurveProjector<D> {
             domain: curve.domain(),
             step_tol,
             tree,
+            polys,
         }
     }
 
@@ -246,9 +257,10 @@ impl<const D: usize> CurveProjector<D> {
         self.breaks[1..n].partition_point(|&b| b <= u)
     }
 
-    /// `[C, C', C'']` at `u` from the Bézier segments.
+    /// `[C, C', C'']` at `u` from the Bézier segments (no allocation; `u` outside the
+    /// domain extrapolates the end segment).
     #[inline]
-    fn derivs2(&self, u: f64) -> [SVector<f64, D>; 3] {
+    pub fn derivs2(&self, u: f64) -> [SVector<f64, D>; 3] {
         self.segs[self.seg_index(u)].derivs2(u)
     }
 
@@ -263,9 +275,11 @@ impl<const D: usize> CurveProjector<D> {
         let (a, b) = self.domain;
         if !q.iter().all(|c| c.is_finite()) {
             // No point is closest to a non-finite query.
+            let e = self.derivs2(a);
             return CurvePoint {
                 u: a,
-                point: self.derivs2(a)[0],
+                point: e[0],
+                tangent: e[1],
                 distance: f64::NAN,
                 on_boundary: false,
                 certified: false,
@@ -331,15 +345,17 @@ impl<const D: usize> CurveProjector<D> {
             Some(l) => CurvePoint {
                 u: l.u,
                 point: l.point,
+                tangent: self.derivs2(l.u)[1],
                 distance: l.d2.sqrt(),
                 on_boundary: l.active != 0,
                 certified: false,
             },
             None => {
-                let c = self.derivs2(a)[0];
+                let [c, t, _] = self.derivs2(a);
                 CurvePoint {
                     u: a,
                     point: c,
+                    tangent: t,
                     distance: (c - q).norm(),
                     on_boundary: true,
                     certified: false,
@@ -382,7 +398,7 @@ impl<const D: usize> CurveProjector<D> {
             }
             let node = &self.tree[id];
             match node.kids {
-                None => search_piece(&self.segs[node.lo], node.lo, q, &mut best),
+                None => search_piece(&self.polys[node.lo], node.lo, q, &mut best),
                 Some((l, r)) => {
                     if top + 2 > stack.len() {
                         walked_all = false;
@@ -409,6 +425,7 @@ impl<const D: usize> CurveProjector<D> {
         CurvePoint {
             u,
             point: e[0],
+            tangent: e[1],
             distance: (e[0] - q).norm(),
             on_boundary: (u <= a && g > 0.0) || (u >= b && g < 0.0),
             certified: best.certified && walked_all,

@@ -36,7 +36,9 @@
 //! round-off) is solved by the bracketed iteration and its ends, and the answer's
 //! `certified` flag is cleared. Nothing allocates; degree ≤ [`MAX_CERT_DEGREE`].
 //!
-//! Cost per piece O(p²) for the products, O(p²) per halving; the tree visits the pieces
+//! The products do not depend on the query but for `q` entering linearly: they are
+//! precomputed per piece ([`PiecePolys`]), so a query forms `S` and `N` in O(D p); then
+//! O(p²) per halving and a few Newton steps on `N` for the root. The tree visits the pieces
 //! whose box is nearer than the best distance, O(log n) for a query near one piece.
 
 use nalgebra::SVector;
@@ -87,8 +89,32 @@ const fn binom_table() -> [[f64; NC + 1]; NC + 1] {
 
 static BINOM: [[f64; NC + 1]; NC + 1] = binom_table();
 
+/// `scale · Σ_k c_k B_{k,n}(t)` for `t ∈ [0, 1]` by Horner's scheme on `c_k C(n, k)` in the
+/// ratio `t / (1 − t)` (for t ≤ ½) or `(1 − t) / t` (for t > ½), times the power of the
+/// larger of `t`, `1 − t`: O(n), every ratio ≤ 1.
+#[inline]
+fn bernstein_horner(c: &[f64], n: usize, t: f64, scale: f64) -> f64 {
+    let s = 1.0 - t;
+    let binom = &BINOM[n];
+    if t <= 0.5 {
+        let r = t / s;
+        let mut acc = c[n] * binom[n];
+        for k in (0..n).rev() {
+            acc = acc * r + c[k] * binom[k];
+        }
+        scale * acc * s.powi(n as i32)
+    } else {
+        let r = s / t;
+        let mut acc = c[0] * binom[0];
+        for k in 1..=n {
+            acc = acc * r + c[k] * binom[k];
+        }
+        scale * acc * t.powi(n as i32)
+    }
+}
+
 /// A Bernstein polynomial on a sub-interval, coefficients `c[0..=deg]`.
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 struct Poly {
     c: [f64; NC],
     deg: usize,
@@ -144,15 +170,28 @@ impl Poly {
         r
     }
 
-    /// Value at local t ∈ [0, 1] (de Casteljau).
+    /// Value at local t ∈ [0, 1]: Horner's scheme in `t / (1 − t)` (or `(1 − t) / t` for
+    /// t > ½, so the ratio stays ≤ 1) on the scaled coefficients `c_k C(n, k)`. O(n), no
+    /// copy of the coefficients.
     fn eval(&self, t: f64) -> f64 {
-        let mut b = self.c;
-        for r in 1..=self.deg {
-            for k in 0..=self.deg - r {
-                b[k] = b[k] * (1.0 - t) + b[k + 1] * t;
-            }
+        bernstein_horner(&self.c[..=self.deg], self.deg, t, 1.0)
+    }
+
+    /// Value and derivative (in the local parameter) at t ∈ [0, 1], both by
+    /// [`bernstein_horner`]: `f' = n Σ (c_{k+1} − c_k) B_{k,n−1}`.
+    fn eval_with_deriv(&self, t: f64) -> (f64, f64) {
+        let n = self.deg;
+        if n == 0 {
+            return (self.c[0], 0.0);
         }
-        b[0]
+        let mut d = [0.0; NC];
+        for k in 0..n {
+            d[k] = self.c[k + 1] - self.c[k];
+        }
+        (
+            bernstein_horner(&self.c[..=n], n, t, 1.0),
+            bernstein_horner(&d[..n], n - 1, t, n as f64),
+        )
     }
 
     /// Halves at t = ½ (de Casteljau): (left, right).
@@ -197,36 +236,115 @@ pub(crate) struct Best {
     pub certified: bool,
 }
 
-/// Searches piece `piece` (segment `seg`) for a point nearer than `best` (see module docs).
+/// The query-independent Bernstein polynomials of one piece, so that a query only forms
+/// linear combinations (no polynomial products per query). With the control points shifted
+/// by the piece's centre `c` (homogeneous `X_d = w (P_d − c_d)`), `q' = q − c` and
+/// `R_d = X_d − q'_d W`:
+///
+/// ```text
+/// S = Σ R_d² = A − 2 Σ q'_d B_d + |q'|² C     A = Σ X_d²,  B_d = X_d W,  C = W²
+/// N = ½ W S' − W' S = N(A) − 2 Σ q'_d N(B_d) + |q'|² N(C)     (N linear in S)
+/// ```
+///
+/// Shifting by the centre keeps the terms of the sum of the order of the piece's size, so
+/// the round-off of the expansion stays that of the direct products (within a small factor).
+#[derive(Debug, Clone)]
+pub(crate) struct PiecePolys<const D: usize> {
+    centre: SVector<f64, D>,
+    w: Poly,
+    sa: Poly,
+    sb: [Poly; D],
+    sc: Poly,
+    na: Poly,
+    nb: [Poly; D],
+    nc: Poly,
+}
+
+impl<const D: usize> PiecePolys<D> {
+    /// Precomputes the polynomials of `seg` (degree ≤ [`MAX_CERT_DEGREE`]). O(D p²).
+    pub(crate) fn new(seg: &BezierSegment<D>) -> Self {
+        let p = seg.p;
+        let mut centre = SVector::<f64, D>::zeros();
+        let (mut lo, mut hi) = (
+            SVector::<f64, D>::repeat(f64::INFINITY),
+            SVector::<f64, D>::repeat(f64::NEG_INFINITY),
+        );
+        for pt in seg.points() {
+            lo = lo.inf(&pt);
+            hi = hi.sup(&pt);
+        }
+        if lo.iter().chain(hi.iter()).all(|x| x.is_finite()) {
+            centre = (lo + hi) * 0.5;
+        }
+        let mut w = Poly::zero(p);
+        for (i, (_, wi)) in seg.pw.iter().enumerate() {
+            w.c[i] = *wi;
+        }
+        let x: [Poly; D] = std::array::from_fn(|d| {
+            let mut x = Poly::zero(p);
+            for (i, (pw, wi)) in seg.pw.iter().enumerate() {
+                x.c[i] = pw[d] - centre[d] * wi;
+            }
+            x
+        });
+        let mut sa = Poly::zero(2 * p);
+        for xd in &x {
+            let sq = xd.mul(xd);
+            for k in 0..=2 * p {
+                sa.c[k] += sq.c[k];
+            }
+        }
+        let sb: [Poly; D] = std::array::from_fn(|d| x[d].mul(&w));
+        let sc = w.mul(&w);
+        let rational = seg.rational;
+        let nlin = |t: &Poly| -> Poly {
+            if rational {
+                w.mul(&t.deriv()).scale(0.5).sub(&w.deriv().mul(t))
+            } else {
+                t.deriv().scale(0.5)
+            }
+        };
+        PiecePolys {
+            centre,
+            na: nlin(&sa),
+            nb: std::array::from_fn(|d| nlin(&sb[d])),
+            nc: nlin(&sc),
+            w,
+            sa,
+            sb,
+            sc,
+        }
+    }
+}
+
+/// Searches piece `piece` (precomputed polynomials `pre`) for a point nearer than `best`
+/// (see module docs). O(D p) to form `S` and `N`, then the root isolation.
 pub(crate) fn search_piece<const D: usize>(
-    seg: &BezierSegment<D>,
+    pre: &PiecePolys<D>,
     piece: usize,
     q: &SVector<f64, D>,
     best: &mut Best,
 ) {
-    let p = seg.p;
-    let mut w = Poly::zero(p);
-    let mut s = Poly::zero(2 * p);
-    let mut r = Poly::zero(p);
-    for d in 0..D {
-        for (i, (pw, wi)) in seg.pw.iter().enumerate() {
-            r.c[i] = pw[d] - q[d] * wi;
+    let qc = q - pre.centre;
+    let q2 = qc.norm_squared();
+    let mut s = pre.sa;
+    for k in 0..=s.deg {
+        let mut acc = s.c[k] + q2 * pre.sc.c[k];
+        for d in 0..D {
+            acc -= 2.0 * qc[d] * pre.sb[d].c[k];
         }
-        let sq = r.mul(&r);
-        for k in 0..=2 * p {
-            s.c[k] += sq.c[k];
+        s.c[k] = acc;
+    }
+    let mut n = pre.na;
+    for k in 0..=n.deg {
+        let mut acc = n.c[k] + q2 * pre.nc.c[k];
+        for d in 0..D {
+            acc -= 2.0 * qc[d] * pre.nb[d].c[k];
         }
+        n.c[k] = acc;
     }
-    for (i, (_, wi)) in seg.pw.iter().enumerate() {
-        w.c[i] = *wi;
-    }
-    let n = if seg.rational {
-        w.mul(&s.deriv()).scale(0.5).sub(&w.deriv().mul(&s))
-    } else {
-        s.deriv().scale(0.5)
-    };
-    let flat = FLAT_REL * (s.max().abs() * (2 * p) as f64).max(f64::MIN_POSITIVE);
-    isolate(&n, &s, &w, 0.0, 1.0, 0, flat, piece, best);
+    let flat = FLAT_REL * (s.max().abs() * s.deg as f64).max(f64::MIN_POSITIVE);
+    isolate(&n, &s, &pre.w, 0.0, 1.0, 0, flat, piece, best);
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -329,34 +447,56 @@ fn isolate(
     }
 }
 
-/// A root of `n` on [0, 1] where it goes from negative to positive (or the sign change
-/// nearest to that), by Newton steps kept inside a shrinking bracket (bisection when a step
-/// leaves it). `None` when `n` has no sign change at the ends.
+/// A root of `n` on [0, 1] where it goes from negative to positive, by Newton steps kept
+/// inside a shrinking bracket; a step that leaves the bracket is replaced by a false-position
+/// step (every third such step by bisection, so the bracket shrinks geometrically). Starts at
+/// the false-position point of the ends. Stops when the Newton correction or the bracket is
+/// below [`ROOT_TOL`]. `None` when the ends do not go from − to +.
 fn root(n: &Poly) -> Option<f64> {
     let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-    let (flo, fhi) = (n.c[0], n.c[n.deg]);
+    let (mut flo, mut fhi) = (n.c[0], n.c[n.deg]);
     if flo > 0.0 || fhi < 0.0 {
         // The ends do not bracket (several roots): the interior minimum of the coefficients.
         return None;
     }
-    let dn = n.deriv();
-    let mut t = 0.5;
+    if flo == 0.0 {
+        return Some(0.0);
+    }
+    if fhi == 0.0 {
+        return Some(1.0);
+    }
+    let mut t = flo / (flo - fhi);
+    let mut fallbacks = 0usize;
     for _ in 0..ROOT_ITER {
-        let f = n.eval(t);
+        let (f, df) = n.eval_with_deriv(t);
         if f == 0.0 {
             return Some(t);
         }
         if f < 0.0 {
             lo = t;
+            flo = f;
         } else {
             hi = t;
+            fhi = f;
         }
-        let df = dn.eval(t);
-        let mut next = if df > 0.0 { t - f / df } else { f64::NAN };
+        let step = f / df;
+        if df > 0.0 && step.abs() <= ROOT_TOL {
+            // Converged: the correction is below the tolerance (it may round to `t`).
+            return Some((t - step).clamp(lo, hi));
+        }
+        let mut next = if df > 0.0 { t - step } else { f64::NAN };
         if !(next > lo && next < hi) {
-            next = 0.5 * (lo + hi);
+            fallbacks += 1;
+            next = if fallbacks % 3 == 0 {
+                0.5 * (lo + hi)
+            } else {
+                lo - flo * (hi - lo) / (fhi - flo)
+            };
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
+            }
         }
-        if (next - t).abs() <= ROOT_TOL || hi - lo <= ROOT_TOL {
+        if hi - lo <= ROOT_TOL {
             return Some(next);
         }
         t = next;

@@ -24,6 +24,8 @@ pub(crate) struct Local {
     pub u: f64,
     pub v: f64,
     pub point: Vector3<f64>,
+    /// The natural normal `S_u × S_v` (not normalised) at the point.
+    pub normal: Vector3<f64>,
     /// Squared distance.
     pub d2: f64,
     /// Per variable: 0 = free (gradient ≈ 0), -1 = held at the lower bound, +1 = at the upper.
@@ -210,6 +212,7 @@ pub(crate) fn minimise<F: Fn(f64, f64) -> SurfaceDerivs2>(
         u,
         v,
         point: e.p,
+        normal: e.su.cross(&e.sv),
         d2: f,
         active,
         converged,

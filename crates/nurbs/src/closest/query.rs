@@ -66,13 +66,12 @@ impl PointQuery for super::SurfaceProjector {
 
     /// Signed along `S_u × S_v` at the closest point (at a degenerate normal, or on the
     /// boundary where `S − q` is not normal, the sign of `(q − S)·(S_u × S_v)` still decides;
-    /// 0 counts as positive). Certified for polynomial surfaces (rigorous hodograph bounds);
-    /// for rational ones see the projector's docs.
+    /// 0 counts as positive). Certified for polynomial and rational (positive weights)
+    /// surfaces alike: the bounds are rigorous (hodographs of the polynomial or of the
+    /// homogeneous net).
     fn query(&self, q: &Vector3<f64>, hint: Option<(f64, f64)>) -> PointProjection<(f64, f64)> {
         let r = self.closest_point_with_hint(q, hint);
-        let d = self.derivs2(r.u, r.v);
-        let n = d.su.cross(&d.sv);
-        let sign = if (q - r.point).dot(&n) < 0.0 {
+        let sign = if (q - r.point).dot(&r.normal) < 0.0 {
             -1.0
         } else {
             1.0
@@ -81,7 +80,7 @@ impl PointQuery for super::SurfaceProjector {
             point: r.point,
             signed_distance: sign * r.distance,
             hint: (r.u, r.v),
-            certified: !self.is_rational() && r.distance.is_finite(),
+            certified: r.distance.is_finite(),
         }
     }
 }
