@@ -508,9 +508,6 @@ pub fn post(
         mode,
         post: PostOptions {
             linearisation_tol: Some(job.tolerances.linearisation_tol),
-            // Rapids too: between plunges the tool travels a few mm above the blank, and a
-            // joint-interpolated G0 with a rotary change leaves the straight line by more.
-            linearise_rapids: true,
             reverse_motion: Some(ReverseMotionOptions::default()),
             ..PostOptions::default()
         },

@@ -53,7 +53,9 @@ pub struct PostOptions {
     /// M128); default `false`. No block is inserted and every block's linearisation error is
     /// 0 — the tip deviation of joint interpolation does not occur in such a program.
     pub tool_centre_point: bool,
-    /// Also subdivide rapid moves (default `false`).
+    /// Also subdivide rapid moves (default `false`); a rapid that changes the solution branch
+    /// (a reconfiguration, which the posture choice allows on the rapid that starts a group)
+    /// cannot follow its straight line and is left as it is.
     pub linearise_rapids: bool,
     /// Unwind continuous rotary axes to (−180°, 180°] on rapid moves (default `true`).
     pub unwind_on_rapid: bool,
@@ -327,7 +329,9 @@ pub fn post_path_checked(
     // parallel, then subdivide only the segments above tolerance.
     let wants = |p: &PostedBlock, b: &PostedBlock| {
         !options.tool_centre_point
-            && (b.kind != MoveKind::Rapid || options.linearise_rapids)
+            && (b.kind != MoveKind::Rapid
+                || (options.linearise_rapids
+                    && !is_reconfiguration(machine, tl, &p.cl, &p.joints, &b.cl, &b.joints)))
             && !b.unwound
             && b.limit_violation.is_none()
             && p.limit_violation.is_none()
