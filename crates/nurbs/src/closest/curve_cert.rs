@@ -487,7 +487,7 @@ fn root(n: &Poly) -> Option<f64> {
         let mut next = if df > 0.0 { t - step } else { f64::NAN };
         if !(next > lo && next < hi) {
             fallbacks += 1;
-            next = if fallbacks % 3 == 0 {
+            next = if fallbacks.is_multiple_of(3) {
                 0.5 * (lo + hi)
             } else {
                 lo - flo * (hi - lo) / (fhi - flo)
