@@ -508,6 +508,10 @@ pub fn post(
         mode,
         post: PostOptions {
             linearisation_tol: Some(job.tolerances.linearisation_tol),
+            // Rapids too: near the part (between plunges the tool travels a few mm above the
+            // blank) a joint-interpolated G0 with a rotary change leaves its straight line by
+            // more than the clearance; rapids that change branch are left as they are.
+            linearise_rapids: true,
             reverse_motion: Some(ReverseMotionOptions::default()),
             ..PostOptions::default()
         },

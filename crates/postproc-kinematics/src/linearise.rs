@@ -111,7 +111,8 @@ const EXCESS_ROTARY_TRAVEL: f64 = 1e-2;
 /// linear axes recomputed so the tip still lies halfway on the chord: the tip path stays
 /// exact, the axis deviates from the great circle by at most the ends' own angular distance
 /// near the singular direction (where the orientation a controller produces is this joint
-/// interpolation anyway).
+/// interpolation anyway). The same interpolation splits a turn of the rotary axis about the
+/// singular direction itself (where the exact inverse keeps the angle of an end).
 fn midpoint_posture(
     machine: &Machine,
     cl0: &CutterLocation,
@@ -123,7 +124,11 @@ fn midpoint_posture(
     let mid = interpolate_cl(cl0, cl1, 0.5);
     let jm = machine.inverse(&mid, tool_length, Some(j0))?;
     let travel = |a: &Joints, b: &Joints| (a.tilt - b.tilt).abs() + (a.rotate - b.rotate).abs();
-    if travel(j0, &jm) + travel(&jm, j1) <= travel(j0, j1) + EXCESS_ROTARY_TRAVEL {
+    let (a, b, whole) = (travel(j0, &jm), travel(&jm, j1), travel(j0, j1));
+    // An exact midpoint that repeats an end (a turn about the singular direction, where the
+    // inverse holds the rotary angle) would never split the turn: interpolate it instead.
+    let stuck = whole > 1e-12 && (a < 1e-12 || b < 1e-12);
+    if !stuck && a + b <= whole + EXCESS_ROTARY_TRAVEL {
         return Ok((mid, jm));
     }
     let (t, r) = (0.5 * (j0.tilt + j1.tilt), 0.5 * (j0.rotate + j1.rotate));
@@ -163,6 +168,28 @@ pub fn subdivide(
     settings: &LinearisationSettings,
     out: &mut Vec<(CutterLocation, Joints, f64)>,
 ) -> Result<f64, KinematicsError> {
+    // At a singular end (tool axis along the rotary axis) the rotary angle is a free choice:
+    // the exact sweep leaves the pole with the other end's rotary angle at once, so the whole
+    // rotary change sits at the pole and no bisection can spread it. Turn the rotary axis at
+    // the pole first (tip and axis fixed: a pure table/head turn), then sweep with it held
+    // (or the reverse at a singular far end).
+    let singular = |cl: &CutterLocation| {
+        let a = cl.axis.into_inner();
+        a.x.hypot(a.y) < machine.singularity_tol().sin()
+    };
+    let turn = (j1.rotate - j0.rotate).abs() > 1e-9;
+    if turn && singular(cl0) && !singular(cl1) {
+        let jp = machine.joints_for_angles(&cl0.tip, tool_length, j0.tilt, j1.rotate);
+        let d = subdivide_rec(machine, cl0, j0, cl0, &jp, tool_length, settings, 0, out)?;
+        out.push((*cl0, jp, d));
+        return subdivide_rec(machine, cl0, &jp, cl1, j1, tool_length, settings, 0, out);
+    }
+    if turn && singular(cl1) && !singular(cl0) {
+        let jp = machine.joints_for_angles(&cl1.tip, tool_length, j1.tilt, j0.rotate);
+        let d = subdivide_rec(machine, cl0, j0, cl1, &jp, tool_length, settings, 0, out)?;
+        out.push((*cl1, jp, d));
+        return subdivide_rec(machine, cl1, &jp, cl1, j1, tool_length, settings, 0, out);
+    }
     subdivide_rec(machine, cl0, j0, cl1, j1, tool_length, settings, 0, out)
 }
 

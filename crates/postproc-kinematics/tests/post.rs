@@ -588,3 +588,50 @@ fn tool_centre_point_output_is_not_linearised() {
     assert_eq!(p.metrics.inserted_blocks, 0);
     assert_eq!(p.metrics.max_linearisation_error_mm, 0.0);
 }
+
+/// A rapid leaving the vertical axis (the linker's safety travel) toward a tilted axis whose C
+/// differs from the one held at the pole: the exact sweep puts the whole C change at the pole,
+/// where no bisection of the move can spread it (10 mm left at depth 16 on the impeller-8+8
+/// finishing job). The post turns C at the pole first, then tilts; the tip stays on the line.
+#[test]
+fn rapid_leaving_the_singular_direction_is_linearised() {
+    let m = fixture("xyzac-trt");
+    let tol = 0.005;
+    let up = CutterLocation::new(Point3::new(30.0, 5.0, 60.0), Vector3::z()).unwrap();
+    let tilted = CutterLocation::new(
+        Point3::new(32.0, 4.0, 58.0),
+        Vector3::new(0.66, -0.75, 0.02),
+    )
+    .unwrap();
+    let moves = vec![
+        Move::rapid(CutterLocation::new(Point3::new(0.0, 0.0, 60.0), Vector3::z()).unwrap()),
+        Move::rapid(up),
+        Move::rapid(tilted),
+    ];
+    let opts = PostOptions {
+        linearisation_tol: Some(tol),
+        linearise_rapids: true,
+        unwind_on_rapid: false,
+        ..Default::default()
+    };
+    let posted = post_path(&m, &moves, &opts).unwrap();
+    assert!(
+        posted.metrics.max_linearisation_error_mm <= tol,
+        "{:?}",
+        posted.metrics
+    );
+    let mut worst: f64 = 0.0;
+    for w in posted.blocks.windows(2) {
+        let src = w[1].source_index;
+        for k in 1..200 {
+            let s = k as f64 / 200.0;
+            let tip = m.forward(&w[0].joints.lerp(&w[1].joints, s), 0.0).tip;
+            worst = worst.max(point_segment_distance(
+                &tip,
+                &moves[src - 1].cl.tip,
+                &moves[src].cl.tip,
+            ));
+        }
+    }
+    assert!(worst <= tol * 1.0001, "dense deviation {worst}");
+}
