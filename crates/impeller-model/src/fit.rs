@@ -20,13 +20,14 @@ pub fn averaged_knots(params: &[f64], degree: usize) -> Result<KnotVector, Model
             "interpolation needs more than {degree} samples, got {n}"
         )));
     }
+    // One home for the averaging: the `nurbs` crate's (eq. 9.8, clamped to [0, 1]); its
+    // interior knots are the same sums in the same order, so only the clamped ends change to
+    // this parameter range's ends.
     let (a, b) = (params[0], params[n - 1]);
-    let mut knots = vec![a; degree + 1];
-    for j in 1..n - degree {
-        let s: f64 = params[j..j + degree].iter().sum();
-        knots.push(s / degree as f64);
-    }
-    knots.extend(std::iter::repeat_n(b, degree + 1));
+    let mut knots = nurbs::fit::averaged_knots(params, degree, false);
+    let m = knots.len();
+    knots[..=degree].fill(a);
+    knots[m - degree - 1..].fill(b);
     Ok(KnotVector::new(degree, knots)?)
 }
 
@@ -162,6 +163,39 @@ pub fn ruled_through(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The averaging this module carried before it called `nurbs` (issue 15): the knots must
+    /// stay identical (within 1e-12) on any parameter range.
+    fn averaged_knots_before(params: &[f64], degree: usize) -> Vec<f64> {
+        let n = params.len();
+        let (a, b) = (params[0], params[n - 1]);
+        let mut knots = vec![a; degree + 1];
+        for j in 1..n - degree {
+            let s: f64 = params[j..j + degree].iter().sum();
+            knots.push(s / degree as f64);
+        }
+        knots.extend(std::iter::repeat_n(b, degree + 1));
+        knots
+    }
+
+    #[test]
+    fn averaged_knots_match_the_former_implementation() {
+        for (lo, hi) in [(0.0, 1.0), (-3.5, 17.25), (2.0, 2.001)] {
+            for n in [2usize, 5, 12, 40] {
+                let params: Vec<f64> = (0..n)
+                    .map(|i| lo + (hi - lo) * (i as f64 / (n - 1) as f64).powf(1.3))
+                    .collect();
+                for degree in 1..n.min(6) {
+                    let new = averaged_knots(&params, degree).unwrap();
+                    let old = averaged_knots_before(&params, degree);
+                    assert_eq!(new.knots().len(), old.len());
+                    for (x, y) in new.knots().iter().zip(&old) {
+                        assert!((x - y).abs() <= 1e-12, "{x} vs {y} (n {n}, p {degree})");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn interpolant_passes_through_samples_and_reproduces_cubics() {
