@@ -248,7 +248,7 @@ fn search_axis(
         edge_v(blade, side, imp.hub(), u),
         edge_v(blade, side, imp.shroud(), u),
     ) {
-        (Some(a), Some(b)) => s.point(u, b) - s.point(u, a),
+        (Ok(a), Ok(b)) => s.point(u, b) - s.point(u, a),
         _ => s.derivs2(u, 0.5 * (s.domain().1 .0 + s.domain().1 .1)).sv,
     };
     let mut a0 = ruling.try_normalize(1e-12).unwrap_or(nh);

@@ -201,7 +201,8 @@ impl RulingTable {
         let mut rows: Vec<(f64, Vector3<f64>)> = (0..RULING_SAMPLES)
             .filter_map(|k| {
                 let u = u0 + (u1 - u0) * k as f64 / (RULING_SAMPLES - 1) as f64;
-                let vh = edge_v(blade, side, hub, u)?;
+                // Past the hub edge's ends there is no ruling: skip this u.
+                let vh = edge_v(blade, side, hub, u).ok()?;
                 let vs = edge_v(blade, side, imp.shroud(), u).unwrap_or(v1.max(v0));
                 let ph = s.point(u, vh);
                 let ruling = (s.point(u, vs) - ph).try_normalize(1e-12)?;
@@ -681,7 +682,8 @@ fn certify_line(
 fn station(p: &Planner<'_>, t: f64) -> Option<Station> {
     let imp = p.ctx.impeller;
     let ch = imp.channel(0);
-    let sec = ch.section(imp.hub(), t)?;
+    // Beyond the blades' ends there is no station: a normal answer here.
+    let sec = ch.section(imp.hub(), t).ok()?;
     let g = |phi: f64| {
         let c = p.centre(t, phi);
         p.ctx.clearance.blade_signed_distance(&Point3::from(c)).0 - p.rho_b
@@ -742,7 +744,7 @@ fn blade_extent(imp: &Impeller) -> Option<(f64, f64)> {
     let ch = imp.channel(0);
     let hub = imp.hub();
     let (a, b) = hub.meridional().domain();
-    let ok = |t: f64| ch.section(hub, t).is_some();
+    let ok = |t: f64| ch.section(hub, t).is_ok();
     let n = 200;
     let ts: Vec<f64> = (0..=n).map(|k| a + (b - a) * k as f64 / n as f64).collect();
     let first = ts.iter().position(|&t| ok(t))?;

@@ -66,8 +66,8 @@ impl FlankSide {
         let blade = set.blade().clone();
         let v_range = match blade.design() {
             Some(_) => blade.hub_shroud_v(side),
-            None => impeller.span_v_range(&blade, side).ok_or_else(|| {
-                FlankError::Geometry(format!("{side:?} side: hub or shroud edge not found"))
+            None => impeller.span_v_range(&blade, side).map_err(|e| {
+                FlankError::Geometry(format!("{side:?} side: hub or shroud edge not found: {e}"))
             })?,
         };
         let s = blade.side(side);

@@ -183,8 +183,10 @@ impl FlankSemiFinishing {
         for side in [Side::Pressure, Side::Suction] {
             let v_range = match blade.design() {
                 Some(_) => blade.hub_shroud_v(side),
-                None => ctx.impeller.span_v_range(&blade, side).ok_or_else(|| {
-                    FlankError::Geometry(format!("{side:?} side: hub or shroud edge not found"))
+                None => ctx.impeller.span_v_range(&blade, side).map_err(|e| {
+                    FlankError::Geometry(format!(
+                        "{side:?} side: hub or shroud edge not found: {e}"
+                    ))
                 })?,
             };
             let strips =

@@ -364,29 +364,48 @@ impl BladeSet {
 }
 
 /// Where the line `c + λ n` meets `s`: Newton on S(a, b) − λ n = c in (a, b, λ), from
-/// (u, v, λ0). Returns λ, or `None` if it does not converge in 30 steps to 1e-12 mm.
+/// (u, v, λ0). Returns λ.
+///
+/// # Errors
+/// [`ModelError::LineMissesSurface`] with the start point and the last residual when the
+/// Jacobian is singular (line tangent to the surface) or Newton does not converge in 30 steps
+/// to 1e-12 mm (1e-9 mm accepted at the end).
 pub fn line_surface_intersection(
     s: &NurbsSurface,
     c: &Vector3<f64>,
     n: &Vector3<f64>,
     start: (f64, f64, f64),
-) -> Option<f64> {
+) -> Result<f64, ModelError> {
     let ((u0, u1), (v0, v1)) = s.domain();
     let (mut a, mut b, mut l) = start;
+    let fail = |residual_mm: f64, reason: &'static str| ModelError::LineMissesSurface {
+        u: start.0,
+        v: start.1,
+        lambda0: start.2,
+        residual_mm,
+        reason,
+    };
     for _ in 0..30 {
         let d = s.derivs2(a, b);
         let r = d.p - n * l - c;
         if r.norm() < 1e-12 {
-            return Some(l);
+            return Ok(l);
         }
         let j = nalgebra::Matrix3::from_columns(&[d.su, d.sv, -n]);
-        let step = j.lu().solve(&(-r))?;
+        let step = j
+            .lu()
+            .solve(&(-r))
+            .ok_or_else(|| fail(r.norm(), "singular Jacobian (line tangent to the surface)"))?;
         a = (a + step[0]).clamp(u0, u1);
         b = (b + step[1]).clamp(v0, v1);
         l += step[2];
     }
-    let r = s.point(a, b) - n * l - c;
-    (r.norm() < 1e-9).then_some(l)
+    let r = (s.point(a, b) - n * l - c).norm();
+    if r < 1e-9 {
+        Ok(l)
+    } else {
+        Err(fail(r, "no convergence in 30 Newton steps"))
+    }
 }
 
 impl Blade {
@@ -397,8 +416,9 @@ impl Blade {
         let c = self.camber.as_ref()?;
         let p = c.point(u, v);
         let n = c.normal(u, v)?;
-        let a = line_surface_intersection(&self.pressure, &p, &n, (u, v, 0.0))?;
-        let b = line_surface_intersection(&self.suction, &p, &n, (u, v, 0.0))?;
+        // A missed side means "no thickness here", which this query reports as `None`.
+        let a = line_surface_intersection(&self.pressure, &p, &n, (u, v, 0.0)).ok()?;
+        let b = line_surface_intersection(&self.suction, &p, &n, (u, v, 0.0)).ok()?;
         Some((a - b).abs())
     }
 }

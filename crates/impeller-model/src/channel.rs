@@ -19,6 +19,7 @@
 //! angular extent of the channel floor or opening there.
 
 use crate::blade::{Blade, Side};
+use crate::error::ModelError;
 use crate::impeller::Impeller;
 use crate::revolved::RevolvedSurface;
 use nalgebra::Vector3;
@@ -40,8 +41,18 @@ fn wall_of(imp: &Impeller, wall: Wall) -> &RevolvedSurface {
     }
 }
 
-/// Parameter v where the side's isoparametric line u crosses `wall`, if it does.
-pub fn edge_v(blade: &Blade, side: Side, wall: &RevolvedSurface, u: f64) -> Option<f64> {
+/// Parameter v where the side's isoparametric line u crosses `wall`.
+///
+/// # Errors
+/// [`ModelError::EdgeMissesWall`] (with `wall: None`, as only the surface is known here) when
+/// the line does not cross from inside to outside the wall within the side's v range. Callers
+/// scanning for where an edge ends treat this as a normal answer.
+pub fn edge_v(
+    blade: &Blade,
+    side: Side,
+    wall: &RevolvedSurface,
+    u: f64,
+) -> Result<f64, ModelError> {
     let s = blade.side(side);
     let (_, (v0, v1)) = s.domain();
     let f = |v: f64| wall.signed_distance(&s.point(u, v));
@@ -59,7 +70,7 @@ pub fn edge_v(blade: &Blade, side: Side, wall: &RevolvedSurface, u: f64) -> Opti
                 let x = (lo * fhi - hi * flo) / (fhi - flo);
                 let fx = f(x);
                 if fx.abs() < 1e-10 || (hi - lo) < 1e-15 {
-                    return Some(x);
+                    return Ok(x);
                 }
                 if fx <= 0.0 {
                     lo = x;
@@ -77,29 +88,49 @@ pub fn edge_v(blade: &Blade, side: Side, wall: &RevolvedSurface, u: f64) -> Opti
                     side_kept = 1;
                 }
             }
-            return Some(0.5 * (lo + hi));
+            return Ok(0.5 * (lo + hi));
         }
         a = b;
         fa = fb;
     }
-    None
+    Err(ModelError::EdgeMissesWall {
+        side,
+        wall: None,
+        u,
+    })
 }
 
 /// A blade side's intersection with hub or shroud as (u, v, point) samples at `n` values of u.
+/// Values of u where the side's isoparametric line misses the wall (beyond the wall's ends) are
+/// left out.
+///
+/// # Errors
+/// [`ModelError::EdgeEmpty`] (with `wall: None`) when no sample meets the wall (or `n` is 0).
 pub fn edge_curve(
     blade: &Blade,
     side: Side,
     wall: &RevolvedSurface,
     n: usize,
-) -> Vec<(f64, f64, Vector3<f64>)> {
+) -> Result<Vec<(f64, f64, Vector3<f64>)>, ModelError> {
     let s = blade.side(side);
     let ((u0, u1), _) = s.domain();
-    (0..n)
+    let edge: Vec<_> = (0..n)
         .filter_map(|i| {
             let u = u0 + (u1 - u0) * i as f64 / (n.max(2) - 1) as f64;
-            edge_v(blade, side, wall, u).map(|v| (u, v, s.point(u, v)))
+            // A miss at one u is normal (the edge ends before the side's u end): skip it.
+            edge_v(blade, side, wall, u)
+                .ok()
+                .map(|v| (u, v, s.point(u, v)))
         })
-        .collect()
+        .collect();
+    if edge.is_empty() {
+        return Err(ModelError::EdgeEmpty {
+            side,
+            wall: None,
+            n,
+        });
+    }
+    Ok(edge)
 }
 
 fn golden(mut a: f64, mut b: f64, f: impl Fn(f64) -> f64) -> f64 {
@@ -135,8 +166,8 @@ pub fn min_edge_distance(
     wall: &RevolvedSurface,
 ) -> Option<(f64, Vector3<f64>, Vector3<f64>)> {
     let n = 121;
-    let ea = edge_curve(a, sa, wall, n);
-    let eb = edge_curve(b, sb, wall, n);
+    let ea = edge_curve(a, sa, wall, n).ok()?;
+    let eb = edge_curve(b, sb, wall, n).ok()?;
     let mut best = (f64::INFINITY, 0, 0);
     for (i, pa) in ea.iter().enumerate() {
         for (j, pb) in eb.iter().enumerate() {
@@ -153,8 +184,9 @@ pub fn min_edge_distance(
     let ha = 1.5 / (n - 1) as f64;
     let (ua0, ua1) = (a.side(sa).domain().0 .0, a.side(sa).domain().0 .1);
     let (ub0, ub1) = (b.side(sb).domain().0 .0, b.side(sb).domain().0 .1);
-    let pa_of = |u: f64| edge_v(a, sa, wall, u).map(|v| a.side(sa).point(u, v));
-    let pb_of = |u: f64| edge_v(b, sb, wall, u).map(|v| b.side(sb).point(u, v));
+    // A miss inside the search bracket only means "no candidate here" (infinite distance).
+    let pa_of = |u: f64| edge_v(a, sa, wall, u).ok().map(|v| a.side(sa).point(u, v));
+    let pb_of = |u: f64| edge_v(b, sb, wall, u).ok().map(|v| b.side(sb).point(u, v));
     let (mut xa, mut xb) = (ua, ub);
     let dist = |pa: Option<Vector3<f64>>, pb: Option<Vector3<f64>>| match (pa, pb) {
         (Some(p), Some(q)) => (p - q).norm(),
@@ -204,7 +236,8 @@ pub fn edge_angle_at(blade: &Blade, side: Side, wall: &RevolvedSurface, t: f64) 
     let s = blade.side(side);
     let ((u0, u1), _) = s.domain();
     let foot = |u: f64| {
-        edge_v(blade, side, wall, u).map(|v| {
+        // Option on purpose: the bisection asks where the edge exists.
+        edge_v(blade, side, wall, u).ok().map(|v| {
             let p = s.point(u, v);
             (
                 wall.meridional()
@@ -250,16 +283,32 @@ impl Channel {
     /// The channel's angular extent where it meets `wall` at contour parameter `t` (the floor
     /// between the blades on the hub, or the opening on the shroud); `None` where a bounding
     /// side does not reach `t`.
-    pub fn section(&self, wall: &RevolvedSurface, t: f64) -> Option<ChannelSection> {
-        let left = edge_angle_at(&self.left, self.left_side(), wall, t)?;
+    ///
+    /// # Errors
+    /// [`ModelError::SectionOutOfReach`] (with `wall: None`) naming the bounding blade (left or
+    /// right) whose side does not reach `t`. A splitter that does not reach `t` is no error
+    /// (`splitter` is `None` then).
+    pub fn section(&self, wall: &RevolvedSurface, t: f64) -> Result<ChannelSection, ModelError> {
+        let miss = |bound: &'static str, side: Side| ModelError::SectionOutOfReach {
+            channel: self.index,
+            bound,
+            side,
+            wall: None,
+            t,
+        };
+        let left = edge_angle_at(&self.left, self.left_side(), wall, t)
+            .ok_or_else(|| miss("left", self.left_side()))?;
         let after = |phi: f64| left + (phi - left).rem_euclid(std::f64::consts::TAU);
-        let right = after(edge_angle_at(&self.right, self.right_side(), wall, t)?);
+        let right = after(
+            edge_angle_at(&self.right, self.right_side(), wall, t)
+                .ok_or_else(|| miss("right", self.right_side()))?,
+        );
         let splitter = self.splitter.as_ref().and_then(|s| {
             let a = edge_angle_at(s, s.plus_theta_side().other(), wall, t)?;
             let b = edge_angle_at(s, s.plus_theta_side(), wall, t)?;
             Some((after(a), after(b)))
         });
-        Some(ChannelSection {
+        Ok(ChannelSection {
             left,
             right,
             splitter,
@@ -293,22 +342,40 @@ impl Impeller {
     /// Side parameters (v_hub, v_shroud) of the isocurves that enclose the part of `side`
     /// between hub and shroud: the smallest v of its hub edge and the largest v of its shroud
     /// edge over 41 values of u. For imported blades (no design data) this is the v range a
-    /// ruled approximation ([`crate::ruled`]) should span. `None` if an edge misses its wall.
-    pub fn span_v_range(&self, blade: &Blade, side: Side) -> Option<(f64, f64)> {
+    /// ruled approximation ([`crate::ruled`]) should span.
+    ///
+    /// # Errors
+    /// [`ModelError::EdgeMissesWall`] (naming hub or shroud and the u) if an edge misses its
+    /// wall at one of the 41 values of u; [`ModelError::SpanInverted`] if the hub edge does not
+    /// lie below the shroud edge.
+    pub fn span_v_range(&self, blade: &Blade, side: Side) -> Result<(f64, f64), ModelError> {
         let ((u0, u1), _) = blade.side(side).domain();
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
         for i in 0..=40 {
             let u = u0 + (u1 - u0) * i as f64 / 40.0;
-            lo = lo.min(edge_v(blade, side, self.hub(), u)?);
-            hi = hi.max(edge_v(blade, side, self.shroud(), u)?);
+            lo = lo.min(edge_v(blade, side, self.hub(), u).map_err(|e| e.on_wall(Wall::Hub))?);
+            hi =
+                hi.max(edge_v(blade, side, self.shroud(), u).map_err(|e| e.on_wall(Wall::Shroud))?);
         }
-        (lo < hi).then_some((lo, hi))
+        if lo < hi {
+            Ok((lo, hi))
+        } else {
+            Err(ModelError::SpanInverted {
+                side,
+                v_hub: lo,
+                v_shroud: hi,
+            })
+        }
     }
 
     /// Smallest distance between facing blade sides along `wall` (mm); every channel is the
-    /// same by N-fold symmetry, so channel 0 is measured. `None` if an edge misses the wall.
-    pub fn min_channel_width(&self, wall: Wall) -> Option<f64> {
+    /// same by N-fold symmetry, so channel 0 is measured.
+    ///
+    /// # Errors
+    /// [`ModelError::EdgeEmpty`] (naming the side and `wall`) if a facing side's edge misses
+    /// the wall entirely.
+    pub fn min_channel_width(&self, wall: Wall) -> Result<f64, ModelError> {
         let w = wall_of(self, wall);
         let c = self.channel(0);
         let mut pairs: Vec<(&Blade, Side, &Blade, Side)> =
@@ -317,11 +384,24 @@ impl Impeller {
             pairs.push((&c.left, c.left_side(), s, s.plus_theta_side().other()));
             pairs.push((s, s.plus_theta_side(), &c.right, c.right_side()));
         }
-        let widths: Vec<Option<f64>> = {
+        let widths: Vec<Result<f64, ModelError>> = {
             use rayon::prelude::*;
             pairs
                 .par_iter()
-                .map(|&(a, sa, b, sb)| min_edge_distance(a, sa, b, sb, w).map(|x| x.0))
+                .map(|&(a, sa, b, sb)| {
+                    if let Some((d, _, _)) = min_edge_distance(a, sa, b, sb, w) {
+                        return Ok(d);
+                    }
+                    // Name the side whose edge misses (min_edge_distance only says "none").
+                    for (bl, s) in [(a, sa), (b, sb)] {
+                        edge_curve(bl, s, w, 121).map_err(|e| e.on_wall(wall))?;
+                    }
+                    Err(ModelError::Geometry(format!(
+                        "channel width on the {}: the refined closest edge points of the {sa:?} \
+                         and {sb:?} sides left the edges",
+                        if wall == Wall::Hub { "hub" } else { "shroud" }
+                    )))
+                })
                 .collect()
         };
         widths

@@ -20,13 +20,14 @@ pub fn averaged_knots(params: &[f64], degree: usize) -> Result<KnotVector, Model
             "interpolation needs more than {degree} samples, got {n}"
         )));
     }
+    // One home for the averaging: the `nurbs` crate's (eq. 9.8, clamped to [0, 1]); its
+    // interior knots are the same sums in the same order, so only the clamped ends change to
+    // this parameter range's ends.
     let (a, b) = (params[0], params[n - 1]);
-    let mut knots = vec![a; degree + 1];
-    for j in 1..n - degree {
-        let s: f64 = params[j..j + degree].iter().sum();
-        knots.push(s / degree as f64);
-    }
-    knots.extend(std::iter::repeat_n(b, degree + 1));
+    let mut knots = nurbs::fit::averaged_knots(params, degree, false);
+    let m = knots.len();
+    knots[..=degree].fill(a);
+    knots[m - degree - 1..].fill(b);
     Ok(KnotVector::new(degree, knots)?)
 }
 
@@ -104,37 +105,31 @@ pub fn interpolate_surface(
     pu: usize,
     pv: usize,
 ) -> Result<NurbsSurface, ModelError> {
-    let iu = Interpolator::new(u, pu)?;
-    let iv = Interpolator::new(v, pv)?;
-    let nu = u.len();
-    let nv = v.len();
-    if grid.len() != nu || grid.iter().any(|r| r.len() != nv) {
+    for params in [u, v] {
+        for w in params.windows(2) {
+            if w[1] <= w[0] || !w[0].is_finite() || !w[1].is_finite() {
+                return Err(ModelError::Geometry(
+                    "interpolation parameters must increase strictly".into(),
+                ));
+            }
+        }
+    }
+    for (params, degree) in [(u, pu), (v, pv)] {
+        if params.len() <= degree {
+            return Err(ModelError::Geometry(format!(
+                "interpolation needs more than {degree} samples, got {}",
+                params.len()
+            )));
+        }
+    }
+    if grid.len() != u.len() || grid.iter().any(|r| r.len() != v.len()) {
         return Err(ModelError::Geometry(
             "interpolation grid size mismatch".into(),
         ));
     }
-    // Along u for each column j.
-    let mut r = vec![vec![Vector3::zeros(); nv]; nu];
-    for j in 0..nv {
-        let col: Vec<Vector3<f64>> = (0..nu).map(|i| grid[i][j]).collect();
-        let c = iu.solve(&col)?;
-        for i in 0..nu {
-            r[i][j] = c[i];
-        }
-    }
-    // Along v for each row i.
-    let mut ctrl = Vec::with_capacity(nu);
-    for row in &r {
-        ctrl.push(iv.solve(row)?);
-    }
-    Ok(NurbsSurface::new(
-        pu,
-        pv,
-        iu.knots().knots().to_vec(),
-        iv.knots().knots().to_vec(),
-        ctrl,
-        None,
-    )?)
+    // One home for the algorithm: the `nurbs` crate's A9.4 at given parameters.
+    nurbs::fit::interpolate_surface_at(grid, u, v, pu, pv)
+        .map_err(|e| ModelError::Geometry(format!("surface interpolation: {e}")))
 }
 
 /// The ruled surface S(u, v) = (1 − v) A(u) + v B(u) between two curves interpolated through
@@ -163,6 +158,39 @@ pub fn ruled_through(
 mod tests {
     use super::*;
 
+    /// The averaging this module carried before it called `nurbs` (issue 15): the knots must
+    /// stay identical (within 1e-12) on any parameter range.
+    fn averaged_knots_before(params: &[f64], degree: usize) -> Vec<f64> {
+        let n = params.len();
+        let (a, b) = (params[0], params[n - 1]);
+        let mut knots = vec![a; degree + 1];
+        for j in 1..n - degree {
+            let s: f64 = params[j..j + degree].iter().sum();
+            knots.push(s / degree as f64);
+        }
+        knots.extend(std::iter::repeat_n(b, degree + 1));
+        knots
+    }
+
+    #[test]
+    fn averaged_knots_match_the_former_implementation() {
+        for (lo, hi) in [(0.0, 1.0), (-3.5, 17.25), (2.0, 2.001)] {
+            for n in [2usize, 5, 12, 40] {
+                let params: Vec<f64> = (0..n)
+                    .map(|i| lo + (hi - lo) * (i as f64 / (n - 1) as f64).powf(1.3))
+                    .collect();
+                for degree in 1..n.min(6) {
+                    let new = averaged_knots(&params, degree).unwrap();
+                    let old = averaged_knots_before(&params, degree);
+                    assert_eq!(new.knots().len(), old.len());
+                    for (x, y) in new.knots().iter().zip(&old) {
+                        assert!((x - y).abs() <= 1e-12, "{x} vs {y} (n {n}, p {degree})");
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn interpolant_passes_through_samples_and_reproduces_cubics() {
         let u: Vec<f64> = (0..12).map(|i| (i as f64 / 11.0).powf(1.3)).collect();
@@ -176,6 +204,61 @@ mod tests {
         for k in 0..50 {
             let t = k as f64 / 49.0;
             assert!((c.point(t) - f(t)).norm() < 1e-10);
+        }
+    }
+
+    /// The tensor-product interpolation this module carried before it called `nurbs` (issue
+    /// 15): LU-factored collocation along u, then along v.
+    fn interpolate_surface_before(
+        grid: &[Vec<Vector3<f64>>],
+        u: &[f64],
+        v: &[f64],
+        pu: usize,
+        pv: usize,
+    ) -> Vec<Vec<Vector3<f64>>> {
+        let iu = Interpolator::new(u, pu).unwrap();
+        let iv = Interpolator::new(v, pv).unwrap();
+        let mut r = vec![vec![Vector3::zeros(); v.len()]; u.len()];
+        for j in 0..v.len() {
+            let col: Vec<Vector3<f64>> = grid.iter().map(|row| row[j]).collect();
+            for (i, c) in iu.solve(&col).unwrap().into_iter().enumerate() {
+                r[i][j] = c;
+            }
+        }
+        r.iter().map(|row| iv.solve(row).unwrap()).collect()
+    }
+
+    #[test]
+    fn surface_interpolation_matches_the_former_implementation() {
+        // Blade-like sizes: 100 mm, 41 × 9 samples at non-uniform parameters, shifted range.
+        let u: Vec<f64> = (0..41).map(|i| 0.2 + (i as f64 / 40.0).powf(1.2)).collect();
+        let v: Vec<f64> = (0..9)
+            .map(|j| -1.0 + 2.5 * (j as f64 / 8.0).powf(0.9))
+            .collect();
+        let grid: Vec<Vec<Vector3<f64>>> = u
+            .iter()
+            .map(|&a| {
+                v.iter()
+                    .map(|&b| {
+                        let (r, t) = (40.0 + 60.0 * a, 0.8 * a + 0.1 * b * b);
+                        Vector3::new(r * t.cos(), r * t.sin(), 25.0 * b + 10.0 * (2.0 * a).sin())
+                    })
+                    .collect()
+            })
+            .collect();
+        for (pu, pv) in [(3, 3), (3, 1), (2, 3)] {
+            let new = interpolate_surface(&grid, &u, &v, pu, pv).unwrap();
+            let old = interpolate_surface_before(&grid, &u, &v, pu, pv);
+            let mut worst = 0.0f64;
+            for (i, row) in old.iter().enumerate() {
+                for (j, p) in row.iter().enumerate() {
+                    worst = worst.max((new.control_point(i, j) - p).norm());
+                }
+            }
+            assert!(
+                worst <= 1e-12,
+                "control points differ by {worst:e} mm ({pu}, {pv})"
+            );
         }
     }
 

@@ -85,7 +85,8 @@ impl Impeller {
                 let u = ua + (ub - ua) * i as f64 / (nu - 1) as f64;
                 let vh = edge_v(blade, side, self.hub(), u);
                 let vs = edge_v(blade, side, self.shroud(), u);
-                let (Some(vh), Some(vs)) = (vh, vs) else {
+                // No span at this u (beyond a wall's end) is normal: nothing to measure.
+                let (Ok(vh), Ok(vs)) = (vh, vs) else {
                     return f64::INFINITY;
                 };
                 (0..9)
@@ -110,7 +111,8 @@ impl Impeller {
                 (0..nu)
                     .map(|i| {
                         let u = u0 + (u1 - u0) * i as f64 / (nu - 1) as f64;
-                        let (Some(vh), Some(vs)) = (
+                        // No span at this u (beyond a wall's end): nothing to measure.
+                        let (Ok(vh), Ok(vs)) = (
                             edge_v(blade, side, self.hub(), u),
                             edge_v(blade, side, self.shroud(), u),
                         ) else {

@@ -2,14 +2,16 @@
 //! fixture impellers against a dense brute force followed by a local polish: cold and warm
 //! (hint = a random parameter pair, or the answer of a nearby query) answers are never
 //! farther than the brute force by more than 1e-9 mm (the brute force is an upper bound of
-//! the true minimum). Cases: `PROPTEST_CASES` (default 256).
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+//! the true minimum). Cases: max(`PROPTEST_CASES` or 256, 256), so
+//! at least 256 even under `cargo xtask ci` (which sets 64 when unset).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use impeller_model::query::blade_side_distance;
 use impeller_model::{load, Impeller, Side};
 use nalgebra::Vector3;
 use nurbs::NurbsSurface;
 use proptest::prelude::*;
+use proptest::test_runner::{TestCaseError, TestRunner};
 use std::sync::OnceLock;
 
 const FIXTURES: [&str; 2] = ["impeller-8+8", "impeller-5-freeform"];
@@ -25,11 +27,40 @@ fn fixtures() -> &'static Vec<Impeller> {
     })
 }
 
+/// Number of cases: max(`PROPTEST_CASES` or 256, 256). `cargo xtask ci` sets
+/// `PROPTEST_CASES=64` when unset; this property keeps its 256 cases there, while a larger
+/// value (a nightly run with `PROPTEST_CASES=10000`) raises it.
 fn cases() -> u32 {
     std::env::var("PROPTEST_CASES")
         .ok()
         .and_then(|c| c.parse().ok())
         .unwrap_or(256)
+        .max(256)
+}
+
+/// The proptest configuration of test `name`: [`cases`] cases, the other settings from
+/// proptest's defaults and environment. The properties run on a [`TestRunner`] rather than in
+/// `proptest!`, because that macro lets `PROPTEST_CASES` replace the configured count (which
+/// would undo the floor of 256 under `cargo xtask ci`).
+fn config(name: &'static str) -> ProptestConfig {
+    ProptestConfig {
+        cases: cases(),
+        source_file: Some(file!()),
+        test_name: Some(name),
+        ..ProptestConfig::default()
+    }
+}
+
+/// Runs `test` on `strategy` with [`config`]; panics with the minimal failing input.
+fn run<S: Strategy>(
+    name: &'static str,
+    strategy: S,
+    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
+) {
+    let mut runner = TestRunner::new(config(name));
+    if let Err(e) = runner.run(&strategy, test) {
+        panic!("{name}: {e}");
+    }
 }
 
 /// Bound-constrained Newton polish of |S − q|² from `(u, v)` (backtracking, 60 steps).
@@ -96,40 +127,61 @@ fn brute(s: &NurbsSurface, q: &Vector3<f64>) -> f64 {
     best
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig::with_cases(cases()))]
-
-    /// Points within 3 mm of either side of a main blade (both sides of the side surface,
-    /// through the blade and beyond its edges), cold and warm.
-    #[test]
-    fn blade_side_distance_is_the_global_minimum(
-        k in 0usize..FIXTURES.len(), suction in any::<bool>(),
-        u in -0.05f64..1.05, v in -0.05f64..1.05, h in -3.0f64..3.0,
-        hu in 0.0f64..=1.0, hv in 0.0f64..=1.0,
-    ) {
-        let blade = fixtures()[k].main().blade();
-        let side = if suction { Side::Suction } else { Side::Pressure };
-        let s = blade.side(side);
-        let ((u0, u1), (v0, v1)) = s.domain();
-        let (uc, vc) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
-        let (pu, pv) = (u0 + uc * (u1 - u0), v0 + vc * (v1 - v0));
-        let n = blade.outward_normal(side, pu, pv).unwrap_or(Vector3::z());
-        // Beyond the domain in u or v: push the point out along the surface too.
-        let d = s.derivs2(pu, pv);
-        let q = d.p + n * h + d.su * ((u - uc) * (u1 - u0)) + d.sv * ((v - vc) * (v1 - v0));
-        let truth = brute(s, &q);
-        let (cold, sd) = blade_side_distance(blade, side, &q, None);
-        prop_assert!(cold.distance <= truth + 1e-9, "cold {} > brute {} (excess {:.3e})",
-            cold.distance, truth, cold.distance - truth);
-        prop_assert!((sd.abs() - cold.distance).abs() <= 1e-12);
-        prop_assert!(((s.point(cold.u, cold.v) - q).norm() - cold.distance).abs() <= 1e-9);
-        let hint = (u0 + hu * (u1 - u0), v0 + hv * (v1 - v0));
-        let (warm, _) = blade_side_distance(blade, side, &q, Some(hint));
-        prop_assert!(warm.distance <= truth + 1e-9, "warm {} > brute {}", warm.distance, truth);
-        // A nearby query warm-started from this answer.
-        let q2 = q + n * 0.05;
-        let (next, _) = blade_side_distance(blade, side, &q2, Some((cold.u, cold.v)));
-        let (next_cold, _) = blade_side_distance(blade, side, &q2, None);
-        prop_assert!((next.distance - next_cold.distance).abs() <= 1e-9);
-    }
+/// Points within 3 mm of either side of a main blade (both sides of the side surface,
+/// through the blade and beyond its edges), cold and warm.
+#[test]
+fn blade_side_distance_is_the_global_minimum() {
+    run(
+        "blade_side_distance_is_the_global_minimum",
+        (
+            0usize..FIXTURES.len(),
+            any::<bool>(),
+            -0.05f64..1.05,
+            -0.05f64..1.05,
+            -3.0f64..3.0,
+            0.0f64..=1.0,
+            0.0f64..=1.0,
+        ),
+        |(k, suction, u, v, h, hu, hv)| {
+            let blade = fixtures()[k].main().blade();
+            let side = if suction {
+                Side::Suction
+            } else {
+                Side::Pressure
+            };
+            let s = blade.side(side);
+            let ((u0, u1), (v0, v1)) = s.domain();
+            let (uc, vc) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
+            let (pu, pv) = (u0 + uc * (u1 - u0), v0 + vc * (v1 - v0));
+            let n = blade.outward_normal(side, pu, pv).unwrap_or(Vector3::z());
+            // Beyond the domain in u or v: push the point out along the surface too.
+            let d = s.derivs2(pu, pv);
+            let q = d.p + n * h + d.su * ((u - uc) * (u1 - u0)) + d.sv * ((v - vc) * (v1 - v0));
+            let truth = brute(s, &q);
+            let (cold, sd) = blade_side_distance(blade, side, &q, None);
+            prop_assert!(
+                cold.distance <= truth + 1e-9,
+                "cold {} > brute {} (excess {:.3e})",
+                cold.distance,
+                truth,
+                cold.distance - truth
+            );
+            prop_assert!((sd.abs() - cold.distance).abs() <= 1e-12);
+            prop_assert!(((s.point(cold.u, cold.v) - q).norm() - cold.distance).abs() <= 1e-9);
+            let hint = (u0 + hu * (u1 - u0), v0 + hv * (v1 - v0));
+            let (warm, _) = blade_side_distance(blade, side, &q, Some(hint));
+            prop_assert!(
+                warm.distance <= truth + 1e-9,
+                "warm {} > brute {}",
+                warm.distance,
+                truth
+            );
+            // A nearby query warm-started from this answer.
+            let q2 = q + n * 0.05;
+            let (next, _) = blade_side_distance(blade, side, &q2, Some((cold.u, cold.v)));
+            let (next_cold, _) = blade_side_distance(blade, side, &q2, None);
+            prop_assert!((next.distance - next_cold.distance).abs() <= 1e-9);
+            Ok(())
+        },
+    );
 }

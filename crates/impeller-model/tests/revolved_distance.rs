@@ -3,13 +3,15 @@
 //! random query points around the contour, any polar angle. The answer is never farther
 //! than the brute force by more than 1e-9 mm (the brute force is an upper bound of the true
 //! minimum), the returned point is on the surface at the returned distance, and the answer
-//! is certified. Cases: `PROPTEST_CASES` (default 256).
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+//! is certified. Cases: max(`PROPTEST_CASES` or 256, 256), so
+//! at least 256 even under `cargo xtask ci` (which sets 64 when unset).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use impeller_model::{load, Impeller, MeridionalCurve, RevolvedSurface};
 use nalgebra::{Vector2, Vector3};
 use nurbs::closest::PointQuery;
 use proptest::prelude::*;
+use proptest::test_runner::{TestCaseError, TestRunner};
 use std::sync::OnceLock;
 
 const FIXTURES: [&str; 5] = [
@@ -67,11 +69,40 @@ fn brute(m: &MeridionalCurve, q: &Vector2<f64>) -> (f64, f64) {
     }
 }
 
+/// Number of cases: max(`PROPTEST_CASES` or 256, 256). `cargo xtask ci` sets
+/// `PROPTEST_CASES=64` when unset; this property keeps its 256 cases there, while a larger
+/// value (a nightly run with `PROPTEST_CASES=10000`) raises it.
 fn cases() -> u32 {
     std::env::var("PROPTEST_CASES")
         .ok()
         .and_then(|c| c.parse().ok())
         .unwrap_or(256)
+        .max(256)
+}
+
+/// The proptest configuration of test `name`: [`cases`] cases, the other settings from
+/// proptest's defaults and environment. The properties run on a [`TestRunner`] rather than in
+/// `proptest!`, because that macro lets `PROPTEST_CASES` replace the configured count (which
+/// would undo the floor of 256 under `cargo xtask ci`).
+fn config(name: &'static str) -> ProptestConfig {
+    ProptestConfig {
+        cases: cases(),
+        source_file: Some(file!()),
+        test_name: Some(name),
+        ..ProptestConfig::default()
+    }
+}
+
+/// Runs `test` on `strategy` with [`config`]; panics with the minimal failing input.
+fn run<S: Strategy>(
+    name: &'static str,
+    strategy: S,
+    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
+) {
+    let mut runner = TestRunner::new(config(name));
+    if let Err(e) = runner.run(&strategy, test) {
+        panic!("{name}: {e}");
+    }
 }
 
 fn surface(k: usize, shroud: bool) -> &'static RevolvedSurface {
@@ -83,50 +114,82 @@ fn surface(k: usize, shroud: bool) -> &'static RevolvedSurface {
     }
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig::with_cases(cases()))]
+/// Random points in the box of the contour widened by 40 % (and down to the axis).
+#[test]
+fn hub_and_shroud_distance_is_the_global_minimum() {
+    run(
+        "hub_and_shroud_distance_is_the_global_minimum",
+        (
+            0usize..FIXTURES.len(),
+            any::<bool>(),
+            0.0f64..=1.0,
+            0.0f64..=1.0,
+            -4.0f64..4.0,
+        ),
+        |(k, shroud, a, b, phi)| {
+            let s = surface(k, shroud);
+            let m = s.meridional();
+            let (mut lo, mut hi) = (
+                Vector2::repeat(f64::INFINITY),
+                Vector2::repeat(f64::NEG_INFINITY),
+            );
+            for i in 0..=64 {
+                let (t0, t1) = m.domain();
+                let p = m.point(t0 + (t1 - t0) * i as f64 / 64.0);
+                lo = lo.inf(&p);
+                hi = hi.sup(&p);
+            }
+            let pad = (hi - lo) * 0.4;
+            let z = lo.x - pad.x + a * (hi.x - lo.x + 2.0 * pad.x);
+            let r = ((lo.y - pad.y).max(0.0)) + b * (hi.y + pad.y - (lo.y - pad.y).max(0.0));
+            let p = Vector3::new(r * phi.cos(), r * phi.sin(), z);
+            let d = s.signed_distance(&p);
+            let (truth, _) = brute(m, &MeridionalCurve::zr_of(&p));
+            prop_assert!(
+                d.abs() <= truth + 1e-9,
+                "{} > brute {} (excess {:.3e})",
+                d.abs(),
+                truth,
+                d.abs() - truth
+            );
+            prop_assert!(
+                d.abs() >= truth - 1e-6,
+                "{} far below brute {}",
+                d.abs(),
+                truth
+            );
+            let a = s.query(&p, None);
+            prop_assert!(a.certified);
+            prop_assert!((a.signed_distance - d).abs() <= 1e-12);
+            prop_assert!(((a.point - p).norm() - d.abs()).abs() <= 1e-9);
+            let (t, _, _) = s.closest(&p);
+            prop_assert!((s.point(t, phi) - a.point).norm() <= 1e-9);
+            Ok(())
+        },
+    );
+}
 
-    /// Random points in the box of the contour widened by 40 % (and down to the axis).
-    #[test]
-    fn hub_and_shroud_distance_is_the_global_minimum(
-        k in 0usize..FIXTURES.len(), shroud in any::<bool>(),
-        a in 0.0f64..=1.0, b in 0.0f64..=1.0, phi in -4.0f64..4.0,
-    ) {
-        let s = surface(k, shroud);
-        let m = s.meridional();
-        let (mut lo, mut hi) = (Vector2::repeat(f64::INFINITY), Vector2::repeat(f64::NEG_INFINITY));
-        for i in 0..=64 {
-            let (t0, t1) = m.domain();
-            let p = m.point(t0 + (t1 - t0) * i as f64 / 64.0);
-            lo = lo.inf(&p);
-            hi = hi.sup(&p);
-        }
-        let pad = (hi - lo) * 0.4;
-        let z = lo.x - pad.x + a * (hi.x - lo.x + 2.0 * pad.x);
-        let r = ((lo.y - pad.y).max(0.0)) + b * (hi.y + pad.y - (lo.y - pad.y).max(0.0));
-        let p = Vector3::new(r * phi.cos(), r * phi.sin(), z);
-        let d = s.signed_distance(&p);
-        let (truth, _) = brute(m, &MeridionalCurve::zr_of(&p));
-        prop_assert!(d.abs() <= truth + 1e-9, "{} > brute {} (excess {:.3e})", d.abs(), truth, d.abs() - truth);
-        prop_assert!(d.abs() >= truth - 1e-6, "{} far below brute {}", d.abs(), truth);
-        let a = s.query(&p, None);
-        prop_assert!(a.certified);
-        prop_assert!((a.signed_distance - d).abs() <= 1e-12);
-        prop_assert!(((a.point - p).norm() - d.abs()).abs() <= 1e-9);
-        let (t, _, _) = s.closest(&p);
-        prop_assert!((s.point(t, phi) - a.point).norm() <= 1e-9);
-    }
-
-    /// Points offset along the channel-side normal by less than the contour's radius of
-    /// curvature: the signed distance is the offset (sign convention of the existing API).
-    #[test]
-    fn offsets_along_the_normal(k in 0usize..FIXTURES.len(), shroud in any::<bool>(),
-                                f in 0.05f64..0.95, h in -0.5f64..0.5, phi in -4.0f64..4.0) {
-        let s = surface(k, shroud);
-        let (t0, t1) = s.meridional().domain();
-        let t = t0 + f * (t1 - t0);
-        let p = s.point(t, phi) + s.normal(t, phi) * h;
-        let d = s.signed_distance(&p);
-        prop_assert!((d - h).abs() <= 1e-9, "{d} vs offset {h}");
-    }
+/// Points offset along the channel-side normal by less than the contour's radius of
+/// curvature: the signed distance is the offset (sign convention of the existing API).
+#[test]
+fn offsets_along_the_normal() {
+    run(
+        "offsets_along_the_normal",
+        (
+            0usize..FIXTURES.len(),
+            any::<bool>(),
+            0.05f64..0.95,
+            -0.5f64..0.5,
+            -4.0f64..4.0,
+        ),
+        |(k, shroud, f, h, phi)| {
+            let s = surface(k, shroud);
+            let (t0, t1) = s.meridional().domain();
+            let t = t0 + f * (t1 - t0);
+            let p = s.point(t, phi) + s.normal(t, phi) * h;
+            let d = s.signed_distance(&p);
+            prop_assert!((d - h).abs() <= 1e-9, "{d} vs offset {h}");
+            Ok(())
+        },
+    );
 }

@@ -1,13 +1,15 @@
 //! The certified curve search against a dense brute force followed by a local polish, on
 //! random rational and polynomial curves (circular arcs, random positive weights) and queries
 //! on both sides, near and far (beyond centres of curvature): the answer is never farther
-//! than the true minimum by more than 1e-9 mm, and it is certified.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+//! than the true minimum by more than 1e-9 mm, and it is certified. Cases: max(`PROPTEST_CASES`
+//! or 256, 256), so at least 256 even under `cargo xtask ci` (which sets 64 when unset).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use nalgebra::Vector2;
 use nurbs::closest::CurveProjector;
 use nurbs::{KnotVector, NurbsCurve};
 use proptest::prelude::*;
+use proptest::test_runner::{TestCaseError, TestRunner};
 
 /// Dense sample, then golden-section polish around the best sample (an upper bound of the
 /// true minimum, within round-off of it for samples finer than the curve's features).
@@ -77,6 +79,7 @@ fn quarter(rx: f64, ry: f64) -> NurbsCurve<2> {
     .unwrap()
 }
 
+/// Number of cases: max(`PROPTEST_CASES` or 256, 256) (see the module docs).
 fn cases() -> u32 {
     std::env::var("PROPTEST_CASES")
         .ok()
@@ -85,31 +88,83 @@ fn cases() -> u32 {
         .max(256)
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig::with_cases(cases()))]
-
-    #[test]
-    fn random_curves(seed in 0u64..1_000_000, p in 1usize..=4, n in 5usize..=9,
-                     rational in any::<bool>(), x in -20.0f64..110.0, y in -60.0f64..60.0) {
-        let c = random_curve(seed, p, n, rational);
-        let q = Vector2::new(x, y);
-        let r = CurveProjector::new(&c).closest_point(&q);
-        let t = brute(&c, &q);
-        prop_assert!(r.distance <= t + 1e-9, "{} > {} (excess {:.3e})", r.distance, t, r.distance - t);
-        prop_assert!(r.certified);
-        prop_assert!(((c.point(r.u) - q).norm() - r.distance).abs() < 1e-9);
+/// The proptest configuration of test `name`: [`cases`] cases, the other settings from
+/// proptest's defaults and environment. The properties run on a [`TestRunner`] rather than in
+/// `proptest!`, because that macro lets `PROPTEST_CASES` replace the configured count (which
+/// would undo the floor of 256 under `cargo xtask ci`).
+fn config(name: &'static str) -> ProptestConfig {
+    ProptestConfig {
+        cases: cases(),
+        source_file: Some(file!()),
+        test_name: Some(name),
+        ..ProptestConfig::default()
     }
+}
 
-    #[test]
-    fn conics_from_any_side(rx in 5.0f64..60.0, ry in 5.0f64..60.0, x in -80.0f64..80.0, y in -80.0f64..80.0,
-                            hint in proptest::option::of(0.0f64..=1.0)) {
-        let c = quarter(rx, ry);
-        let q = Vector2::new(x, y);
-        let r = CurveProjector::new(&c).closest_point_with_hint(&q, hint);
-        let t = brute(&c, &q);
-        prop_assert!(r.distance <= t + 1e-9, "{} > {}", r.distance, t);
-        prop_assert!(r.certified);
+/// Runs `test` on `strategy` with [`config`]; panics with the minimal failing input.
+fn run<S: Strategy>(
+    name: &'static str,
+    strategy: S,
+    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
+) {
+    let mut runner = TestRunner::new(config(name));
+    if let Err(e) = runner.run(&strategy, test) {
+        panic!("{name}: {e}");
     }
+}
+
+#[test]
+fn random_curves() {
+    run(
+        "random_curves",
+        (
+            0u64..1_000_000,
+            1usize..=4,
+            5usize..=9,
+            any::<bool>(),
+            -20.0f64..110.0,
+            -60.0f64..60.0,
+        ),
+        |(seed, p, n, rational, x, y)| {
+            let c = random_curve(seed, p, n, rational);
+            let q = Vector2::new(x, y);
+            let r = CurveProjector::new(&c).closest_point(&q);
+            let t = brute(&c, &q);
+            prop_assert!(
+                r.distance <= t + 1e-9,
+                "{} > {} (excess {:.3e})",
+                r.distance,
+                t,
+                r.distance - t
+            );
+            prop_assert!(r.certified);
+            prop_assert!(((c.point(r.u) - q).norm() - r.distance).abs() < 1e-9);
+            Ok(())
+        },
+    );
+}
+
+#[test]
+fn conics_from_any_side() {
+    run(
+        "conics_from_any_side",
+        (
+            5.0f64..60.0,
+            5.0f64..60.0,
+            -80.0f64..80.0,
+            -80.0f64..80.0,
+            proptest::option::of(0.0f64..=1.0),
+        ),
+        |(rx, ry, x, y, hint)| {
+            let c = quarter(rx, ry);
+            let q = Vector2::new(x, y);
+            let r = CurveProjector::new(&c).closest_point_with_hint(&q, hint);
+            let t = brute(&c, &q);
+            prop_assert!(r.distance <= t + 1e-9, "{} > {}", r.distance, t);
+            prop_assert!(r.certified);
+            Ok(())
+        },
+    );
 }
 
 /// The centre of a circular arc is equidistant from all of it: any point is an answer, at

@@ -3,19 +3,50 @@
 //! dense brute force followed by a local polish: the answer (cold, and warm from a random
 //! hint) is never farther than the brute force by more than 1e-9 mm (the brute force is an
 //! upper bound of the true minimum), lies on the surface at the reported distance, and is
-//! flagged certified. Cases: `PROPTEST_CASES` (default 256).
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+//! flagged certified. Cases: max(`PROPTEST_CASES` or 256, 256), so
+//! at least 256 even under `cargo xtask ci` (which sets 64 when unset).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use nalgebra::Vector3;
 use nurbs::closest::{PointQuery, SurfaceProjector};
 use nurbs::{KnotVector, NurbsCurve, NurbsSurface};
 use proptest::prelude::*;
+use proptest::test_runner::{TestCaseError, TestRunner};
 
+/// Number of cases: max(`PROPTEST_CASES` or 256, 256). `cargo xtask ci` sets
+/// `PROPTEST_CASES=64` when unset; this property keeps its 256 cases there, while a larger
+/// value (a nightly run with `PROPTEST_CASES=10000`) raises it.
 fn cases() -> u32 {
     std::env::var("PROPTEST_CASES")
         .ok()
         .and_then(|c| c.parse().ok())
         .unwrap_or(256)
+        .max(256)
+}
+
+/// The proptest configuration of test `name`: [`cases`] cases, the other settings from
+/// proptest's defaults and environment. The properties run on a [`TestRunner`] rather than in
+/// `proptest!`, because that macro lets `PROPTEST_CASES` replace the configured count (which
+/// would undo the floor of 256 under `cargo xtask ci`).
+fn config(name: &'static str) -> ProptestConfig {
+    ProptestConfig {
+        cases: cases(),
+        source_file: Some(file!()),
+        test_name: Some(name),
+        ..ProptestConfig::default()
+    }
+}
+
+/// Runs `test` on `strategy` with [`config`]; panics with the minimal failing input.
+fn run<S: Strategy>(
+    name: &'static str,
+    strategy: S,
+    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
+) {
+    let mut runner = TestRunner::new(config(name));
+    if let Err(e) = runner.run(&strategy, test) {
+        panic!("{name}: {e}");
+    }
 }
 
 /// Deterministic pseudo-random numbers in [0, 1) from a seed.
@@ -155,26 +186,50 @@ fn check(s: &NurbsSurface, q: Vector3<f64>, hint: (f64, f64)) -> Result<(), Test
     Ok(())
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig::with_cases(cases()))]
+/// Surfaces of revolution (partial and full turns) and query points around them,
+/// including points near the axis (beyond every centre of curvature of the circles).
+#[test]
+fn surfaces_of_revolution() {
+    run(
+        "surfaces_of_revolution",
+        (
+            0u64..1_000_000,
+            2usize..=3,
+            4usize..=6,
+            0.5f64..=std::f64::consts::TAU,
+            -45.0f64..45.0,
+            -45.0f64..45.0,
+            -10.0f64..55.0,
+            0.0f64..=1.0,
+            0.0f64..=1.0,
+        ),
+        |(seed, p, n, angle, x, y, z, hu, hv)| {
+            let s = revolved(seed, p, n, angle);
+            check(&s, Vector3::new(x, y, z), (hu, hv))?;
+            Ok(())
+        },
+    );
+}
 
-    /// Surfaces of revolution (partial and full turns) and query points around them,
-    /// including points near the axis (beyond every centre of curvature of the circles).
-    #[test]
-    fn surfaces_of_revolution(seed in 0u64..1_000_000, p in 2usize..=3, n in 4usize..=6,
-                              angle in 0.5f64..=std::f64::consts::TAU,
-                              x in -45.0f64..45.0, y in -45.0f64..45.0, z in -10.0f64..55.0,
-                              hu in 0.0f64..=1.0, hv in 0.0f64..=1.0) {
-        let s = revolved(seed, p, n, angle);
-        check(&s, Vector3::new(x, y, z), (hu, hv))?;
-    }
-
-    /// General rational nets (degree 2–3, random positive weights), points anywhere around.
-    #[test]
-    fn random_positive_weights(seed in 0u64..1_000_000, p in 2usize..=3, n in 4usize..=6,
-                               x in -15.0f64..65.0, y in -15.0f64..65.0, z in -25.0f64..25.0,
-                               hu in 0.0f64..=1.0, hv in 0.0f64..=1.0) {
-        let s = weighted(seed, p, n);
-        check(&s, Vector3::new(x, y, z), (hu, hv))?;
-    }
+/// General rational nets (degree 2–3, random positive weights), points anywhere around.
+#[test]
+fn random_positive_weights() {
+    run(
+        "random_positive_weights",
+        (
+            0u64..1_000_000,
+            2usize..=3,
+            4usize..=6,
+            -15.0f64..65.0,
+            -15.0f64..65.0,
+            -25.0f64..25.0,
+            0.0f64..=1.0,
+            0.0f64..=1.0,
+        ),
+        |(seed, p, n, x, y, z, hu, hv)| {
+            let s = weighted(seed, p, n);
+            check(&s, Vector3::new(x, y, z), (hu, hv))?;
+            Ok(())
+        },
+    );
 }

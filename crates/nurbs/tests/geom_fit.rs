@@ -410,3 +410,51 @@ fn every_fit_error_is_reported() {
     let err = interpolate_curve(&huge, 2, Parametrisation::ChordLength, None).unwrap_err();
     assert!(matches!(err, FitError::Nurbs(_)), "{err:?}");
 }
+
+/// `interpolate_surface_at`: passes through the grid at the given parameters on any range,
+/// equals `interpolate_surface` when given that function's own (normalised) parameters, and
+/// reports bad parameters and grids.
+#[test]
+fn surface_interpolation_at_given_parameters() {
+    let u: Vec<f64> = (0..9)
+        .map(|i| 3.0 + 2.0 * (i as f64 / 8.0).powf(1.4))
+        .collect();
+    let v: Vec<f64> = (0..6).map(|j| -1.0 + 0.5 * j as f64).collect();
+    let grid: Vec<Vec<Vector3<f64>>> = u
+        .iter()
+        .map(|&a| {
+            v.iter()
+                .map(|&b| Vector3::new(10.0 * a, 20.0 * b, (a * b).sin()))
+                .collect()
+        })
+        .collect();
+    let s = fit::interpolate_surface_at(&grid, &u, &v, 3, 2).unwrap();
+    assert_eq!(s.domain(), ((3.0, 5.0), (-1.0, 1.5)));
+    for (i, &a) in u.iter().enumerate() {
+        for (j, &b) in v.iter().enumerate() {
+            assert!((s.point(a, b) - grid[i][j]).norm() < 1e-12);
+        }
+    }
+    // Same parameters as the chord-length version on [0, 1]: the same surface.
+    let auto = interpolate_surface(&grid, 3, 2, Parametrisation::Uniform).unwrap();
+    let un: Vec<f64> = (0..9).map(|i| i as f64 / 8.0).collect();
+    let vn: Vec<f64> = (0..6).map(|j| j as f64 / 5.0).collect();
+    let at = fit::interpolate_surface_at(&grid, &un, &vn, 3, 2).unwrap();
+    for (p, q) in auto.control_points().iter().zip(at.control_points()) {
+        assert!((p - q).norm() < 1e-12);
+    }
+    let mut bad = u.clone();
+    bad[4] = bad[3];
+    assert!(matches!(
+        fit::interpolate_surface_at(&grid, &bad, &v, 3, 2),
+        Err(FitError::CoincidentPoints { index: 3 })
+    ));
+    assert!(matches!(
+        fit::interpolate_surface_at(&grid[..8], &u, &v, 3, 2),
+        Err(FitError::RaggedGrid { row: 8, got: 0, .. })
+    ));
+    assert!(matches!(
+        fit::interpolate_surface_at(&grid, &u, &v, 0, 2),
+        Err(FitError::InvalidDegree { degree: 0 })
+    ));
+}

@@ -118,14 +118,19 @@ impl<'a> ChannelFrame<'a> {
             .map(|&m| {
                 // Stay a hair inside the contour ends where edge searches are bracketed.
                 let mm = m.clamp(1e-6, 1.0 - 1e-6);
-                let h = channel.section(
-                    impeller.hub(),
-                    impeller.hub().meridional().param_at_fraction(mm),
-                )?;
-                let s = channel.section(
-                    impeller.shroud(),
-                    impeller.shroud().meridional().param_at_fraction(mm),
-                )?;
+                // A station beyond a blade's end is normal here (filled in below): `.ok()`.
+                let h = channel
+                    .section(
+                        impeller.hub(),
+                        impeller.hub().meridional().param_at_fraction(mm),
+                    )
+                    .ok()?;
+                let s = channel
+                    .section(
+                        impeller.shroud(),
+                        impeller.shroud().meridional().param_at_fraction(mm),
+                    )
+                    .ok()?;
                 Some(FrameRow {
                     m,
                     hub: (h.left, h.right),

@@ -184,9 +184,13 @@ impl Operation for ChannelRoughing {
     }
 }
 
-fn side_v_range(imp: &Impeller, blade: &Blade, side: Side) -> Option<(f64, f64)> {
+fn side_v_range(
+    imp: &Impeller,
+    blade: &Blade,
+    side: Side,
+) -> Result<(f64, f64), impeller_model::ModelError> {
     match blade.design() {
-        Some(_) => Some(blade.hub_shroud_v(side)),
+        Some(_) => Ok(blade.hub_shroud_v(side)),
         None => imp.span_v_range(blade, side),
     }
 }
@@ -205,8 +209,12 @@ impl ChannelRoughing {
         radius: f64,
     ) -> Result<Bound, PlanError> {
         let imp = ctx.impeller;
-        let v = side_v_range(imp, blade, side)
-            .ok_or_else(|| self.geo(label, "blade side does not reach both hub and shroud"))?;
+        let v = side_v_range(imp, blade, side).map_err(|e| {
+            self.geo(
+                label,
+                format!("blade side does not reach both hub and shroud: {e}"),
+            )
+        })?;
         let ruled =
             ruled_approximation(blade, side, v).map_err(|e| PlanError::model(&self.name, e))?;
         // Orient the offset along the blade's outward normal (into the channel).

@@ -85,6 +85,7 @@ fn side_section(
         .map(|i| {
             let t = 0.5 * (1.0 - (std::f64::consts::PI * i as f64 / (n - 1) as f64).cos());
             let u = u0 + (u1 - u0) * t;
+            // Where the side misses a wall its own v limit stands in (see module docs).
             let vh = edge_v(blade, side, imp.hub(), u).unwrap_or(v0);
             let vs = edge_v(blade, side, imp.shroud(), u).unwrap_or(v1);
             s.point(u, vh + span * (vs - vh))

@@ -32,4 +32,4 @@ pub use error::FitError;
 pub use params::{averaged_knots, parameters, Parametrisation};
 pub use skin::skin;
 
-pub use surface_interp::interpolate_surface;
+pub use surface_interp::{interpolate_surface, interpolate_surface_at};

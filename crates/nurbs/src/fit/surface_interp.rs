@@ -160,3 +160,100 @@ pub fn interpolate_surface(
         degree_u, degree_v, knots_u, knots_v, ctrl, None,
     )?)
 }
+
+/// Global interpolation of the grid `points[k][l]` (`k` along u, `l` along v) at given
+/// parameters `u_params[k]`, `v_params[l]` (each strictly increasing, any range) by a
+/// non-rational B-spline surface of degrees `(degree_u, degree_v)` on
+/// `[u_params[0], u_params[n]] × [v_params[0], v_params[m]]`: knots by averaging (eq. 9.8,
+/// clamped to the parameter range), then A9.4 as in [`interpolate_surface`] (one factored
+/// system per direction). `S(u_params[k], v_params[l]) = points[k][l]` to round-off.
+///
+/// Errors: a degree of 0, fewer than `degree + 1` parameters in a direction, a grid whose size
+/// is not `u_params.len() × v_params.len()` ([`FitError::RaggedGrid`]), non-finite points or
+/// parameters ([`FitError::NonFinitePoint`], [`FitError::InvalidValue`]), parameters that do
+/// not increase strictly ([`FitError::CoincidentPoints`] at the first offending index).
+/// More rows than u parameters is an [`FitError::InvalidValue`].
+pub fn interpolate_surface_at(
+    points: &[Vec<Vector3<f64>>],
+    u_params: &[f64],
+    v_params: &[f64],
+    degree_u: usize,
+    degree_v: usize,
+) -> Result<NurbsSurface, FitError> {
+    let mut knots = Vec::with_capacity(2);
+    for (degree, params, what) in [
+        (degree_u, u_params, "grid rows (u)"),
+        (degree_v, v_params, "grid columns (v)"),
+    ] {
+        if degree == 0 {
+            return Err(FitError::InvalidDegree { degree });
+        }
+        if params.len() < degree + 1 {
+            return Err(FitError::TooFewPoints {
+                what,
+                needed: degree + 1,
+                got: params.len(),
+            });
+        }
+        if let Some(index) = params.iter().position(|p| !p.is_finite()) {
+            return Err(FitError::InvalidValue {
+                field: "interpolation parameter",
+                value: params[index],
+                reason: "must be finite",
+            });
+        }
+        if let Some(index) = params.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(FitError::CoincidentPoints { index });
+        }
+        let mut k = averaged_knots(params, degree, false);
+        let m = k.len();
+        k[..=degree].fill(params[0]);
+        k[m - degree - 1..].fill(params[params.len() - 1]);
+        knots.push(k);
+    }
+    let (rows, cols) = (u_params.len(), v_params.len());
+    if points.len() < rows {
+        // The first missing row has no points.
+        return Err(FitError::RaggedGrid {
+            row: points.len(),
+            expected: cols,
+            got: 0,
+        });
+    }
+    if points.len() > rows {
+        return Err(FitError::InvalidValue {
+            field: "number of grid rows",
+            value: points.len() as f64,
+            reason: "must equal the number of u parameters",
+        });
+    }
+    for (row, line) in points.iter().enumerate() {
+        if line.len() != cols {
+            return Err(FitError::RaggedGrid {
+                row,
+                expected: cols,
+                got: line.len(),
+            });
+        }
+        if let Some(l) = line.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(FitError::NonFinitePoint {
+                index: row * cols + l,
+            });
+        }
+    }
+    let knots_v = knots.pop().unwrap_or_default();
+    let knots_u = knots.pop().unwrap_or_default();
+    let kv_u = KnotVector::new(degree_u, knots_u.clone())?;
+    let kv_v = KnotVector::new(degree_v, knots_v.clone())?;
+    let u_lines: Vec<Vec<Vector3<f64>>> = (0..cols)
+        .map(|l| points.iter().map(|row| row[l]).collect())
+        .collect();
+    let r = interpolate_families(&kv_u, u_params, &u_lines)?;
+    let v_lines: Vec<Vec<Vector3<f64>>> = (0..rows)
+        .map(|i| (0..cols).map(|l| r[l][i]).collect())
+        .collect();
+    let ctrl = interpolate_families(&kv_v, v_params, &v_lines)?;
+    Ok(NurbsSurface::new(
+        degree_u, degree_v, knots_u, knots_v, ctrl, None,
+    )?)
+}
