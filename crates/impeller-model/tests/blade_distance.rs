@@ -11,8 +11,9 @@ use impeller_model::{load, Impeller, Side};
 use nalgebra::Vector3;
 use nurbs::NurbsSurface;
 use proptest::prelude::*;
-use proptest::test_runner::{TestCaseError, TestRunner};
 use std::sync::OnceLock;
+
+mod case_floor;
 
 const FIXTURES: [&str; 2] = ["impeller-8+8", "impeller-5-freeform"];
 
@@ -25,42 +26,6 @@ fn fixtures() -> &'static Vec<Impeller> {
             .map(|n| load(format!("{root}/{n}/impeller.toml")).unwrap())
             .collect()
     })
-}
-
-/// Number of cases: max(`PROPTEST_CASES` or 256, 256). `cargo xtask ci` sets
-/// `PROPTEST_CASES=64` when unset; this property keeps its 256 cases there, while a larger
-/// value (a nightly run with `PROPTEST_CASES=10000`) raises it.
-fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|c| c.parse().ok())
-        .unwrap_or(256)
-        .max(256)
-}
-
-/// The proptest configuration of test `name`: [`cases`] cases, the other settings from
-/// proptest's defaults and environment. The properties run on a [`TestRunner`] rather than in
-/// `proptest!`, because that macro lets `PROPTEST_CASES` replace the configured count (which
-/// would undo the floor of 256 under `cargo xtask ci`).
-fn config(name: &'static str) -> ProptestConfig {
-    ProptestConfig {
-        cases: cases(),
-        source_file: Some(file!()),
-        test_name: Some(name),
-        ..ProptestConfig::default()
-    }
-}
-
-/// Runs `test` on `strategy` with [`config`]; panics with the minimal failing input.
-fn run<S: Strategy>(
-    name: &'static str,
-    strategy: S,
-    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
-) {
-    let mut runner = TestRunner::new(config(name));
-    if let Err(e) = runner.run(&strategy, test) {
-        panic!("{name}: {e}");
-    }
 }
 
 /// Bound-constrained Newton polish of |S − q|² from `(u, v)` (backtracking, 60 steps).
@@ -131,7 +96,8 @@ fn brute(s: &NurbsSurface, q: &Vector3<f64>) -> f64 {
 /// through the blade and beyond its edges), cold and warm.
 #[test]
 fn blade_side_distance_is_the_global_minimum() {
-    run(
+    case_floor::run(
+        file!(),
         "blade_side_distance_is_the_global_minimum",
         (
             0usize..FIXTURES.len(),

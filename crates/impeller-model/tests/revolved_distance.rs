@@ -11,7 +11,8 @@ use impeller_model::{load, Impeller, MeridionalCurve, RevolvedSurface};
 use nalgebra::{Vector2, Vector3};
 use nurbs::closest::PointQuery;
 use proptest::prelude::*;
-use proptest::test_runner::{TestCaseError, TestRunner};
+
+mod case_floor;
 use std::sync::OnceLock;
 
 const FIXTURES: [&str; 5] = [
@@ -69,42 +70,6 @@ fn brute(m: &MeridionalCurve, q: &Vector2<f64>) -> (f64, f64) {
     }
 }
 
-/// Number of cases: max(`PROPTEST_CASES` or 256, 256). `cargo xtask ci` sets
-/// `PROPTEST_CASES=64` when unset; this property keeps its 256 cases there, while a larger
-/// value (a nightly run with `PROPTEST_CASES=10000`) raises it.
-fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|c| c.parse().ok())
-        .unwrap_or(256)
-        .max(256)
-}
-
-/// The proptest configuration of test `name`: [`cases`] cases, the other settings from
-/// proptest's defaults and environment. The properties run on a [`TestRunner`] rather than in
-/// `proptest!`, because that macro lets `PROPTEST_CASES` replace the configured count (which
-/// would undo the floor of 256 under `cargo xtask ci`).
-fn config(name: &'static str) -> ProptestConfig {
-    ProptestConfig {
-        cases: cases(),
-        source_file: Some(file!()),
-        test_name: Some(name),
-        ..ProptestConfig::default()
-    }
-}
-
-/// Runs `test` on `strategy` with [`config`]; panics with the minimal failing input.
-fn run<S: Strategy>(
-    name: &'static str,
-    strategy: S,
-    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
-) {
-    let mut runner = TestRunner::new(config(name));
-    if let Err(e) = runner.run(&strategy, test) {
-        panic!("{name}: {e}");
-    }
-}
-
 fn surface(k: usize, shroud: bool) -> &'static RevolvedSurface {
     let imp = &fixtures()[k];
     if shroud {
@@ -117,7 +82,8 @@ fn surface(k: usize, shroud: bool) -> &'static RevolvedSurface {
 /// Random points in the box of the contour widened by 40 % (and down to the axis).
 #[test]
 fn hub_and_shroud_distance_is_the_global_minimum() {
-    run(
+    case_floor::run(
+        file!(),
         "hub_and_shroud_distance_is_the_global_minimum",
         (
             0usize..FIXTURES.len(),
@@ -173,7 +139,8 @@ fn hub_and_shroud_distance_is_the_global_minimum() {
 /// curvature: the signed distance is the offset (sign convention of the existing API).
 #[test]
 fn offsets_along_the_normal() {
-    run(
+    case_floor::run(
+        file!(),
         "offsets_along_the_normal",
         (
             0usize..FIXTURES.len(),

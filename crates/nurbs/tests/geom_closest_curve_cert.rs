@@ -9,7 +9,8 @@ use nalgebra::Vector2;
 use nurbs::closest::CurveProjector;
 use nurbs::{KnotVector, NurbsCurve};
 use proptest::prelude::*;
-use proptest::test_runner::{TestCaseError, TestRunner};
+
+mod case_floor;
 
 /// Dense sample, then golden-section polish around the best sample (an upper bound of the
 /// true minimum, within round-off of it for samples finer than the curve's features).
@@ -79,43 +80,10 @@ fn quarter(rx: f64, ry: f64) -> NurbsCurve<2> {
     .unwrap()
 }
 
-/// Number of cases: max(`PROPTEST_CASES` or 256, 256) (see the module docs).
-fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|c| c.parse().ok())
-        .unwrap_or(256)
-        .max(256)
-}
-
-/// The proptest configuration of test `name`: [`cases`] cases, the other settings from
-/// proptest's defaults and environment. The properties run on a [`TestRunner`] rather than in
-/// `proptest!`, because that macro lets `PROPTEST_CASES` replace the configured count (which
-/// would undo the floor of 256 under `cargo xtask ci`).
-fn config(name: &'static str) -> ProptestConfig {
-    ProptestConfig {
-        cases: cases(),
-        source_file: Some(file!()),
-        test_name: Some(name),
-        ..ProptestConfig::default()
-    }
-}
-
-/// Runs `test` on `strategy` with [`config`]; panics with the minimal failing input.
-fn run<S: Strategy>(
-    name: &'static str,
-    strategy: S,
-    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
-) {
-    let mut runner = TestRunner::new(config(name));
-    if let Err(e) = runner.run(&strategy, test) {
-        panic!("{name}: {e}");
-    }
-}
-
 #[test]
 fn random_curves() {
-    run(
+    case_floor::run(
+        file!(),
         "random_curves",
         (
             0u64..1_000_000,
@@ -146,7 +114,8 @@ fn random_curves() {
 
 #[test]
 fn conics_from_any_side() {
-    run(
+    case_floor::run(
+        file!(),
         "conics_from_any_side",
         (
             5.0f64..60.0,

@@ -11,43 +11,8 @@ use nalgebra::Vector3;
 use nurbs::closest::{PointQuery, SurfaceProjector};
 use nurbs::{KnotVector, NurbsCurve, NurbsSurface};
 use proptest::prelude::*;
-use proptest::test_runner::{TestCaseError, TestRunner};
 
-/// Number of cases: max(`PROPTEST_CASES` or 256, 256). `cargo xtask ci` sets
-/// `PROPTEST_CASES=64` when unset; this property keeps its 256 cases there, while a larger
-/// value (a nightly run with `PROPTEST_CASES=10000`) raises it.
-fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|c| c.parse().ok())
-        .unwrap_or(256)
-        .max(256)
-}
-
-/// The proptest configuration of test `name`: [`cases`] cases, the other settings from
-/// proptest's defaults and environment. The properties run on a [`TestRunner`] rather than in
-/// `proptest!`, because that macro lets `PROPTEST_CASES` replace the configured count (which
-/// would undo the floor of 256 under `cargo xtask ci`).
-fn config(name: &'static str) -> ProptestConfig {
-    ProptestConfig {
-        cases: cases(),
-        source_file: Some(file!()),
-        test_name: Some(name),
-        ..ProptestConfig::default()
-    }
-}
-
-/// Runs `test` on `strategy` with [`config`]; panics with the minimal failing input.
-fn run<S: Strategy>(
-    name: &'static str,
-    strategy: S,
-    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
-) {
-    let mut runner = TestRunner::new(config(name));
-    if let Err(e) = runner.run(&strategy, test) {
-        panic!("{name}: {e}");
-    }
-}
+mod case_floor;
 
 /// Deterministic pseudo-random numbers in [0, 1) from a seed.
 fn rng(seed: u64) -> impl FnMut() -> f64 {
@@ -190,7 +155,8 @@ fn check(s: &NurbsSurface, q: Vector3<f64>, hint: (f64, f64)) -> Result<(), Test
 /// including points near the axis (beyond every centre of curvature of the circles).
 #[test]
 fn surfaces_of_revolution() {
-    run(
+    case_floor::run(
+        file!(),
         "surfaces_of_revolution",
         (
             0u64..1_000_000,
@@ -214,7 +180,8 @@ fn surfaces_of_revolution() {
 /// General rational nets (degree 2–3, random positive weights), points anywhere around.
 #[test]
 fn random_positive_weights() {
-    run(
+    case_floor::run(
+        file!(),
         "random_positive_weights",
         (
             0u64..1_000_000,

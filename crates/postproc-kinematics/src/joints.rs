@@ -103,6 +103,12 @@ impl Joints {
         Joints::from_array(std::array::from_fn(|i| a[i] + s * (b[i] - a[i])))
     }
 
+    /// Rotary travel `|ΔT| + |ΔR|` (rad) to `other`: the measure the posture choice and
+    /// linearisation compare solutions by.
+    pub fn rotary_travel(&self, other: &Joints) -> f64 {
+        (other.tilt - self.tilt).abs() + (other.rotate - self.rotate).abs()
+    }
+
     /// `true` when all five values are finite.
     pub fn is_finite(&self) -> bool {
         self.to_array().iter().all(|v| v.is_finite())

@@ -123,8 +123,11 @@ fn midpoint_posture(
 ) -> Result<(CutterLocation, Joints), KinematicsError> {
     let mid = interpolate_cl(cl0, cl1, 0.5);
     let jm = machine.inverse(&mid, tool_length, Some(j0))?;
-    let travel = |a: &Joints, b: &Joints| (a.tilt - b.tilt).abs() + (a.rotate - b.rotate).abs();
-    let (a, b, whole) = (travel(j0, &jm), travel(&jm, j1), travel(j0, j1));
+    let (a, b, whole) = (
+        j0.rotary_travel(&jm),
+        jm.rotary_travel(j1),
+        j0.rotary_travel(j1),
+    );
     // An exact midpoint that repeats an end (a turn about the singular direction, where the
     // inverse holds the rotary angle) would never split the turn: interpolate it instead.
     let stuck = whole > 1e-12 && (a < 1e-12 || b < 1e-12);

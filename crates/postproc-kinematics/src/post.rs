@@ -555,9 +555,13 @@ fn is_reconfiguration(
     clb: &CutterLocation,
     b: &Joints,
 ) -> bool {
-    let large = (b.tilt - a.tilt).abs() > RECONFIGURATION_STEP_RAD
-        || (b.rotate - a.rotate).abs() > RECONFIGURATION_STEP_RAD;
-    large && !follows_sweep(machine, tool_length, cla, a, clb, b)
+    large_rotary_step(a, b) && !follows_sweep(machine, tool_length, cla, a, clb, b)
+}
+
+/// A rotary step above [`RECONFIGURATION_STEP_RAD`] on either axis.
+fn large_rotary_step(a: &Joints, b: &Joints) -> bool {
+    (b.tilt - a.tilt).abs() > RECONFIGURATION_STEP_RAD
+        || (b.rotate - a.rotate).abs() > RECONFIGURATION_STEP_RAD
 }
 
 /// Largest rotary travel (rad) of one step of [`follows_sweep`]'s continuation.
@@ -576,7 +580,7 @@ fn follows_sweep(
     clb: &CutterLocation,
     b: &Joints,
 ) -> bool {
-    sweep_end(machine, tool_length, cla, a, clb).is_some_and(|e| rotary_travel(&e, b) < 1e-6)
+    sweep_end(machine, tool_length, cla, a, clb).is_some_and(|e| e.rotary_travel(b) < 1e-6)
 }
 
 /// The posture at `clb` reached by continuing the exact inverse kinematics from `a` along the
@@ -602,7 +606,7 @@ fn sweep_end(
         let (j, _) = machine
             .inverse_best_effort(&cl, tool_length, Some(&cur))
             .ok()?;
-        if rotary_travel(&cur, &j) > SWEEP_STEP_RAD {
+        if cur.rotary_travel(&j) > SWEEP_STEP_RAD {
             if h <= 1e-12 {
                 return None;
             }
@@ -614,11 +618,6 @@ fn sweep_end(
         h = (2.0 * h).min(1.0 / 16.0);
     }
     (s >= 1.0).then_some(cur)
-}
-
-/// Rotary travel `|ΔT| + |ΔR|` (rad) between two postures.
-fn rotary_travel(a: &Joints, b: &Joints) -> f64 {
-    (b.tilt - a.tilt).abs() + (b.rotate - a.rotate).abs()
 }
 
 /// Solution choice over a whole group by dynamic programming (Viterbi).
@@ -674,7 +673,7 @@ fn solve_group_optimal(
                 .into_iter()
                 .map(|c| {
                     let p = usize::from(c.1.is_some());
-                    let t = rotary_travel(prev, &c.0);
+                    let t = prev.rotary_travel(&c.0);
                     (c, p, t, usize::MAX)
                 })
                 .collect(),
@@ -682,14 +681,12 @@ fn solve_group_optimal(
                 // where each predecessor's branch arrives (computed once, only when needed)
                 let mut ends: Vec<Option<Option<Joints>>> = vec![None; before.len()];
                 let mut reconf = |k: usize, b: &Joints, c: &Joints| {
-                    let large = (c.tilt - b.tilt).abs() > RECONFIGURATION_STEP_RAD
-                        || (c.rotate - b.rotate).abs() > RECONFIGURATION_STEP_RAD;
-                    large
+                    large_rotary_step(b, c)
                         && !ends[k]
                             .get_or_insert_with(|| {
                                 sweep_end(machine, tl, &moves[index - 1].cl, b, &m.cl)
                             })
-                            .is_some_and(|e| rotary_travel(&e, c) < 1e-6)
+                            .is_some_and(|e| e.rotary_travel(c) < 1e-6)
                 };
                 cands
                     .into_iter()
@@ -698,7 +695,7 @@ fn solve_group_optimal(
                         for (k, (b, p, t, _)) in before.iter().enumerate() {
                             let p =
                                 p + usize::from(c.1.is_some()) + usize::from(reconf(k, &b.0, &c.0));
-                            let t = t + rotary_travel(&b.0, &c.0);
+                            let t = t + b.0.rotary_travel(&c.0);
                             if p < best.0 || (p == best.0 && t < best.1) {
                                 best = (p, t, k);
                             }
