@@ -8,7 +8,11 @@
 //!   alone would extend the body past the contour's ends); signed distance
 //!   `max(d_hub, z − z_inlet, r − r_outlet)`, exact near the hub surface;
 //! - blade k: the points inside both sides (each side's signed distance is positive along its
-//!   outward normal) and below the shroud contour: `max(d_pressure, d_suction, d_shroud)`.
+//!   outward normal) and below the shroud contour: `max(d_pressure, d_suction, d_shroud)`, except
+//!   beyond a leading or trailing edge (both side distances positive), where that over-reads
+//!   and `max(d_shroud, min(d_pressure, d_suction) − g/2)` bounds it (`g` the gap between the
+//!   sides at that edge: 0 at a rounded edge, the face width at a blunt one)
+//!   (`impeller_model::query::blade_solid_distance`).
 //!   Only the two instances of each row that enclose the query's polar angle are evaluated
 //!   (the reference blade's angle at the nearest meridional position is tabulated), so an
 //!   exact query costs four blade-side projections however many blades there are.
@@ -189,6 +193,8 @@ pub struct Clearance {
 struct RowAngles {
     zr: Vec<[f64; 2]>,
     theta: Vec<f64>,
+    /// Half the gap between the sides at the u-min and u-max edges (0 where they meet).
+    edge_half_gaps: [f64; 2],
 }
 
 impl RowAngles {
@@ -209,7 +215,11 @@ impl RowAngles {
                 theta.push(p.y.atan2(p.x));
             }
         }
-        Self { zr, theta }
+        Self {
+            zr,
+            theta,
+            edge_half_gaps: impeller_model::query::blade_edge_half_gaps(blade),
+        }
     }
 
     /// The reference blade's polar angle nearest to `p`'s meridional position.
@@ -697,9 +707,16 @@ impl<'a> DesignClearance<'a> {
             let k0 = ((rel / pitch).floor() as usize) % n;
             for k in [k0, (k0 + 1) % n] {
                 let local = set.rotation(k).inverse() * p.coords;
-                let (_, dp) = blade_side_distance(set.blade(), Side::Pressure, &local, None);
+                let (sp, dp) = blade_side_distance(set.blade(), Side::Pressure, &local, None);
                 let (_, ds) = blade_side_distance(set.blade(), Side::Suction, &local, None);
-                let d = dp.max(ds).max(d_shroud);
+                let ((u0, u1), _) = set.blade().side(Side::Pressure).domain();
+                let end = usize::from(sp.u > 0.5 * (u0 + u1));
+                let d = impeller_model::query::blade_solid_distance(
+                    dp,
+                    ds,
+                    d_shroud,
+                    angles.edge_half_gaps[end],
+                );
                 if d < best.0 {
                     best = (
                         d,

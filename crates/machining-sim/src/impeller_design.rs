@@ -67,6 +67,8 @@ const EXACT_BAND_MM: f64 = 2.0;
 pub struct ImpellerDesign {
     impeller: Impeller,
     blades: Vec<(String, Blade)>,
+    /// Per blade: half the gap between its sides at the pressure side's u-min and u-max edges.
+    edge_half_gaps: Vec<[f64; 2]>,
     sides_mesh: TriMesh,
     tri_info: Vec<(u32, Side, f64, f64)>,
     sampling: ImpellerSampling,
@@ -112,6 +114,10 @@ impl ImpellerDesign {
                 };
                 (name, b)
             })
+            .collect();
+        let edge_half_gaps = blades
+            .iter()
+            .map(|(_, b)| impeller_model::query::blade_edge_half_gaps(b))
             .collect();
         let (mu, mv) = (sampling.mesh_u.max(2), sampling.mesh_v.max(2));
         let mut vertices = Vec::new();
@@ -181,6 +187,7 @@ impl ImpellerDesign {
             shroud_sd: ContourDistance::new(impeller.shroud().meridional()),
             impeller: impeller.clone(),
             blades,
+            edge_half_gaps,
             sides_mesh,
             tri_info,
             sampling,
@@ -219,10 +226,17 @@ impl ImpellerDesign {
             return (dm - self.far_mm).max(ds).max(1e-9);
         }
         let blade = &self.blades[bi as usize].1;
-        let d1 = side_distance(blade, side, p, (u, v));
-        let d2 = side_distance(blade, side.other(), p, (u, v));
+        let (d1, u1) = side_distance(blade, side, p, (u, v));
+        let (d2, u2) = side_distance(blade, side.other(), p, (u, v));
         let ds = self.shroud_sd.signed_distance(p);
-        d1.max(d2).max(ds)
+        let u_pressure = if side == Side::Pressure { u1 } else { u2 };
+        let ((ua, ub), _) = blade.side(Side::Pressure).domain();
+        let end = usize::from(u_pressure > 0.5 * (ua + ub));
+        let half_gap = self
+            .edge_half_gaps
+            .get(bi as usize)
+            .map_or(self.far_mm, |g| g[end]);
+        impeller_model::query::blade_solid_distance(d1, d2, ds, half_gap)
     }
 
     fn blade_grid(&self, name: &str, blade: &Blade, side: Side) -> SurfaceGrid {
@@ -412,12 +426,14 @@ impl ContourDistance {
 
 /// Signed distance to one blade side by Newton point inversion from `hint` (impeller-model's
 /// `closest_point`, NURBS Book §6.1; allocation-free), positive on the outward side.
-fn side_distance(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> f64 {
+/// Signed distance of `p` to one side of `blade` and the u parameter of the closest point.
+fn side_distance(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> (f64, f64) {
     let sp = closest_point(blade.side(side), &p.coords, Some(hint));
-    match blade.outward_normal(side, sp.u, sp.v) {
+    let d = match blade.outward_normal(side, sp.u, sp.v) {
         Some(n) if (p.coords - sp.point).dot(&n) < 0.0 => -sp.distance,
         _ => sp.distance,
-    }
+    };
+    (d, sp.u)
 }
 
 fn side_name(side: Side) -> &'static str {
@@ -459,12 +475,12 @@ impl DesignModel for ImpellerDesign {
             .project_local_point_and_get_location(q, false);
         let side = self.tri_info.get(tri as usize).map(|&(bi, side, u, v)| {
             let blade = &self.blades[bi as usize].1;
-            let d = side_distance(blade, side, entry, (u, v)).abs();
+            let d = side_distance(blade, side, entry, (u, v)).0.abs();
             (d, blade, side, (u, v))
         });
         match side {
             Some((d, blade, s, hint)) if d <= hub && d <= shroud => {
-                -side_distance(blade, s, p, hint)
+                -side_distance(blade, s, p, hint).0
             }
             _ if hub <= shroud => -self.hub_signed_distance(p),
             _ => -self.shroud_sd.signed_distance(p),
