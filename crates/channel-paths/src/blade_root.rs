@@ -36,8 +36,8 @@
 
 use cam_core::{CutterLocation, Move, ToolPath};
 use cam_plan::{
-    pattern, Metrics, Operation, OperationSpec, PlanContext, PlanError, PlannedOperation, Plot,
-    PlotKind, PlotSeries, Point3,
+    pattern, ClearanceOptions, DesignClearance, Metrics, Operation, OperationSpec, PartSet,
+    PlanContext, PlanError, PlannedOperation, Plot, PlotKind, PlotSeries, Point3,
 };
 use impeller_model::{channel::edge_v, Blade, Impeller, Side};
 use nalgebra::{Rotation3, Vector3};
@@ -227,6 +227,7 @@ enum Search {
 #[allow(clippy::too_many_arguments)]
 fn search_axis(
     ctx: &PlanContext<'_>,
+    upper: &DesignClearance<'_>,
     blade: &Blade,
     side: Side,
     neighbour: &Blade,
@@ -311,8 +312,9 @@ fn search_axis(
             return Search::None { c_max };
         }
         let axis = Rotation3::from_axis_angle(&turn_axis, rot) * a0;
-        if upper_clearance(ctx, centre, &axis, r, ball, -tol) >= -tol {
-            let clearance = upper_clearance(ctx, centre, &axis, r, ball, f64::NEG_INFINITY);
+        if assembly_clearance(ctx, upper, centre, &axis, r, ball, -tol) >= -tol {
+            let clearance =
+                assembly_clearance(ctx, upper, centre, &axis, r, ball, f64::NEG_INFINITY);
             return Search::Found {
                 axis,
                 steps: k,
@@ -322,6 +324,43 @@ fn search_axis(
         }
         k += 1;
     }
+}
+
+/// The clearance query of the shank and holder alone (cutter samples left out: the flutes
+/// are measured by [`upper_clearance`], which can also place a smaller ball).
+fn shank_and_holder<'a>(ctx: &PlanContext<'a>) -> DesignClearance<'a> {
+    ctx.clearance.with_options(ClearanceOptions {
+        parts: PartSet::MATERIAL,
+        above_mm: ctx.tool.cutter.flute_length,
+        ..ClearanceOptions::default()
+    })
+}
+
+/// Smallest signed clearance (mm) of everything above the ball with its centre at `centre`
+/// and unit `axis`: the flutes ([`upper_clearance`], with a ball of radius `ball`) and the
+/// shank and holder frusta (`upper`, placed as on the job's tool: tip at `centre − r·axis`).
+/// Stops below `stop_below` like [`upper_clearance`].
+fn assembly_clearance(
+    ctx: &PlanContext<'_>,
+    upper: &DesignClearance<'_>,
+    centre: &Vector3<f64>,
+    axis: &Vector3<f64>,
+    r: f64,
+    ball: f64,
+    stop_below: f64,
+) -> f64 {
+    let flutes = upper_clearance(ctx, centre, axis, r, ball, stop_below);
+    if flutes < stop_below {
+        return flutes;
+    }
+    let Some(unit) = nalgebra::Unit::try_new(*axis, 1e-12) else {
+        return flutes;
+    };
+    let cl = CutterLocation {
+        tip: Point3::from(centre - axis * r),
+        axis: unit,
+    };
+    flutes.min(upper.clearance(&cl).distance_mm)
 }
 
 /// Largest penetration of the ball (centre, radius `r`) into hub, blades and the fillet of
@@ -408,6 +447,7 @@ pub fn plan_side(
 ) -> Result<Vec<RootPosition>, PlanError> {
     let r = ball_radius(ctx, operation, "blade-root finishing")?;
     let imp = ctx.impeller;
+    let upper = shank_and_holder(ctx);
     let s = blade.side(side);
     let ((u0, u1), _) = s.domain();
     let plus = blade.plus_theta_side() == side;
@@ -423,7 +463,9 @@ pub fn plan_side(
                 "the hub and blade offset surfaces do not intersect here",
             )
         })?;
-        match search_axis(ctx, blade, side, neighbour, u, &centre, &nb, r, r, step) {
+        match search_axis(
+            ctx, &upper, blade, side, neighbour, u, &centre, &nb, r, r, step,
+        ) {
             Search::Found {
                 axis,
                 steps,
@@ -449,7 +491,9 @@ pub fn plan_side(
                     let mid = 0.5 * (lo + hi);
                     let ok = spine(imp, blade, side, u, mid).is_some_and(|(c, _, nb2, _)| {
                         matches!(
-                            search_axis(ctx, blade, side, neighbour, u, &c, &nb2, r, mid, step),
+                            search_axis(
+                                ctx, &upper, blade, side, neighbour, u, &c, &nb2, r, mid, step,
+                            ),
                             Search::Found { .. }
                         )
                     });
@@ -547,7 +591,7 @@ impl Operation for BladeRootFinishing {
                         .map(|(k, p)| [k as f64, p.rotation.to_degrees()])
                         .collect(),
                 });
-                ctx.linker.close(&mut path, APPROACH_MM)?;
+                ctx.close(&mut path, APPROACH_MM)?;
                 let order = cam_plan::order::angular_sequence(count, 0);
                 paths.extend(pattern::copy_to(&path, pitch, &order));
             }
