@@ -42,7 +42,7 @@ pub use clearance::{
     Clearance, ClearanceOptions, DesignClearance, DesignMesh, DesignPart, PartSet, Row, ToolPart,
 };
 pub use error::PlanError;
-pub use linking::{Linker, SafetySurface};
+pub use linking::{LinkCheck, LinkStats, Linker, SafetySurface};
 pub use metrics::{MetricValue, Metrics, Plot, PlotKind, PlotSeries};
 pub use operation::{Builder, Operation, OperationSpec, PlanContext, PlannedOperation};
 pub use process::Process;

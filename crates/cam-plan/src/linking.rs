@@ -25,7 +25,7 @@
 //!
 //! Cost: O(1) per retract and per travel.
 
-use crate::{PlanError, Point3, Vector3};
+use crate::{DesignClearance, PlanError, Point3, Vector3};
 use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
 use impeller_model::Stock;
 
@@ -127,11 +127,23 @@ impl Linker {
     /// the blank (probed every 0.25 mm, the tip and four lateral and one lower point at
     /// `approach_mm`), whichever is higher. O(inside / 0.25) blank tests.
     pub fn rapid_approach_end(&self, to: &CutterLocation, inside: f64, approach_mm: f64) -> f64 {
+        self.rapid_approach_end_along(to, &to.axis.into_inner(), inside, approach_mm)
+    }
+
+    /// [`Linker::rapid_approach_end`] for an approach along the unit direction `dir` (the
+    /// tool keeps `to`'s axis).
+    pub fn rapid_approach_end_along(
+        &self,
+        to: &CutterLocation,
+        dir: &Vector3,
+        inside: f64,
+        approach_mm: f64,
+    ) -> f64 {
         let a = approach_mm.clamp(0.0, inside);
         let Some(blank) = &self.blank else {
             return a;
         };
-        let axis = to.axis.into_inner();
+        let axis = *dir;
         let m = approach_mm.max(0.0);
         let probes = [
             Vector3::zeros(),
@@ -175,6 +187,35 @@ impl Linker {
             tip: cl.tip + a * t,
             axis: cl.axis,
         })
+    }
+
+    /// The point where a straight move from `cl` along the unit direction `dir` (the tool
+    /// keeping `cl`'s axis) reaches the safety surface, when that move leaves it with the
+    /// whole tool outside ([`Linker::leaves_clear`]); `None` otherwise.
+    pub fn exit_point(&self, cl: &CutterLocation, dir: &Vector3) -> Option<CutterLocation> {
+        let t = self.surface.exit_distance(&cl.tip, dir);
+        if !t.is_finite() {
+            return None;
+        }
+        let out = CutterLocation {
+            tip: cl.tip + dir * t,
+            axis: cl.axis,
+        };
+        self.leaves_clear(&out).then_some(out)
+    }
+
+    /// Whether the tool at `cl`, whose tip lies on the safety surface, stands wholly outside
+    /// the capped cylinder: on the cap with an axis that does not point down (`a_z ≥ 0`), or on
+    /// the side with an axis that does not point inward (`xy(p)·xy(a) ≥ 0`; then
+    /// `|xy(p + t·a)|² = R² + 2t·xy(p)·xy(a) + t²|xy(a)|² ≥ R²` for every `t ≥ 0`). The travel
+    /// from such a posture keeps the whole tool outside (module docs).
+    pub fn leaves_clear(&self, cl: &CutterLocation) -> bool {
+        let a = cl.axis.into_inner();
+        let p = cl.tip;
+        let eps = 1e-9 * (1.0 + self.surface.top_z_mm.abs() + self.surface.radius_mm);
+        let on_cap = p.z >= self.surface.top_z_mm - eps;
+        let on_side = p.x.hypot(p.y) >= self.surface.radius_mm - eps;
+        (on_cap && a.z >= -1e-12) || (on_side && p.x * a.x + p.y * a.y >= -1e-12)
     }
 
     /// Travel on the safety surface from `from` to `to` (both on or outside it), as rapid
@@ -307,6 +348,278 @@ impl Linker {
         Ok(moves)
     }
 
+    /// [`Linker::connect`] with the retract from `from` along the unit direction `out_dir`
+    /// and the approach to `to` along `in_dir` (the tool keeps its axis on both; directions
+    /// from [`Linker::exit_direction`]). Ends exactly at `to`.
+    pub fn connect_along(
+        &self,
+        (from, out_dir): (&CutterLocation, &Vector3),
+        (to, in_dir): (&CutterLocation, &Vector3),
+        approach_mm: f64,
+    ) -> Result<Vec<Move>, PlanError> {
+        let out = self
+            .exit_point(from, out_dir)
+            .ok_or_else(|| no_exit(from))?;
+        let inn = self.exit_point(to, in_dir).ok_or_else(|| no_exit(to))?;
+        let mut moves = Vec::new();
+        if (out.tip - from.tip).norm() >= SAME_POSTURE_MM {
+            moves.push(Move {
+                kind: MoveKind::Retract,
+                cl: out,
+                feed_mm_per_min: None,
+            });
+        }
+        moves.extend(self.travel(&out, &inn));
+        let inside = (inn.tip - to.tip).norm();
+        if inside >= SAME_POSTURE_MM {
+            let a = self.rapid_approach_end_along(to, in_dir, inside, approach_mm);
+            if a < inside {
+                moves.push(Move::rapid(CutterLocation {
+                    tip: to.tip + in_dir * a,
+                    axis: to.axis,
+                }));
+            }
+            moves.push(Move {
+                kind: MoveKind::Plunge,
+                cl: *to,
+                feed_mm_per_min: None,
+            });
+        }
+        Ok(moves)
+    }
+
+    /// The direction in which the tool leaves `cl` (and, reversed, approaches it) keeping its
+    /// axis: the tool axis when that straight move keeps the design clearance `check` asks
+    /// for, otherwise the first clear one of the axis turned toward +Z and toward the radial
+    /// direction outward by 15°, 30°, 45°, 60°, 75° and 90° (axis first, then in that order).
+    /// A direction qualifies when the move reaches the safety surface with the tool wholly
+    /// outside ([`Linker::leaves_clear`]) and [`DesignClearance::segment_clearance`]
+    /// certifies the whole move at least `min(c₀, floor_mm) − tol_mm` from the design (`c₀`
+    /// the clearance at `cl`: a move that starts at a contact may stay at it, never go
+    /// deeper), within `max_queries` clearance queries.
+    ///
+    /// Returns the direction and whether it was certified; when none is, the tool axis
+    /// (`false`). Cost: at most 13 candidates × `max_queries` clearance queries; 2–20 for a
+    /// move that leaves the design.
+    pub fn exit_direction(&self, cl: &CutterLocation, check: &LinkCheck<'_>) -> (Vector3, bool) {
+        let a = cl.axis.into_inner();
+        if check
+            .profile
+            .is_some_and(|top| self.axis_retract_is_clear(cl, top))
+        {
+            return (a, true);
+        }
+        let c0 = check.clearance.clearance(cl).distance_mm;
+        let floor = c0.min(check.floor_mm) - check.tol_mm.max(0.0);
+        let radial = Vector3::new(cl.tip.x, cl.tip.y, 0.0)
+            .try_normalize(1e-9)
+            .unwrap_or_else(Vector3::z);
+        let mut candidates = vec![a];
+        for u in [Vector3::z(), radial] {
+            for deg in [15.0f64, 30.0, 45.0, 60.0, 75.0, 90.0] {
+                candidates.push(turned_toward(&a, &u, deg.to_radians()));
+            }
+        }
+        for d in candidates {
+            let Some(out) = self.exit_point(cl, &d) else {
+                continue;
+            };
+            let c1 = check.clearance.clearance(&out).distance_mm;
+            if check
+                .clearance
+                .segment_clearance_between(
+                    (cl, c0),
+                    (&out, c1),
+                    floor + check.tol_mm.max(0.0),
+                    check.tol_mm.max(0.0),
+                    check.max_queries,
+                )
+                .is_ok()
+            {
+                return (d, true);
+            }
+        }
+        (a, false)
+    }
+
+    /// [`Linker::link`] with the retract from `from` and the approach to `to` along
+    /// directions that keep the design clearance of `check` ([`Linker::exit_direction`]);
+    /// path ends that could not be certified are counted in `check.stats`.
+    pub fn link_checked(
+        &self,
+        from: &CutterLocation,
+        to: &CutterLocation,
+        approach_mm: f64,
+        check: &LinkCheck<'_>,
+    ) -> Result<Vec<Move>, PlanError> {
+        let out_dir = self.checked_direction(from, check);
+        let in_dir = self.checked_direction(to, check);
+        self.connect_along((from, &out_dir), (to, &in_dir), approach_mm)
+    }
+
+    /// [`Linker::close`] with the approach to the first move and the retract from the last
+    /// along directions that keep the design clearance of `check`.
+    pub fn close_checked(
+        &self,
+        path: &mut ToolPath,
+        approach_mm: f64,
+        check: &LinkCheck<'_>,
+    ) -> Result<(), PlanError> {
+        let (Some(first), Some(last)) = (path.moves.first().copied(), path.moves.last().copied())
+        else {
+            return Ok(());
+        };
+        if self.surface.contains(&last.cl.tip) {
+            let d = self.checked_direction(&last.cl, check);
+            let end = self
+                .exit_point(&last.cl, &d)
+                .ok_or_else(|| no_exit(&last.cl))?;
+            path.moves.push(Move {
+                kind: MoveKind::Retract,
+                cl: end,
+                feed_mm_per_min: None,
+            });
+        }
+        if self.surface.contains(&first.cl.tip) {
+            let d = self.checked_direction(&first.cl, check);
+            self.close_start_along(path, &d, approach_mm)?;
+        }
+        Ok(())
+    }
+
+    /// [`Linker::exit_direction`], counting the outcome in `check.stats`.
+    fn checked_direction(&self, cl: &CutterLocation, check: &LinkCheck<'_>) -> Vector3 {
+        if !self.surface.contains(&cl.tip) {
+            return cl.axis.into_inner();
+        }
+        let (d, ok) = self.exit_direction(cl, check);
+        check.stats.count(ok, d.dot(&cl.axis) < 1.0 - 1e-12);
+        d
+    }
+
+    /// Whether the retract of `cl` along its own axis to the safety surface is certified by
+    /// the shape of the tool alone: for a tool whose radius never shrinks from the tip up
+    /// ([`LinkCheck::profile`] = `(h_top, r_top)`), the tool moved by `t` along its axis
+    /// covers nothing the tool at `cl` does not, except a cylinder of radius `r_top` from
+    /// `h_top` to `h_top + t` above the tip. That cylinder is clear when its axis stays more
+    /// than `r_top` (plus the 1 mm sampling step) outside the blank's bounding capped
+    /// cylinder, which contains the design. Then the move is never closer to the design
+    /// than the cutting posture itself. O(t) point tests; `false` without a blank.
+    fn axis_retract_is_clear(&self, cl: &CutterLocation, (h_top, r_top): (f64, f64)) -> bool {
+        let Some(blank) = &self.blank else {
+            return false;
+        };
+        let a = cl.axis.into_inner();
+        let t = self.surface.exit_distance(&cl.tip, &a);
+        if !t.is_finite() || self.exit_point(cl, &a).is_none() {
+            return false;
+        }
+        let (z0, z1) = blank.z_range();
+        let r_max = blank.max_radius();
+        let step = 1.0;
+        let n = (t / step).ceil() as usize;
+        (0..=n).all(|i| {
+            let q = cl.tip + a * (h_top + t * i as f64 / n.max(1) as f64);
+            let dr = (q.x.hypot(q.y) - r_max).max(0.0);
+            let dz = (z0 - q.z).max(q.z - z1).max(0.0);
+            dr.hypot(dz) > r_top + step
+        })
+    }
+
+    /// [`Linker::join`] with every retract and approach along a direction that keeps the
+    /// design clearance of `check` ([`Linker::exit_direction`]; path ends in parallel;
+    /// outcomes counted in `check.stats`).
+    pub fn join_checked(
+        &self,
+        name: &str,
+        tool: &str,
+        paths: &[ToolPath],
+        approach_mm: f64,
+        check: &LinkCheck<'_>,
+    ) -> Result<ToolPath, PlanError> {
+        use rayon::prelude::*;
+        let paths: Vec<&ToolPath> = paths.iter().filter(|p| !p.moves.is_empty()).collect();
+        let ends: Vec<(Vector3, Vector3)> = paths
+            .par_iter()
+            .map(|p| {
+                let first = &p.moves[0].cl;
+                let last = &p.moves[p.moves.len() - 1].cl;
+                (
+                    self.checked_direction(first, check),
+                    self.checked_direction(last, check),
+                )
+            })
+            .collect();
+        let mut out = ToolPath::new(name, tool);
+        let mut last_dir = Vector3::z();
+        for (p, (in_dir, end_dir)) in paths.iter().zip(&ends) {
+            let first = p.moves[0];
+            if let Some(last) = out.moves.last() {
+                let link =
+                    self.connect_along((&last.cl, &last_dir), (&first.cl, in_dir), approach_mm)?;
+                out.moves.extend(link);
+                out.moves.extend_from_slice(&p.moves[1..]);
+            } else {
+                let mut head = (*p).clone();
+                if self.surface.contains(&first.cl.tip) {
+                    // Only the approach: the retract follows the last path.
+                    self.close_start_along(&mut head, in_dir, approach_mm)?;
+                }
+                out.moves = head.moves;
+            }
+            last_dir = *end_dir;
+        }
+        if let Some(last) = out.moves.last().copied() {
+            if self.surface.contains(&last.cl.tip) {
+                out.moves.push(Move {
+                    kind: MoveKind::Retract,
+                    cl: self
+                        .exit_point(&last.cl, &last_dir)
+                        .ok_or_else(|| no_exit(&last.cl))?,
+                    feed_mm_per_min: None,
+                });
+            }
+        }
+        Ok(out)
+    }
+
+    /// Prepends the approach from the safety surface along `dir` to the first move (a plunge
+    /// replacing a first cutting move).
+    fn close_start_along(
+        &self,
+        path: &mut ToolPath,
+        dir: &Vector3,
+        approach_mm: f64,
+    ) -> Result<(), PlanError> {
+        let Some(first) = path.moves.first().copied() else {
+            return Ok(());
+        };
+        let start = self
+            .exit_point(&first.cl, dir)
+            .ok_or_else(|| no_exit(&first.cl))?;
+        let inside = (start.tip - first.cl.tip).norm();
+        let mut head = vec![Move::rapid(start)];
+        let a = self.rapid_approach_end_along(&first.cl, dir, inside, approach_mm);
+        if a < inside {
+            head.push(Move::rapid(CutterLocation {
+                tip: first.cl.tip + dir * a,
+                axis: first.cl.axis,
+            }));
+        }
+        if first.kind == MoveKind::Feed {
+            head.push(Move {
+                kind: MoveKind::Plunge,
+                cl: first.cl,
+                feed_mm_per_min: None,
+            });
+            head.extend_from_slice(&path.moves[1..]);
+        } else {
+            head.extend_from_slice(&path.moves);
+        }
+        path.moves = head;
+        Ok(())
+    }
+
     /// One tool path `name` (tool `tool`) of `paths` in order: each path's moves, linked to
     /// the next with [`Linker::connect`] (which replaces the next path's first move by the
     /// link arriving at it); the whole starts and ends on the safety surface (an approach
@@ -381,4 +694,111 @@ impl Linker {
         path.moves = head;
         Ok(())
     }
+}
+
+/// What a checked linker keeps: the design clearance query of the operation's tool, the
+/// clearance its retracts and approaches keep (`floor_mm`: the operation's smallest
+/// allowance; a move starting closer may stay as close, never closer), the certification
+/// tolerance and the query budget per direction tried ([`Linker::exit_direction`]).
+#[derive(Debug, Clone, Copy)]
+pub struct LinkCheck<'a> {
+    /// The operation's clearance query.
+    pub clearance: &'a DesignClearance<'a>,
+    /// `(h_top, r_top)`, the height and radius of the tool's top, when its radius never
+    /// shrinks from the tip up ([`widening_profile`]): then a retract along the axis is
+    /// certified by the tool's shape ([`Linker::exit_direction`]).
+    pub profile: Option<(f64, f64)>,
+    /// Where the outcomes are counted.
+    pub stats: &'a LinkStats,
+    /// Clearance to keep (mm).
+    pub floor_mm: f64,
+    /// Certification tolerance (mm).
+    pub tol_mm: f64,
+    /// Clearance queries per direction tried.
+    pub max_queries: usize,
+}
+
+/// Clearance queries per retract direction tried by default (a move leaving the design
+/// needs 2–20).
+pub const DEFAULT_LINK_QUERIES: usize = 40;
+
+/// `a` turned toward the unit vector `u` by `angle` (rad) in their common plane, stopping at
+/// `u`; `u` when the two are parallel or opposite.
+fn turned_toward(a: &Vector3, u: &Vector3, angle: f64) -> Vector3 {
+    let perp = u - a * a.dot(u);
+    match perp.try_normalize(1e-9) {
+        Some(e) => {
+            let along = a.dot(u).clamp(-1.0, 1.0).acos();
+            let t = angle.min(along);
+            a * t.cos() + e * t.sin()
+        }
+        None => *u,
+    }
+}
+
+fn no_exit(cl: &CutterLocation) -> PlanError {
+    PlanError::geometry(
+        "-",
+        format!("tip ({:.3}, {:.3}, {:.3})", cl.tip.x, cl.tip.y, cl.tip.z),
+        "no move from here reaches the safety surface with the tool outside it",
+    )
+}
+
+/// Counts of checked retracts and approaches (shared by the threads of one operation).
+#[derive(Debug, Default)]
+pub struct LinkStats {
+    uncertified: std::sync::atomic::AtomicUsize,
+    turned: std::sync::atomic::AtomicUsize,
+}
+
+impl LinkStats {
+    fn count(&self, certified: bool, off_axis: bool) {
+        use std::sync::atomic::Ordering::Relaxed;
+        if !certified {
+            self.uncertified.fetch_add(1, Relaxed);
+        } else if off_axis {
+            self.turned.fetch_add(1, Relaxed);
+        }
+    }
+
+    /// Retracts/approaches no direction tried could certify (left along the tool axis).
+    pub fn uncertified(&self) -> usize {
+        self.uncertified.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Retracts/approaches moved off the tool axis to keep the clearance.
+    pub fn turned(&self) -> usize {
+        self.turned.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
+/// `(h_top, r_top)` of `cutter` when the radius of the whole assembly (flutes, shank,
+/// holder) never decreases from the tip up (checked at 64 heights of the fluted part and at
+/// every part boundary, 1e-9 mm slack), `None` otherwise (e.g. a neck thinner than the ball).
+pub fn widening_profile(cutter: &cam_core::Cutter) -> Option<(f64, f64)> {
+    let slack = 1e-9;
+    let l = cutter.flute_length;
+    let mut prev = cutter.shape.radius_at(0.0);
+    for i in 1..=64 {
+        let r = cutter.shape.radius_at(l * i as f64 / 64.0);
+        if r < prev - slack {
+            return None;
+        }
+        prev = r;
+    }
+    let mut h = cutter.overall_length;
+    if cutter.overall_length > l {
+        if cutter.shank_radius < prev - slack {
+            return None;
+        }
+        prev = cutter.shank_radius;
+    }
+    for seg in &cutter.holder {
+        if seg.bottom_radius < prev - slack || seg.top_radius < seg.bottom_radius - slack {
+            return None;
+        }
+        prev = seg.top_radius;
+        h += seg.length;
+    }
+    Some((h.max(l), prev))
 }

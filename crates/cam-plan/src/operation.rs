@@ -4,8 +4,9 @@
 //! a function [`Builder`] that turns the job's `[[operations]]` table ([`OperationSpec`]) into
 //! a boxed operation. Each operation crate exports one builder per kind.
 
+use crate::linking::{widening_profile, LinkCheck, LinkStats, DEFAULT_LINK_QUERIES};
 use crate::{DesignClearance, Linker, Metrics, PlanError, Plot, Process, Tool};
-use cam_core::{Rates, Tolerances, ToolPath};
+use cam_core::{CutterLocation, Move, Rates, Tolerances, ToolPath};
 use impeller_model::{Impeller, Stock};
 
 /// Everything an operation plans with. Built by the pipeline once per operation.
@@ -25,12 +26,52 @@ pub struct PlanContext<'a> {
     pub clearance: &'a DesignClearance<'a>,
     /// Linking moves over the job's safety surface.
     pub linker: &'a Linker,
+    /// Outcomes of the checked retracts and approaches ([`PlanContext::link`],
+    /// [`PlanContext::close`]).
+    pub links: &'a LinkStats,
 }
 
 impl PlanContext<'_> {
     /// Feed, plunge and rapid rates of this operation's tool and process row.
     pub fn rates(&self) -> Rates {
         self.process.rates(self.tool)
+    }
+
+    /// The design check of this operation's retracts and approaches: its clearance query,
+    /// keeping its smallest allowance (never below 0; a move that starts closer may stay as
+    /// close), certified within half the machining tolerance.
+    pub fn link_check(&self) -> LinkCheck<'_> {
+        LinkCheck {
+            clearance: self.clearance,
+            profile: widening_profile(&self.tool.cutter),
+            stats: self.links,
+            floor_mm: self
+                .process
+                .blade_allowance_mm
+                .min(self.process.hub_allowance_mm)
+                .max(0.0),
+            tol_mm: 0.5 * self.tolerances.machining_tol,
+            max_queries: DEFAULT_LINK_QUERIES,
+        }
+    }
+
+    /// Linking moves from `from` to `to` ([`Linker::link_checked`] with
+    /// [`PlanContext::link_check`]).
+    pub fn link(
+        &self,
+        from: &CutterLocation,
+        to: &CutterLocation,
+        approach_mm: f64,
+    ) -> Result<Vec<Move>, PlanError> {
+        self.linker
+            .link_checked(from, to, approach_mm, &self.link_check())
+    }
+
+    /// Approach and retract of `path` ([`Linker::close_checked`] with
+    /// [`PlanContext::link_check`]).
+    pub fn close(&self, path: &mut ToolPath, approach_mm: f64) -> Result<(), PlanError> {
+        self.linker
+            .close_checked(path, approach_mm, &self.link_check())
     }
 }
 

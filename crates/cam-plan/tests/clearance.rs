@@ -8,8 +8,8 @@ use cam_core::{
 };
 use cam_plan::clearance::DesignMesh;
 use cam_plan::{
-    order, pattern, ClearanceOptions, DesignClearance, DesignPart, Linker, SafetySurface, Tool,
-    ToolPart,
+    order, pattern, ClearanceOptions, DesignClearance, DesignPart, LinkCheck, LinkStats, Linker,
+    SafetySurface, Tool, ToolPart,
 };
 use impeller_model::{Impeller, Side};
 use std::sync::{Arc, OnceLock};
@@ -490,4 +490,200 @@ fn approaches_are_rapid_only_outside_the_blank() {
         .find(|m| m.kind == cam_core::MoveKind::Rapid)
         .unwrap();
     assert!((r.cl.tip.z - (to.tip.z + 2.0)).abs() < 1e-9);
+}
+
+/// The T5 roughing cutter of impeller-8+8 (tapered ball R1.5, 2°, 20 mm flutes, Ø6 shank).
+fn t5() -> Tool {
+    tool(
+        CutterShape::TaperedBallEnd {
+            ball_radius: 1.5,
+            half_angle: 2f64.to_radians(),
+        },
+        20.0,
+        3.0,
+        35.0,
+        &[(10.5, 13.5, 38.0), (13.5, 13.5, 42.0)],
+    )
+}
+
+#[test]
+fn cutter_beside_a_splitter_leading_edge_reads_its_penetration() {
+    // A channel-roughing move planned on impeller-8+8 whose flutes cut into splitter 5 beside
+    // its leading edge: the stock simulation measured 0.32 mm of overcut there, while the
+    // blade distance max(d_pressure, d_suction) over-read beside the edge (the pressure side's
+    // closest point lies on its edge) and the query answered +0.04 … +0.31 mm along the move.
+    let q = query(&t5());
+    let a = CutterLocation::new(
+        Point3::new(
+            -1.357_052_190_866_909,
+            -17.350_289_114_561_15,
+            27.050_912_497_983_14,
+        ),
+        Vector3::new(
+            0.037_227_128_397_598_84,
+            -0.900_449_779_238_418_3,
+            0.433_363_976_330_235_3,
+        ),
+    )
+    .unwrap();
+    let b = CutterLocation::new(
+        Point3::new(
+            -0.035_802_192_405_006_04,
+            -17.723_693_619_090_87,
+            26.143_168_263_720_73,
+        ),
+        Vector3::new(
+            0.043_724_916_296_149_33,
+            -0.895_810_786_528_463,
+            0.442_279_511_659_936,
+        ),
+    )
+    .unwrap();
+    let imp = impeller();
+    let split = imp.splitter().unwrap();
+    let ax = |s: f64| CutterLocation {
+        tip: a.tip + (b.tip - a.tip) * s,
+        axis: a.axis.slerp(&b.axis, s),
+    };
+    // Independent reference: flute surface points inside splitter 5 (behind both sides and
+    // below the shroud, by each side's own closest point and normal).
+    let inside_points = |cl: &CutterLocation| {
+        let axis = cl.axis.into_inner();
+        let e1 = axis.cross(&Vector3::x()).normalize();
+        let e2 = axis.cross(&e1);
+        let mut count = 0;
+        for i in 0..=40 {
+            let h = 4.0 + 0.1 * i as f64;
+            let rho = t5().cutter.shape.radius_at(h);
+            for j in 0..90 {
+                let w = j as f64 * std::f64::consts::TAU / 90.0;
+                let p = cl.tip.coords + axis * h + (e1 * w.cos() + e2 * w.sin()) * rho;
+                let local = split.rotation(5).inverse() * p;
+                let blade = split.blade();
+                let (_, dp) =
+                    impeller_model::query::blade_side_distance(blade, Side::Pressure, &local, None);
+                let (_, ds) =
+                    impeller_model::query::blade_side_distance(blade, Side::Suction, &local, None);
+                if dp < -0.01 && ds < -0.01 && imp.shroud().signed_distance(&p) < 0.0 {
+                    count += 1;
+                }
+            }
+        }
+        count
+    };
+    let mid = ax(0.45);
+    assert!(
+        inside_points(&mid) > 0,
+        "the reference finds no flute point inside"
+    );
+    let c = q.clearance(&mid).distance_mm;
+    assert!(c < -0.01, "query {c} mm: the penetration is not seen");
+    assert!(q.segment_clearance(&a, &b, 0.0, 0.005, 64).is_err());
+}
+
+#[test]
+fn retract_along_the_axis_of_a_widening_tool_is_certified_by_its_shape() {
+    // T5 widens from the ball up to the holder: a retract along its axis covers nothing the
+    // cutting posture does not, but the cylinder above the holder's top, far above the blank.
+    let imp = impeller();
+    let linker = Linker::with_blank(
+        SafetySurface::around_stock(imp.stock(), 10.0).unwrap(),
+        imp.stock(),
+    );
+    let t = t5();
+    let q = query(&t);
+    let (p, n) = hub_point_mid_channel(&q);
+    let cl = CutterLocation::new(p + n * 0.3, n).unwrap();
+    let profile = cam_plan::linking::widening_profile(&t.cutter);
+    assert_eq!(profile, Some((115.0, 13.5)));
+    let stats = LinkStats::default();
+    let check = LinkCheck {
+        clearance: &q,
+        profile,
+        stats: &stats,
+        floor_mm: 0.3,
+        tol_mm: 0.005,
+        max_queries: 40,
+    };
+    let (d, certified) = linker.exit_direction(&cl, &check);
+    assert!(certified && (d - n).norm() < 1e-12);
+    // The certificate agrees with sampling: the retract never comes closer than the start.
+    let c0 = q.clearance(&cl).distance_mm;
+    let out = linker.exit_point(&cl, &d).unwrap();
+    for i in 0..=200 {
+        let s = i as f64 / 200.0;
+        let at = CutterLocation {
+            tip: cl.tip + (out.tip - cl.tip) * s,
+            axis: cl.axis,
+        };
+        assert!(q.clearance(&at).distance_mm >= c0 - 1e-9);
+    }
+}
+
+#[test]
+fn retract_leaves_along_a_clear_direction_when_the_axis_would_cut_a_blade() {
+    // A necked ball end (ball R1 on a R0.4 neck: its radius shrinks above the ball, so the
+    // shape certifies nothing) leaning across the channel: the lean is raised until the ball
+    // would cut the neighbouring blade on its way out along the axis while the cutting posture
+    // itself is clear. The checked linker then picks another direction, certified clear, and
+    // the move along it, sampled every 0.05 mm, keeps the clearance asked for (within the
+    // certification tolerance).
+    let imp = impeller();
+    let linker = Linker::new(SafetySurface::around_stock(imp.stock(), 10.0).unwrap());
+    let t = tool(
+        CutterShape::BallEnd { radius: 1.0 },
+        1.0,
+        0.4,
+        30.0,
+        &[(10.0, 10.0, 40.0)],
+    );
+    assert_eq!(cam_plan::linking::widening_profile(&t.cutter), None);
+    let q = query(&t);
+    let (p, n) = hub_point_mid_channel(&q);
+    let e_theta = Vector3::new(-p.y, p.x, 0.0).normalize();
+    let side = (e_theta - n * n.dot(&e_theta)).normalize();
+    let found = (0..=40).find_map(|k| {
+        let lean = (2.0 * k as f64).to_radians();
+        let axis = n * lean.cos() + side * lean.sin();
+        let cl = CutterLocation::new(p + n * 2.0, axis).unwrap();
+        let c0 = q.clearance(&cl).distance_mm;
+        let out = linker.exit_point(&cl, &axis)?;
+        (c0 > 0.2 && q.segment_clearance(&cl, &out, 0.0, 0.005, 400).is_err())
+            .then_some((cl, axis, c0))
+    });
+    let (cl, axis, c0) = found.expect("no lean makes the axis retract cut a blade");
+    let stats = LinkStats::default();
+    let check = LinkCheck {
+        clearance: &q,
+        profile: None,
+        stats: &stats,
+        floor_mm: 0.1,
+        tol_mm: 0.005,
+        max_queries: 40,
+    };
+    let (d, certified) = linker.exit_direction(&cl, &check);
+    assert!(certified);
+    assert!(
+        d.dot(&axis) < 1.0 - 1e-6,
+        "expected a direction off the axis"
+    );
+    let out = linker.exit_point(&cl, &d).unwrap();
+    assert!(linker.leaves_clear(&out));
+    let floor = c0.min(0.1) - 0.005;
+    let len = (out.tip - cl.tip).norm();
+    let k = (len / 0.05).ceil() as usize;
+    for i in 0..=k {
+        let s = i as f64 / k as f64;
+        let at = CutterLocation {
+            tip: cl.tip + (out.tip - cl.tip) * s,
+            axis: cl.axis,
+        };
+        let c = q.clearance(&at).distance_mm;
+        assert!(c >= floor - 1e-9, "clearance {c} at {s} below {floor}");
+    }
+    // The checked link from this posture to itself leaves and comes back that way.
+    let moves = linker.link_checked(&cl, &cl, 2.0, &check).unwrap();
+    assert_eq!(moves.last().unwrap().cl, cl);
+    assert_eq!(stats.uncertified(), 0);
+    assert!(stats.turned() >= 2);
 }

@@ -64,6 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         process: &process,
         clearance: &clearance,
         linker: &linker,
+        links: &cam_plan::LinkStats::default(),
     };
     let op = channel_paths::build_blade_root_finishing(&OperationSpec {
         name: "root".into(),

@@ -1081,11 +1081,8 @@ impl Operation for HubFinishing {
                                 path.moves.push(Move::feed(first.cl));
                                 cross_links += 1;
                             } else {
-                                path.moves.extend(ctx.linker.link(
-                                    &last.cl,
-                                    &first.cl,
-                                    APPROACH_MM,
-                                )?);
+                                path.moves
+                                    .extend(ctx.link(&last.cl, &first.cl, APPROACH_MM)?);
                             }
                         }
                     }
@@ -1104,7 +1101,7 @@ impl Operation for HubFinishing {
                 ),
             ));
         }
-        ctx.linker.close(&mut path, APPROACH_MM)?;
+        ctx.close(&mut path, APPROACH_MM)?;
         let count = imp.main().count();
         let pitch = std::f64::consts::TAU / count.max(1) as f64;
         let order = cam_plan::order::angular_sequence(count, 0);

@@ -80,6 +80,7 @@ fn rough_default_impeller_within_scallop_and_clear_of_blades() {
         process: &proc_,
         clearance: &clearance,
         linker: &linker,
+        links: &cam_plan::LinkStats::default(),
     };
     let op = build_channel_roughing(&spec("scallop_mm = 0.3")).unwrap();
     let plan = op.plan(&ctx).unwrap();

@@ -71,6 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         process: &process,
         clearance: &clearance,
         linker: &linker,
+        links: &cam_plan::LinkStats::default(),
     };
     let spec = OperationSpec {
         name: "flank".into(),

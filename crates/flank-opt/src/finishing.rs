@@ -598,15 +598,13 @@ impl FlankFinishing {
             let moves: Vec<Move> = res.locations.iter().map(|cl| Move::feed(*cl)).collect();
             if let (Some(last), Some(first)) = (one_path.moves.last(), moves.first()) {
                 let link = ctx
-                    .linker
                     .link(&last.cl, &first.cl, APPROACH_MM)
                     .map_err(|e| FlankError::Geometry(e.to_string()))?;
                 one_path.moves.extend(link);
             }
             one_path.moves.extend(moves);
         }
-        ctx.linker
-            .close(&mut one_path, APPROACH_MM)
+        ctx.close(&mut one_path, APPROACH_MM)
             .map_err(|e| FlankError::Geometry(e.to_string()))?;
         // The accuracy gate: a finishing pass that misses its tolerances is not emitted.
         let pr = &run.problem;

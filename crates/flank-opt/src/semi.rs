@@ -200,7 +200,6 @@ impl FlankSemiFinishing {
                 let moves: Vec<Move> = pass.locations.iter().map(|cl| Move::feed(*cl)).collect();
                 if let (Some(last), Some(first)) = (path.moves.last(), moves.first()) {
                     let link = ctx
-                        .linker
                         .link(&last.cl, &first.cl, 5.0)
                         .map_err(|e| FlankError::Geometry(e.to_string()))?;
                     path.moves.extend(link);
@@ -209,8 +208,7 @@ impl FlankSemiFinishing {
             }
         }
         let flank_len = path.cutting_length_mm();
-        ctx.linker
-            .close(&mut path, 5.0)
+        ctx.close(&mut path, 5.0)
             .map_err(|e| FlankError::Geometry(e.to_string()))?;
         let count = ctx.impeller.main().count();
         let order: Vec<usize> = (0..count).collect();

@@ -62,6 +62,8 @@ pub struct Job {
     pub tolerances: Tolerances,
     /// The safety surface of linking moves.
     pub safety: SafetySpec,
+    /// The stock the job's operations start from (`[stock]`).
+    pub stock: StockStart,
     /// Verification settings.
     pub verification: VerificationSpec,
     /// Post-processing settings (`[post]`).
@@ -116,6 +118,41 @@ impl Default for SafetySpec {
     }
 }
 
+/// The stock a job's operations start from (`[stock]`).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct StockStart {
+    /// `"blank"` (the impeller file's blank, default) or `"turned"`: the blank after the
+    /// turning steps of a turn-mill process plan (paper 003, Table 1, steps 1–3: facing,
+    /// rough and finish turning of the outside contour), i.e. faced at the design's top and
+    /// turned to the shroud contour plus `turning_allowance_mm`
+    /// (`impeller_model::Impeller::turned_stock`).
+    pub start: StockStartKind,
+    /// Material the turning leaves over the shroud contour and the top (mm, ≥ 0; default 0:
+    /// finish-turned blade tips).
+    pub turning_allowance_mm: f64,
+}
+
+/// Which stock a job starts from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StockStartKind {
+    /// The impeller file's blank.
+    #[default]
+    Blank,
+    /// The blank faced and turned to the shroud contour.
+    Turned,
+}
+
+impl Default for StockStart {
+    fn default() -> Self {
+        Self {
+            start: StockStartKind::Blank,
+            turning_allowance_mm: 0.0,
+        }
+    }
+}
+
 /// Post-processing settings of a job (`[post]`).
 #[derive(Debug, Clone, Copy, Default, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -163,6 +200,8 @@ struct RawJob {
     tolerances: Option<RawTolerances>,
     #[serde(default)]
     safety: SafetySpec,
+    #[serde(default)]
+    stock: StockStart,
     #[serde(default)]
     verification: VerificationSpec,
     #[serde(default)]
@@ -747,6 +786,22 @@ impl Job {
             "safety.clearance_mm",
             raw.safety.clearance_mm,
         )?;
+        let ta = raw.stock.turning_allowance_mm;
+        if !(ta.is_finite() && ta >= 0.0) {
+            let line = line_of(
+                text,
+                &[
+                    Seg::Key("stock".into()),
+                    Seg::Key("turning_allowance_mm".into()),
+                ],
+            );
+            return Err(at(
+                path,
+                line,
+                "stock.turning_allowance_mm",
+                format!("must be a number >= 0, got {ta}"),
+            ));
+        }
         let v = raw.verification;
         check_positive(
             path,
@@ -882,6 +937,7 @@ impl Job {
             dialect: raw.dialect,
             tolerances,
             safety: raw.safety,
+            stock: raw.stock,
             verification: v,
             post: raw.post,
             quiet: false,

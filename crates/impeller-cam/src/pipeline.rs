@@ -13,14 +13,14 @@
 //! nothing to do say so in the report's `notes` instead of inventing output.
 
 use crate::error::CliError;
-use crate::job::Job;
+use crate::job::{Job, StockStartKind};
 use crate::progress::Progress;
 use crate::registry::{self, Registry};
 use crate::report::{OperationReport, PostOperationReport, PostReport, Report, VerificationReport};
 use cam_core::{Cutter, CutterLocation, MoveKind, Rates, ToolPath};
 use cam_plan::clearance::DesignMesh;
 use cam_plan::{
-    ClearanceOptions, DesignClearance, Linker, Metrics, PlanContext, PlanError, Plot,
+    ClearanceOptions, DesignClearance, LinkStats, Linker, Metrics, PlanContext, PlanError, Plot,
     SafetySurface, Tool,
 };
 use gcode_emit::assemble::{assemble_program_with_access, AssembledProgram, OperationAccess};
@@ -278,14 +278,25 @@ fn read_back_program(
     Ok(Some(paths))
 }
 
-/// Stage 1: the job's impeller (the embedded default when it names none).
+/// Stage 1: the job's impeller (the embedded default when it names none), on the stock the
+/// job starts from (`[stock]`: the impeller file's blank, or that blank turned to the shroud
+/// contour).
 pub fn model(job: &Job) -> Result<Impeller, CliError> {
-    match &job.impeller {
+    let impeller = match &job.impeller {
         Some(p) if job.is_embedded(p) => {
             impeller_model::from_toml_str(&job.read_text(p)?, p).map_err(msg)
         }
         Some(p) => impeller_model::load(p).map_err(msg),
         None => impeller_model::fixtures::default_impeller().map_err(msg),
+    }?;
+    match job.stock.start {
+        StockStartKind::Blank => Ok(impeller),
+        StockStartKind::Turned => {
+            let stock = impeller
+                .turned_stock(job.stock.turning_allowance_mm)
+                .map_err(|e| CliError::Message(format!("[stock] start = \"turned\": {e}")))?;
+            Ok(impeller.with_stock(stock))
+        }
     }
 }
 
@@ -330,6 +341,7 @@ pub fn plan(
             let clearance =
                 DesignClearance::with_mesh(impeller, mesh, tool, clearance_options(job))
                     .map_err(|e| fail(rename(e, &spec.name)))?;
+            let links = LinkStats::default();
             let ctx = PlanContext {
                 impeller,
                 stock: impeller.stock(),
@@ -338,11 +350,30 @@ pub fn plan(
                 process: &spec.process,
                 clearance: &clearance,
                 linker: &linker,
+                links: &links,
             };
-            let planned = op.plan(&ctx).map_err(fail)?;
+            let mut planned = op.plan(&ctx).map_err(fail)?;
             let mut path = linker
-                .join(&spec.name, tool.name(), &planned.paths, LINK_APPROACH_MM)
+                .join_checked(
+                    &spec.name,
+                    tool.name(),
+                    &planned.paths,
+                    LINK_APPROACH_MM,
+                    &ctx.link_check(),
+                )
                 .map_err(|e| fail(rename(e, &spec.name)))?;
+            let (uncertified, turned) = (links.uncertified(), links.turned());
+            planned
+                .metrics
+                .number("uncertified_links", uncertified as f64)
+                .number("links_off_axis", turned as f64);
+            if uncertified > 0 {
+                planned.notes.push(format!(
+                    "{uncertified} retract(s)/approach(es) could not be certified clear of the \
+                     design in any direction tried; they follow the tool axis (see the \
+                     verification)"
+                ));
+            }
             let rates = ctx.rates();
             set_feeds(&mut path, &rates);
             let plan_ms = ms(t);

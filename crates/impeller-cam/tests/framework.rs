@@ -263,3 +263,41 @@ fn kind_key_errors_name_file_line_and_key() {
     let err = parse_err(&text);
     assert!(err.contains("depth_mm") && err.contains("ring"), "{err}");
 }
+
+#[test]
+fn a_turned_start_stock_follows_the_shroud_and_bad_keys_are_named() {
+    // `[stock] start = "turned"`: the blank faced at the design's top (43 mm) and turned to
+    // the shroud contour (outer radius 38.5 mm at the outlet, 22 mm at the inlet) instead of
+    // the file's Ø79 × 44 cylinder.
+    let stock = "[stock]\nstart = \"turned\"\n\n";
+    let dir = scratch("turned");
+    let path = dir.join("job.toml");
+    std::fs::write(&path, job_text(stock)).unwrap();
+    let job = Job::from_file_with(&path, TEST_REGISTRY).unwrap();
+    let imp = impeller_cam::pipeline::model(&job).unwrap();
+    let s = imp.stock();
+    assert!((s.z_range().1 - 43.0).abs() < 1e-9, "{:?}", s.z_range());
+    assert!((s.max_radius() - 38.5).abs() < 0.01, "{}", s.max_radius());
+    assert!((s.radius_at(42.9).unwrap() - 22.0).abs() < 0.05);
+    // The shroud contour lies inside the turned stock.
+    let shroud = imp.shroud().meridional();
+    for k in 0..=64 {
+        let p = shroud.point_at_fraction(k as f64 / 64.0);
+        assert!(s.radius_at(p.x).unwrap() >= p.y - 1e-9, "at z {}", p.x);
+    }
+    // The default starts from the file's blank.
+    std::fs::write(&path, job_text("")).unwrap();
+    let job = Job::from_file_with(&path, TEST_REGISTRY).unwrap();
+    let imp = impeller_cam::pipeline::model(&job).unwrap();
+    assert!((imp.stock().max_radius() - 39.5).abs() < 1e-9);
+    // A negative allowance is named with file, line and key; an unknown start kind too.
+    let text = job_text("[stock]\nstart = \"turned\"\nturning_allowance_mm = -1.0\n\n");
+    let err = parse_err(&text);
+    let line = line_of(&text, "turning_allowance_mm");
+    assert!(
+        err.contains(&format!("job.toml:{line}: stock.turning_allowance_mm")),
+        "{err}"
+    );
+    let err = parse_err(&job_text("[stock]\nstart = \"lathe\"\n\n"));
+    assert!(err.contains("job.toml:") && err.contains("lathe"), "{err}");
+}

@@ -141,6 +141,25 @@ impl Impeller {
         &self.stock
     }
 
+    /// The same impeller on another blank (e.g. the blank after turning, [`Stock::turned`]).
+    pub fn with_stock(mut self, stock: Stock) -> Self {
+        self.stock = stock;
+        self
+    }
+
+    /// The blank faced at the design's top and turned to the shroud contour plus
+    /// `allowance_mm` ([`Stock::turned`], 256 contour samples): the stock five-axis milling
+    /// starts from after the turning steps of a turn-mill process plan.
+    pub fn turned_stock(&self, allowance_mm: f64) -> Result<Stock, ModelError> {
+        let h = self.hub.meridional();
+        let s = self.shroud.meridional();
+        let top = [h.point_at_fraction(0.0).x, h.point_at_fraction(1.0).x]
+            .into_iter()
+            .chain([s.point_at_fraction(0.0).x, s.point_at_fraction(1.0).x])
+            .fold(f64::NEG_INFINITY, f64::max);
+        Stock::turned(&self.stock, s, top, allowance_mm, 256)
+    }
+
     /// Every blade in +θ order: main 0, splitter 0, main 1, splitter 1, ... (main only when
     /// there are no splitters), each as its own rotated surfaces.
     pub fn blades_in_order(&self) -> Vec<Blade> {

@@ -96,6 +96,7 @@ fn channel(c: &mut Criterion) {
         process: &process,
         clearance: &clearance,
         linker: &linker,
+        links: &cam_plan::LinkStats::default(),
     };
     let mut g = c.benchmark_group("plan");
     g.sample_size(10);

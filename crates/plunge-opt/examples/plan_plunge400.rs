@@ -131,6 +131,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             process: &process,
             clearance: &clearance,
             linker: &linker,
+            links: &cam_plan::LinkStats::default(),
         };
         let t0 = std::time::Instant::now();
         let planned = op.plan(&ctx)?;

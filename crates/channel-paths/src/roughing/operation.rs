@@ -373,7 +373,7 @@ impl ChannelRoughing {
             for area in &lc.moves {
                 let Some(first) = area.first() else { continue };
                 if let Some(prev) = last {
-                    path.moves.extend(ctx.linker.link(&prev, &first.cl, doc)?);
+                    path.moves.extend(ctx.link(&prev, &first.cl, doc)?);
                     path.moves.extend(area.iter().skip(1).copied());
                 } else {
                     path.moves.extend(area.iter().copied());
@@ -381,7 +381,7 @@ impl ChannelRoughing {
                 last = area.last().map(|m| m.cl);
             }
         }
-        ctx.linker.close(&mut path, doc)?;
+        ctx.close(&mut path, doc)?;
         let count = imp.main().count();
         let order = cam_plan::order::angular_sequence(count, 0);
         let paths = cam_plan::pattern::copy_to(&path, imp.main().pitch_rad(), &order);

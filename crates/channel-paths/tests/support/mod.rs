@@ -127,6 +127,7 @@ macro_rules! plan_ctx {
             process: &$c.process,
             clearance: &$cl,
             linker: &$c.linker,
+            links: &cam_plan::LinkStats::default(),
         }
     };
 }
