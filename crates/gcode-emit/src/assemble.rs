@@ -10,7 +10,9 @@
 //!    posted, so the axis limits are checked and the plane's machine angles are known);
 //! 3. otherwise the moves go through `postproc-kinematics`' [`post_path`] (inverse kinematics
 //!    with continuity from the previous operation's last posture, limits, unwinding;
-//!    linearisation control only for joint output, where the controller interpolates joints;
+//!    linearisation control only for joint output, where the controller interpolates joints,
+//!    of the tip and of the top of the flutes of an operation with a cutter
+//!    ([`PostOptions::check_height_mm`] raised to its flute length);
 //!    inverse-time feeds), and each posted block becomes an [`NcMove`]: joint values in
 //!    [`OutputMode::Joint`] (all cutting blocks in inverse time), tool tip + axis angles in
 //!    [`OutputMode::TcpAngles`], tool tip + tool vector in [`OutputMode::TcpVector`].
@@ -235,6 +237,12 @@ pub fn assemble_program_with_access(
         post.initial = posture;
         if let Some(tl) = op.tool_length_mm {
             post.tool_length = tl;
+        }
+        // The flutes cut along their whole length: keep the top of the cutting part on its
+        // path too (joint interpolation near the singular direction swings the axis while
+        // the tip stays on its line).
+        if let Some(c) = &op.cutter {
+            post.check_height_mm = post.check_height_mm.max(c.flute_length);
         }
         if fixed && indexed_ok {
             // Post the moves anyway: checks every block against the axis limits and gives

@@ -41,6 +41,12 @@ pub struct PostOptions {
     pub linearisation_tol: Option<f64>,
     /// Interior samples per segment for the deviation (default 8).
     pub linearisation_samples: usize,
+    /// Height above the tip (mm) along the tool axis whose deviation is kept within
+    /// `linearisation_tol` too (default 0: the tip only). Set it to the top of the cutting
+    /// part (the flute length): near the rotary axis' singular direction joint interpolation
+    /// turns the axis off its great circle while the tip stays on the line, and the flutes
+    /// cut beside the path ([`crate::linearise::segment_deviation`]).
+    pub check_height_mm: f64,
     /// Largest bisection depth per block (default 16). Only the pieces still above the
     /// tolerance are bisected again, so the cost grows with the depth only where the tool
     /// axis passes close to the rotary axis' singular direction: there a few hundredths of a
@@ -74,6 +80,7 @@ impl Default for PostOptions {
             limit_policy: LimitPolicy::Error,
             linearisation_tol: Some(0.005),
             linearisation_samples: 8,
+            check_height_mm: 0.0,
             max_subdivision_depth: 16,
             tool_centre_point: false,
             linearise_rapids: false,
@@ -100,6 +107,9 @@ impl PostOptions {
             if !(t.is_finite() && t > 0.0) {
                 return bad("linearisation_tol", "must be finite and > 0");
             }
+        }
+        if !(self.check_height_mm.is_finite() && self.check_height_mm >= 0.0) {
+            return bad("check_height_mm", "must be finite and >= 0");
         }
         if self.linearisation_samples == 0 {
             return bad("linearisation_samples", "must be >= 1");
@@ -316,6 +326,7 @@ pub fn post_path_checked(
     let mut max_err: f64 = 0.0;
     let settings = LinearisationSettings {
         tol: options.linearisation_tol.unwrap_or(f64::INFINITY),
+        height: options.check_height_mm,
         samples: options.linearisation_samples,
         max_depth: if options.linearisation_tol.is_some() {
             options.max_subdivision_depth
@@ -347,10 +358,11 @@ pub fn post_path_checked(
                 machine,
                 &p.joints,
                 &b.joints,
-                &p.cl.tip,
-                &b.cl.tip,
+                &p.cl,
+                &b.cl,
                 tl,
                 options.linearisation_samples,
+                options.check_height_mm,
             )
         })
         .collect();
@@ -396,10 +408,11 @@ pub fn post_path_checked(
                         machine,
                         &p.joints,
                         &b.joints,
-                        &p.cl.tip,
-                        &b.cl.tip,
+                        &p.cl,
+                        &b.cl,
                         tl,
                         options.linearisation_samples,
+                        options.check_height_mm,
                     )
                 }
                 Err(source) => {

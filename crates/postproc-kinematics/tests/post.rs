@@ -635,3 +635,55 @@ fn rapid_leaving_the_singular_direction_is_linearised() {
     }
     assert!(worst <= tol * 1.0001, "dense deviation {worst}");
 }
+
+#[test]
+fn an_axis_sweep_past_the_singular_direction_reports_the_flutes_off_path() {
+    // The semi-finishing move of impeller-8+8 that cut a blade on xyzac-trt: the tip moves
+    // 2.9 mm while the tool axis sweeps from 7° off +Z on one side to 2° off on the other,
+    // passing about 1° from the table's axis (the singular direction). Joint interpolation
+    // keeps the tip on its line, but the axis can only follow the great circle with a C swing
+    // the linearisation replaces by interpolated angles: the flutes 20 mm up leave the path.
+    // With the flute top checked the post reports that deviation (the tip alone hid it).
+    let m = fixture("xyzac-trt");
+    let a = CutterLocation::new(
+        Point3::new(28.98, 20.727, 5.659),
+        Vector3::new(0.084, 0.0861, 0.9927),
+    )
+    .unwrap();
+    let b = CutterLocation::new(
+        Point3::new(31.3368, 22.3528, 5.4548),
+        Vector3::new(-0.0309, 0.0209, 0.9993),
+    )
+    .unwrap();
+    let tip_only = post_locations(&m, &[a, b], &PostOptions::default()).unwrap();
+    assert!(tip_only.metrics.max_linearisation_error_mm <= 0.005 + 1e-12);
+    let flutes = PostOptions {
+        check_height_mm: 20.0,
+        ..Default::default()
+    };
+    let posted = post_locations(&m, &[a, b], &flutes).unwrap();
+    let err = posted.metrics.max_linearisation_error_mm;
+    assert!(err > 0.1, "flute-top deviation {err} mm not reported");
+    // Dense check of what is reported: the flute top of the interpolated joints, against the
+    // intended sweep (tip linear, axis on the great circle), is off by about that much.
+    let mut worst: f64 = 0.0;
+    for w in posted.blocks.windows(2) {
+        for k in 0..=16 {
+            let s = k as f64 / 16.0;
+            let c = m.forward(&w[0].joints.lerp(&w[1].joints, s), 0.0);
+            let top = c.tip + c.axis.into_inner() * 20.0;
+            let d = (0..=400)
+                .map(|i| {
+                    let t = i as f64 / 400.0;
+                    let cl = postproc_kinematics::linearise::interpolate_cl(&a, &b, t);
+                    (cl.tip + cl.axis.into_inner() * 20.0 - top).norm()
+                })
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(d);
+        }
+    }
+    assert!(
+        worst > 0.5 * err && worst < 2.0 * err + 0.01,
+        "dense {worst} vs reported {err}"
+    );
+}
