@@ -32,10 +32,6 @@ static EMBEDDED_FILES: &[(&str, &str)] = &[
         include_str!("../embedded/impeller-8+8/impeller.toml"),
     ),
     (
-        "<embedded>/fixtures/impeller-8+8/top-ring.cls",
-        include_str!("../embedded/impeller-8+8/top-ring.cls"),
-    ),
-    (
         "<embedded>/fixtures/impeller-8+8/../machines/xyzac-trt.toml",
         include_str!("../embedded/machines/xyzac-trt.toml"),
     ),

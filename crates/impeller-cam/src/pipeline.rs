@@ -215,9 +215,10 @@ const READBACK_PATH_TOL_MM: f64 = 0.001;
 /// really moves: LinuxCNC joint output, every block (rapids, approach, retract, tool-change
 /// moves, linearisation blocks) through the forward kinematics with joint interpolation,
 /// cut into chords within 1 µm of that motion. Operation `k` is the program from its `k`-th
-/// tool change (`M6`) to the next. `None` (the posted cutter locations are verified instead)
-/// for other dialects and output modes, whose syntax the reader does not cover, or when the
-/// tool changes do not match the operations.
+/// tool change (`M6`) to the next, or — when operations share a tool — from its header
+/// comment to the next. `None` (the posted cutter locations are verified instead) for other
+/// dialects and output modes, whose syntax the reader does not cover, or when neither marks
+/// every operation.
 fn read_back_program(
     job: &Job,
     program: &Path,
@@ -241,9 +242,33 @@ fn read_back_program(
         })
         .map(|(i, _)| i + 1)
         .collect();
-    if starts.len() != operations.len() {
-        return Ok(None);
-    }
+    // Consecutive operations with the same tool share one tool change: then each
+    // operation's header comment `(<name> - T<n> …)` marks where it starts.
+    let starts = if starts.len() == operations.len() {
+        starts
+    } else {
+        let mut found = Vec::with_capacity(operations.len());
+        let mut from = 0;
+        for op in operations {
+            let head = format!(
+                "({} - T{}",
+                op.cl.path.name,
+                op.cl.tool_number.unwrap_or_default()
+            );
+            let Some(i) = text
+                .lines()
+                .enumerate()
+                .skip(from)
+                .find(|(_, l)| l.trim_start().starts_with(&head))
+                .map(|(i, _)| i)
+            else {
+                return Ok(None);
+            };
+            found.push(i + 1);
+            from = i + 1;
+        }
+        found
+    };
     let machine = load_machine(job)?;
     let blocks = gcode_emit::read_gcode(&text, &file).map_err(msg)?;
     let mut paths = Vec::with_capacity(operations.len());
