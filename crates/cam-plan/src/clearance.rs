@@ -64,7 +64,7 @@ use impeller_model::query::blade_side_distance;
 use impeller_model::{BladeSet, Impeller, Side};
 use parry3d_f64::math::{Pose, Rotation, Vector as PVec};
 use parry3d_f64::query::{self, PointQueryWithLocation};
-use parry3d_f64::shape::{ConvexPolyhedron, TriMesh};
+use parry3d_f64::shape::{CompositeShapeRef, ConvexPolyhedron, TriMesh};
 use std::sync::Arc;
 
 /// Default sampling tolerance of the swept balls (mm): the largest rim band between two
@@ -235,6 +235,11 @@ pub struct DesignMesh {
     blades: TriMesh,
     /// (row, instance) of each blade triangle.
     blade_of: Vec<(Row, usize)>,
+    /// The blade sides whole, including where they reach past the shroud contour (the exact
+    /// side distances measure to them there).
+    blade_sides: TriMesh,
+    /// (row, instance) of each triangle of `blade_sides`.
+    side_of: Vec<(Row, usize)>,
     chord_mm: f64,
     thickest_blade_mm: f64,
 }
@@ -320,9 +325,11 @@ impl DesignMesh {
         let hub = TriMesh::new(hub_v, hub_t)
             .map_err(|e| PlanError::geometry("-", "hub mesh", format!("{e:?}")))?;
 
-        let mut vertices: Vec<PVec> = Vec::new();
-        let mut triangles: Vec<[u32; 3]> = Vec::new();
-        let mut blade_of = Vec::new();
+        // Every instance of each row's sides: clipped at the shroud (the material, for the
+        // shank and holder) and whole (as far as the exact side distances reach, for the
+        // cutter samples' bounds).
+        let mut clipped = BladeTriangles::default();
+        let mut whole = BladeTriangles::default();
         let mut thickest: f64 = 0.0;
         let rows = std::iter::once((Row::Main, impeller.main()))
             .chain(impeller.splitter().map(|s| (Row::Splitter, s)));
@@ -330,24 +337,9 @@ impl DesignMesh {
             let blade = set.blade();
             for side in [Side::Pressure, Side::Suction] {
                 let name = format!("{row:?} blade {side:?} side");
-                let sm = clip_at_shroud(
-                    impeller,
-                    &tessellate(blade.side(side), chord, &name).map_err(mesh_err)?,
-                );
-                for k in 0..set.count() {
-                    let rot = set.rotation(k);
-                    let base = vertices.len() as u32;
-                    vertices.extend(sm.vertices.iter().map(|v| {
-                        let q = rot * v;
-                        PVec::new(q.x, q.y, q.z)
-                    }));
-                    triangles.extend(
-                        sm.triangles
-                            .iter()
-                            .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
-                    );
-                    blade_of.extend(std::iter::repeat_n((row, k), sm.triangles.len()));
-                }
+                let sm = tessellate(blade.side(side), chord, &name).map_err(mesh_err)?;
+                clipped.add_instances(&clip_at_shroud(impeller, &sm), row, set);
+                whole.add_instances(&sm, row, set);
             }
             // Thickest blade: suction-side distance of pressure-side grid points.
             let ps = blade.side(Side::Pressure);
@@ -364,12 +356,19 @@ impl DesignMesh {
                 }
             }
         }
-        let blades = TriMesh::new(vertices, triangles)
-            .map_err(|e| PlanError::geometry("-", "blade mesh", format!("{e:?}")))?;
+        let blade_mesh = |t: BladeTriangles| {
+            TriMesh::new(t.vertices, t.triangles)
+                .map(|m| (m, t.blade_of))
+                .map_err(|e| PlanError::geometry("-", "blade mesh", format!("{e:?}")))
+        };
+        let (blades, blade_of) = blade_mesh(clipped)?;
+        let (blade_sides, side_of) = blade_mesh(whole)?;
         Ok(Self {
             hub,
             blades,
             blade_of,
+            blade_sides,
+            side_of,
             chord_mm: chord,
             thickest_blade_mm: thickest,
         })
@@ -385,6 +384,23 @@ impl DesignMesh {
         self.thickest_blade_mm
     }
 
+    /// Unsigned distance from `p` to the nearest triangle of the whole blade sides and the
+    /// blade it belongs to when it is below `max_dist`, else `None` (the search prunes every
+    /// BVH node beyond `max_dist`: cheap far from the blades). O(log T).
+    fn side_mesh_distance_within(&self, p: &Point3, max_dist: f64) -> Option<(f64, DesignPart)> {
+        let q = pv(p);
+        let (tri, proj, _) = CompositeShapeRef(&self.blade_sides)
+            .project_local_point_and_get_location(q, max_dist, false)?;
+        let part = self
+            .side_of
+            .get(tri as usize)
+            .map_or(DesignPart::Hub, |&(row, index)| DesignPart::Blade {
+                row,
+                index,
+            });
+        Some(((proj.point - q).length(), part))
+    }
+
     /// Unsigned distance from `p` to the nearest blade side triangle and the blade it
     /// belongs to. O(log T).
     fn blade_mesh_distance(&self, p: &Point3) -> (f64, DesignPart) {
@@ -398,6 +414,40 @@ impl DesignMesh {
                 index,
             });
         ((proj.point - q).length(), part)
+    }
+}
+
+/// Triangles of blade sides copied to every instance of their rows.
+#[derive(Default)]
+struct BladeTriangles {
+    vertices: Vec<PVec>,
+    triangles: Vec<[u32; 3]>,
+    blade_of: Vec<(Row, usize)>,
+}
+
+impl BladeTriangles {
+    /// Adds `mesh` (of the reference blade) at every instance of `set`.
+    fn add_instances(
+        &mut self,
+        mesh: &impeller_model::export::stl::TriMesh,
+        row: Row,
+        set: &BladeSet,
+    ) {
+        for k in 0..set.count() {
+            let rot = set.rotation(k);
+            let base = self.vertices.len() as u32;
+            self.vertices.extend(mesh.vertices.iter().map(|v| {
+                let q = rot * v;
+                PVec::new(q.x, q.y, q.z)
+            }));
+            self.triangles.extend(
+                mesh.triangles
+                    .iter()
+                    .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+            );
+            self.blade_of
+                .extend(std::iter::repeat_n((row, k), mesh.triangles.len()));
+        }
     }
 }
 
@@ -596,6 +646,8 @@ impl<'a> DesignClearance<'a> {
             }
             h = next;
         }
+        // By height: the blade search bisects runs of neighbouring samples.
+        samples.sort_by(|a, b| a.0.total_cmp(&b.0));
         let chord = mesh.chord_mm;
         let frusta = c
             .frusta(chord)
@@ -714,40 +766,14 @@ impl<'a> DesignClearance<'a> {
         best
     }
 
-    /// The blade distance a ball of radius `rho` about `p` needs: exact within
-    /// [`EXACT_BAND_MM`] of the ball, else the mesh's lower bound (see the module docs);
-    /// also using the mesh bound when it shows the
-    /// ball's clearance `d − ρ` is at least `need` (it cannot lower a minimum already at
-    /// `need`, nor fail a check against it).
-    fn blade_distance_below(&self, p: &Point3, rho: f64, need: f64) -> (f64, DesignPart) {
-        let (dm, part) = self.mesh.blade_mesh_distance(p);
-        let c = self.mesh.chord_mm;
-        let outside = dm - c - 0.5 * self.mesh.thickest_blade_mm >= 0.0;
-        if (outside && dm - c - rho >= need)
-            || dm - c - 0.5 * self.mesh.thickest_blade_mm >= rho + EXACT_BAND_MM
-        {
-            (dm - c, part)
-        } else {
-            self.blade_signed_distance(p)
-        }
-    }
-
     /// Signed distance of the selected design parts at `p` (negative inside material; for
     /// the shroud, negative beyond it) and the nearest part. Exact (NURBS).
     pub fn design_signed_distance(&self, p: &Point3) -> (f64, DesignPart) {
-        self.design_distance_for(p, f64::INFINITY)
+        self.parts_signed_distance(&self.options.parts, p)
     }
 
-    /// [`DesignClearance::design_signed_distance`] for a ball of radius `rho` about `p`:
-    /// blade distances more than [`EXACT_BAND_MM`] beyond the ball may be mesh lower bounds.
-    fn design_distance_for(&self, p: &Point3, rho: f64) -> (f64, DesignPart) {
-        self.design_distance_below(p, rho, f64::INFINITY)
-    }
-
-    /// [`DesignClearance::design_distance_for`] where only clearances `d − ρ` below `need`
-    /// must be exact (see [`DesignClearance::blade_distance_below`]).
-    fn design_distance_below(&self, p: &Point3, rho: f64, need: f64) -> (f64, DesignPart) {
-        let parts = self.options.parts;
+    /// [`Self::design_signed_distance`] of the parts `parts`.
+    fn parts_signed_distance(&self, parts: &PartSet, p: &Point3) -> (f64, DesignPart) {
         let mut best = (f64::INFINITY, DesignPart::Hub);
         if parts.hub {
             best = (self.hub_signed_distance(p), DesignPart::Hub);
@@ -759,11 +785,7 @@ impl<'a> DesignClearance<'a> {
             }
         }
         if parts.blades {
-            let b = if rho.is_finite() {
-                self.blade_distance_below(p, rho, need.min(best.0 - rho))
-            } else {
-                self.blade_signed_distance(p)
-            };
+            let b = self.blade_signed_distance(p);
             if b.0 < best.0 {
                 best = b;
             }
@@ -860,67 +882,256 @@ impl<'a> DesignClearance<'a> {
         Ok(())
     }
 
-    /// The clearance at `cl`; with `stop_below`, returns as soon as a part is found below it.
-    fn evaluate(&self, cl: &CutterLocation, stop_below: Option<f64>) -> Clearance {
+    /// The clearance of the reference method: every cutter sample measured, with the exact
+    /// blade distance wherever the blade mesh comes within [`EXACT_BAND_MM`] of its ball (else
+    /// the mesh's lower bound, as in [`Self::clearance`]) and no pruning; then the shroud
+    /// samples and the shank and holder frusta as [`Self::clearance`] measures them. The
+    /// fast query is a lower bound of this answer and equals it where it lies within
+    /// [`EXACT_BAND_MM`]; kept for the tests that check so. Cost: O(L / s) mesh queries and
+    /// as many exact blade projections as samples in the band.
+    #[doc(hidden)]
+    pub fn clearance_exhaustive(&self, cl: &CutterLocation) -> Clearance {
         let axis: Vector3 = cl.axis.into_inner();
-        let mut best = Clearance {
-            distance_mm: f64::INFINITY,
-            design_part: DesignPart::Hub,
-            tool_part: ToolPart::Cutter,
-            height_mm: 0.0,
-        };
-        let failed = |b: &Clearance| stop_below.is_some_and(|m| b.distance_mm < m);
+        let parts = self.options.parts;
+        let c = self.mesh.chord_mm;
+        let half_t = 0.5 * self.mesh.thickest_blade_mm;
+        let mut best = NO_CLEARANCE;
         for &(h, rho, part) in &self.samples {
             if h <= self.options.above_mm {
                 continue;
             }
-            // Exact only where this sample could lower the answer (or fail the check).
-            let need = stop_below.map_or(best.distance_mm, |m| m.min(best.distance_mm));
-            let (d, dp) = self.design_distance_below(&(cl.tip + axis * h), rho, need);
-            if d - rho < best.distance_mm {
+            let p = cl.tip + axis * h;
+            let mut d = self.parts_signed_distance(
+                &PartSet {
+                    blades: false,
+                    ..parts
+                },
+                &p,
+            );
+            if parts.blades {
+                let (dm, dp) = self
+                    .mesh
+                    .side_mesh_distance_within(&p, f64::INFINITY)
+                    .unwrap_or((f64::INFINITY, DesignPart::Hub));
+                let b = if dm - c - half_t >= rho + EXACT_BAND_MM {
+                    (dm - c, dp)
+                } else {
+                    self.blade_signed_distance(&p)
+                };
+                if b.0 < d.0 {
+                    d = b;
+                }
+            }
+            if d.0 - rho < best.distance_mm {
                 best = Clearance {
-                    distance_mm: d - rho,
-                    design_part: dp,
+                    distance_mm: d.0 - rho,
+                    design_part: d.1,
                     tool_part: part,
                     height_mm: h,
                 };
-                if failed(&best) {
-                    return best;
-                }
             }
         }
-        if self.options.parts.shroud {
-            for &(h, rho, part) in &self.upper_samples {
-                let d = self.shroud_signed_distance(&(cl.tip + axis * h));
-                if d - rho < best.distance_mm {
+        self.upper_and_frusta(cl, None, &mut best);
+        best
+    }
+
+    /// The clearance at `cl`; with `stop_below`, returns as soon as a part is found below it.
+    fn evaluate(&self, cl: &CutterLocation, stop_below: Option<f64>) -> Clearance {
+        let axis: Vector3 = cl.axis.into_inner();
+        let mut best = NO_CLEARANCE;
+        // Below this the check fails (−∞: no check, the minimum is wanted).
+        let fail_below = stop_below.unwrap_or(f64::NEG_INFINITY);
+        let parts = self.options.parts;
+        let first = self
+            .samples
+            .partition_point(|s| s.0 <= self.options.above_mm);
+        let samples = &self.samples[first..];
+        // The exact and cheap parts first (a meridional projection each): they fix a bound
+        // the blade search below prunes with, and fail a check early.
+        if parts.hub || parts.shroud {
+            for &(h, rho, part) in samples {
+                let p = cl.tip + axis * h;
+                let mut d = (f64::INFINITY, DesignPart::Hub);
+                if parts.hub {
+                    d = (self.hub_signed_distance(&p), DesignPart::Hub);
+                }
+                if parts.shroud {
+                    let ds = self.shroud_signed_distance(&p);
+                    if ds < d.0 {
+                        d = (ds, DesignPart::Shroud);
+                    }
+                }
+                if d.0 - rho < best.distance_mm {
                     best = Clearance {
-                        distance_mm: d - rho,
-                        design_part: DesignPart::Shroud,
+                        distance_mm: d.0 - rho,
+                        design_part: d.1,
                         tool_part: part,
                         height_mm: h,
                     };
-                    if failed(&best) {
+                    if best.distance_mm < fail_below {
                         return best;
                     }
                 }
             }
         }
-        if self.frusta.is_empty() || !(self.options.parts.hub || self.options.parts.blades) {
+        if parts.blades
+            && !samples.is_empty()
+            && self.blade_search(cl, samples, stop_below, &mut best)
+        {
             return best;
+        }
+        self.upper_and_frusta(cl, stop_below, &mut best);
+        best
+    }
+
+    /// The blades against the cutter samples `samples` (sorted by height), best first (see
+    /// the module docs): lowers `best`; `true` when it fell below `stop_below`.
+    fn blade_search(
+        &self,
+        cl: &CutterLocation,
+        samples: &[(f64, f64, ToolPart)],
+        stop_below: Option<f64>,
+        best: &mut Clearance,
+    ) -> bool {
+        let axis: Vector3 = cl.axis.into_inner();
+        let c = self.mesh.chord_mm;
+        let half_t = 0.5 * self.mesh.thickest_blade_mm;
+        let n = samples.len();
+        let mut open = SCRATCH.with(|s| s.take());
+        open.clear();
+        open.push(Pending::Range {
+            lo: 0,
+            hi: n - 1,
+            left: None,
+            right: None,
+            bound: f64::NEG_INFINITY,
+        });
+        let mut failed = false;
+        while !open.is_empty() {
+            // Only samples that could lower the answer (or fail the check) matter.
+            let need = stop_below.map_or(best.distance_mm, |m| m.min(best.distance_mm));
+            let mut k = 0;
+            for (j, item) in open.iter().enumerate() {
+                if item.bound() < open[k].bound() {
+                    k = j;
+                }
+            }
+            if open[k].bound() >= need {
+                break;
+            }
+            match open.swap_remove(k) {
+                Pending::Exact { index, .. } => {
+                    let (h, rho, part) = samples[index];
+                    let (d, dp) = self.blade_signed_distance(&(cl.tip + axis * h));
+                    if d - rho < best.distance_mm {
+                        *best = Clearance {
+                            distance_mm: d - rho,
+                            design_part: dp,
+                            tool_part: part,
+                            height_mm: h,
+                        };
+                    }
+                }
+                Pending::Range {
+                    lo,
+                    hi,
+                    left,
+                    right,
+                    ..
+                } => {
+                    let m = lo + (hi - lo) / 2;
+                    let (h, rho, part) = samples[m];
+                    let reach = (h - samples[lo].0).max(samples[hi].0 - h);
+                    let rho_max = samples[lo..=hi].iter().map(|s| s.1).fold(rho, f64::max);
+                    // Beyond this, no sample of the range is inside a blade or below `need`.
+                    let cap = c + half_t.max(need + rho_max) + reach;
+                    let Some((dm, dp)) = self
+                        .mesh
+                        .side_mesh_distance_within(&(cl.tip + axis * h), cap + 1e-9 * (1.0 + cap))
+                    else {
+                        continue;
+                    };
+                    let outside = dm - c - half_t >= 0.0;
+                    if (outside && dm - c - rho >= need) || dm - c - half_t >= rho + EXACT_BAND_MM {
+                        if dm - c - rho < best.distance_mm {
+                            *best = Clearance {
+                                distance_mm: dm - c - rho,
+                                design_part: dp,
+                                tool_part: part,
+                                height_mm: h,
+                            };
+                        }
+                    } else {
+                        open.push(Pending::Exact {
+                            index: m,
+                            bound: if outside {
+                                dm - c - rho
+                            } else {
+                                f64::NEG_INFINITY
+                            },
+                        });
+                    }
+                    let anchor = Some((h, dm));
+                    if m > lo {
+                        open.push(Pending::range(samples, lo, m - 1, left, anchor, c, half_t));
+                    }
+                    if m < hi {
+                        open.push(Pending::range(samples, m + 1, hi, anchor, right, c, half_t));
+                    }
+                }
+            }
+            if stop_below.is_some_and(|m| best.distance_mm < m) {
+                failed = true;
+                break;
+            }
+        }
+        open.clear();
+        SCRATCH.with(|s| s.replace(open));
+        failed
+    }
+
+    /// The shroud samples above the flutes and the shank and holder frusta (module docs):
+    /// lowers `best`; `true` when it fell below `stop_below`.
+    fn upper_and_frusta(
+        &self,
+        cl: &CutterLocation,
+        stop_below: Option<f64>,
+        best: &mut Clearance,
+    ) -> bool {
+        let axis: Vector3 = cl.axis.into_inner();
+        let failed = |b: &Clearance| stop_below.is_some_and(|m| b.distance_mm < m);
+        if self.options.parts.shroud {
+            for &(h, rho, part) in &self.upper_samples {
+                let d = self.shroud_signed_distance(&(cl.tip + axis * h));
+                if d - rho < best.distance_mm {
+                    *best = Clearance {
+                        distance_mm: d - rho,
+                        design_part: DesignPart::Shroud,
+                        tool_part: part,
+                        height_mm: h,
+                    };
+                    if failed(best) {
+                        return true;
+                    }
+                }
+            }
+        }
+        if self.frusta.is_empty() || !(self.options.parts.hub || self.options.parts.blades) {
+            return false;
         }
         let a = PVec::new(axis.x, axis.y, axis.z);
         let pose = Pose::from_parts(pv(&cl.tip), Rotation::from_rotation_arc(PVec::Z, a));
         let c = self.mesh.chord_mm;
+        let meshes = [
+            (self.options.parts.hub, &self.mesh.hub, false),
+            (self.options.parts.blades, &self.mesh.blades, true),
+        ];
         for f in &self.frusta {
-            let mut meshes: Vec<(&TriMesh, bool)> = Vec::with_capacity(2);
-            if self.options.parts.hub {
-                meshes.push((&self.mesh.hub, false));
-            }
-            if self.options.parts.blades {
-                meshes.push((&self.mesh.blades, true));
-            }
             let mut crossed = false;
-            for (mesh, blades) in meshes {
+            for &(wanted, mesh, blades) in &meshes {
+                if !wanted {
+                    continue;
+                }
                 // Only contacts that could lower the answer (or fail the check) matter.
                 let reach = match stop_below {
                     Some(m) => m.min(best.distance_mm),
@@ -936,7 +1147,7 @@ impl<'a> DesignClearance<'a> {
                 let d = k.dist - c;
                 if d < best.distance_mm {
                     let at = Point3::new(k.point2.x, k.point2.y, k.point2.z);
-                    best = Clearance {
+                    *best = Clearance {
                         distance_mm: d,
                         design_part: if blades {
                             self.mesh.blade_mesh_distance(&at).1
@@ -946,28 +1157,126 @@ impl<'a> DesignClearance<'a> {
                         tool_part: f.part,
                         height_mm: (at - cl.tip).dot(&axis).max(0.0),
                     };
-                    if failed(&best) {
-                        return best;
+                    if failed(best) {
+                        return true;
                     }
                 }
             }
-            // A frustum buried inside material crosses no mesh triangle.
-            if !crossed {
+            // A frustum buried inside material crosses no mesh triangle; its axis midpoint is
+            // then inside, which the hub distance and the blade mesh rule out cheaply first.
+            if !crossed && self.may_be_inside(&(cl.tip + axis * f.h_mid)) {
                 let mid = cl.tip + axis * f.h_mid;
-                let (d, dp) = self.design_distance_for(&mid, f.r_mid);
+                let (d, dp) = self.design_signed_distance(&mid);
                 if d < 0.0 && d - f.r_mid < best.distance_mm {
-                    best = Clearance {
+                    *best = Clearance {
                         distance_mm: d - f.r_mid,
                         design_part: dp,
                         tool_part: f.part,
                         height_mm: f.h_mid,
                     };
-                    if failed(&best) {
-                        return best;
+                    if failed(best) {
+                        return true;
                     }
                 }
             }
         }
-        best
+        false
     }
+
+    /// Whether `p` may lie inside the selected material: `false` only when the hub distance
+    /// is positive and the blade mesh keeps `p` outside every blade (`d_m − c ≥ t/2`).
+    fn may_be_inside(&self, p: &Point3) -> bool {
+        let parts = self.options.parts;
+        if parts.hub && self.hub_signed_distance(p) < 0.0 {
+            return true;
+        }
+        if parts.shroud && self.shroud_signed_distance(p) < 0.0 {
+            return true;
+        }
+        if parts.blades {
+            let far = self.mesh.chord_mm + 0.5 * self.mesh.thickest_blade_mm;
+            return self.mesh.side_mesh_distance_within(p, far).is_some();
+        }
+        false
+    }
+}
+
+/// No answer yet: infinitely clear.
+const NO_CLEARANCE: Clearance = Clearance {
+    distance_mm: f64::INFINITY,
+    design_part: DesignPart::Hub,
+    tool_part: ToolPart::Cutter,
+    height_mm: 0.0,
+};
+
+/// Open work of the blade search: a run of cutter samples not yet looked at, or one sample
+/// whose blade distance must be computed exactly; each with a lower bound of the clearance it
+/// can still give (−∞ when nothing bounds it yet).
+#[derive(Debug, Clone, Copy)]
+enum Pending {
+    /// Samples `lo..=hi`, between the samples of known blade mesh distance `left` and `right`
+    /// (height, distance).
+    Range {
+        lo: usize,
+        hi: usize,
+        left: Option<(f64, f64)>,
+        right: Option<(f64, f64)>,
+        bound: f64,
+    },
+    /// Sample `index`, whose mesh bound came within the exact band.
+    Exact { index: usize, bound: f64 },
+}
+
+impl Pending {
+    fn bound(&self) -> f64 {
+        match self {
+            Self::Range { bound, .. } | Self::Exact { bound, .. } => *bound,
+        }
+    }
+
+    /// The run `lo..=hi` with its bound: the blade mesh distance is 1-Lipschitz along the
+    /// axis, so over the run it is at least the lowest point of the two cones
+    /// `D_l − (h − h_l)` and `D_r − (h_r − h)` from the known neighbours; minus the chord and
+    /// the widest sample radius. The bound holds only where the run is outside every blade
+    /// (`≥ c + t/2` from the mesh); otherwise it is −∞.
+    #[allow(clippy::too_many_arguments)]
+    fn range(
+        samples: &[(f64, f64, ToolPart)],
+        lo: usize,
+        hi: usize,
+        left: Option<(f64, f64)>,
+        right: Option<(f64, f64)>,
+        chord: f64,
+        half_t: f64,
+    ) -> Self {
+        let (ha, hb) = (samples[lo].0, samples[hi].0);
+        let mesh = match (left, right) {
+            (Some((hl, dl)), Some((hr, dr))) => {
+                let x = (0.5 * (dl - dr + hl + hr)).clamp(ha, hb);
+                (dl - (x - hl)).max(dr - (hr - x))
+            }
+            (Some((hl, dl)), None) => dl - (hb - hl),
+            (None, Some((hr, dr))) => dr - (hr - ha),
+            (None, None) => f64::NEG_INFINITY,
+        };
+        let rho_max = samples[lo..=hi].iter().map(|s| s.1).fold(0.0, f64::max);
+        let bound = if mesh - chord >= half_t {
+            mesh - chord - rho_max
+        } else {
+            f64::NEG_INFINITY
+        };
+        Self::Range {
+            lo,
+            hi,
+            left,
+            right,
+            bound,
+        }
+    }
+}
+
+thread_local! {
+    /// The blade search's open list, kept between queries of a thread (no allocation per
+    /// query once grown).
+    static SCRATCH: std::cell::RefCell<Vec<Pending>> = const { std::cell::RefCell::new(Vec::new()) };
 }
