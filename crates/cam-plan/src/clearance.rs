@@ -541,6 +541,8 @@ pub struct DesignClearance<'a> {
     mesh: Arc<DesignMesh>,
     hub_z_max: f64,
     hub_r_max: f64,
+    /// The two ends of the hub contour.
+    hub_ends: [ContourEnd; 2],
     rows: Vec<(Row, RowAngles)>,
     /// Largest distance of a tool point from the tip (top of the holder plus its radius):
     /// the lever arm of a change of tool axis in [`DesignClearance::segment_clearance`].
@@ -694,6 +696,10 @@ impl<'a> DesignClearance<'a> {
             mesh,
             hub_z_max: a[0].max(b[0]),
             hub_r_max: a[1].max(b[1]),
+            hub_ends: [
+                ContourEnd::new(hub, t0, -1.0, (a[0].max(b[0]), a[1].max(b[1]))),
+                ContourEnd::new(hub, t1, 1.0, (a[0].max(b[0]), a[1].max(b[1]))),
+            ],
             rows,
             reach_mm: top + widest,
         })
@@ -948,23 +954,13 @@ impl<'a> DesignClearance<'a> {
         let samples = &self.samples[first..];
         // The exact and cheap parts first (a meridional projection each): they fix a bound
         // the blade search below prunes with, and fail a check early.
-        if parts.hub || parts.shroud {
+        if parts.shroud {
             for &(h, rho, part) in samples {
-                let p = cl.tip + axis * h;
-                let mut d = (f64::INFINITY, DesignPart::Hub);
-                if parts.hub {
-                    d = (self.hub_signed_distance(&p), DesignPart::Hub);
-                }
-                if parts.shroud {
-                    let ds = self.shroud_signed_distance(&p);
-                    if ds < d.0 {
-                        d = (ds, DesignPart::Shroud);
-                    }
-                }
-                if d.0 - rho < best.distance_mm {
+                let ds = self.shroud_signed_distance(&(cl.tip + axis * h));
+                if ds - rho < best.distance_mm {
                     best = Clearance {
-                        distance_mm: d.0 - rho,
-                        design_part: d.1,
+                        distance_mm: ds - rho,
+                        design_part: DesignPart::Shroud,
                         tool_part: part,
                         height_mm: h,
                     };
@@ -974,6 +970,9 @@ impl<'a> DesignClearance<'a> {
                 }
             }
         }
+        if parts.hub && !samples.is_empty() && self.hub_search(cl, samples, stop_below, &mut best) {
+            return best;
+        }
         if parts.blades
             && !samples.is_empty()
             && self.blade_search(cl, samples, stop_below, &mut best)
@@ -982,6 +981,131 @@ impl<'a> DesignClearance<'a> {
         }
         self.upper_and_frusta(cl, stop_below, &mut best);
         best
+    }
+
+    /// The hub against the cutter samples `samples` (sorted by height), best first (see the
+    /// module docs): lowers `best`; `true` when it fell below `stop_below`.
+    fn hub_search(
+        &self,
+        cl: &CutterLocation,
+        samples: &[(f64, f64, ToolPart)],
+        stop_below: Option<f64>,
+        best: &mut Clearance,
+    ) -> bool {
+        let axis: Vector3 = cl.axis.into_inner();
+        let n = samples.len();
+        let failed = |b: &Clearance| stop_below.is_some_and(|m| b.distance_mm < m);
+        let hub_at = |i: usize, best: &mut Clearance| -> f64 {
+            let (h, rho, part) = samples[i];
+            let d = self.hub_signed_distance(&(cl.tip + axis * h));
+            if d - rho < best.distance_mm {
+                *best = Clearance {
+                    distance_mm: d - rho,
+                    design_part: DesignPart::Hub,
+                    tool_part: part,
+                    height_mm: h,
+                };
+            }
+            d
+        };
+        let (first, last) = (samples[0].0, samples[n - 1].0);
+        if n < 3 || !self.hub_is_lipschitz_on(&(cl.tip + axis * first), &(cl.tip + axis * last)) {
+            for i in 0..n {
+                hub_at(i, best);
+                if failed(best) {
+                    return true;
+                }
+            }
+            return false;
+        }
+        let d0 = hub_at(0, best);
+        let d1 = hub_at(n - 1, best);
+        if failed(best) {
+            return true;
+        }
+        let mut open = SCRATCH.with(|s| s.take());
+        open.clear();
+        open.push(Pending::range(
+            samples,
+            1,
+            n - 2,
+            Some((first, d0)),
+            Some((last, d1)),
+            |valley| valley,
+        ));
+        let mut failed_now = false;
+        while !open.is_empty() {
+            let need = stop_below.map_or(best.distance_mm, |m| m.min(best.distance_mm));
+            let mut k = 0;
+            for (j, item) in open.iter().enumerate() {
+                if item.bound() < open[k].bound() {
+                    k = j;
+                }
+            }
+            if open[k].bound() >= need {
+                break;
+            }
+            if let Pending::Range {
+                lo,
+                hi,
+                left,
+                right,
+                ..
+            } = open.swap_remove(k)
+            {
+                let m = lo + (hi - lo) / 2;
+                let anchor = Some((samples[m].0, hub_at(m, best)));
+                if failed(best) {
+                    failed_now = true;
+                    break;
+                }
+                if m > lo {
+                    open.push(Pending::range(samples, lo, m - 1, left, anchor, |v| v));
+                }
+                if m < hi {
+                    open.push(Pending::range(samples, m + 1, hi, anchor, right, |v| v));
+                }
+            }
+        }
+        open.clear();
+        SCRATCH.with(|s| s.replace(open));
+        failed_now
+    }
+
+    /// Whether the hub's signed distance is 1-Lipschitz along the segment `p0 p1` (module
+    /// docs): at each end `e` of the contour that no cap covers, the meridional trace of the
+    /// segment stays out of the quadrant beyond the end on the material side,
+    /// `(x − e)·T ≥ 0` and `(x − e)·n ≤ 0` (`T` the tangent pointing away from the contour,
+    /// `n` the channel-side normal), where the sign of the distance to the contour jumps on
+    /// the ray `e + s·T`. O(1).
+    fn hub_is_lipschitz_on(&self, p0: &Point3, p1: &Point3) -> bool {
+        let zr = |p: &Point3| [p.z, p.x.hypot(p.y)];
+        let (a, b) = (zr(p0), zr(p1));
+        // Least radius along the segment: its distance from the axis.
+        let (dx, dy) = (p1.x - p0.x, p1.y - p0.y);
+        let l2 = dx * dx + dy * dy;
+        let s = if l2 > 0.0 {
+            (-(p0.x * dx + p0.y * dy) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let r_min = (p0.x + s * dx).hypot(p0.y + s * dy);
+        // Largest value along the segment of g = w·((z, r) − e): z is linear in the segment
+        // parameter and r convex, so g is convex when w_r ≥ 0 (largest at an end), and
+        // below its linear part plus w_r·(r_min − e_r) otherwise.
+        let sup = |w: [f64; 2], e: [f64; 2]| -> f64 {
+            let lin = |q: [f64; 2], r: f64| w[0] * (q[0] - e[0]) + w[1] * (r - e[1]);
+            if w[1] >= 0.0 {
+                lin(a, a[1]).max(lin(b, b[1]))
+            } else {
+                lin(a, r_min).max(lin(b, r_min))
+            }
+        };
+        self.hub_ends.iter().all(|end| {
+            end.capped
+                || sup(end.away, end.point) < 0.0
+                || sup([-end.normal[0], -end.normal[1]], end.point) < 0.0
+        })
     }
 
     /// The blades against the cutter samples `samples` (sorted by height), best first (see
@@ -1072,11 +1196,19 @@ impl<'a> DesignClearance<'a> {
                         });
                     }
                     let anchor = Some((h, dm));
+                    // The mesh bound holds only where the run is outside every blade.
+                    let bound = |valley: f64| {
+                        if valley - c >= half_t {
+                            valley - c
+                        } else {
+                            f64::NEG_INFINITY
+                        }
+                    };
                     if m > lo {
-                        open.push(Pending::range(samples, lo, m - 1, left, anchor, c, half_t));
+                        open.push(Pending::range(samples, lo, m - 1, left, anchor, bound));
                     }
                     if m < hi {
-                        open.push(Pending::range(samples, m + 1, hi, anchor, right, c, half_t));
+                        open.push(Pending::range(samples, m + 1, hi, anchor, right, bound));
                     }
                 }
             }
@@ -1201,6 +1333,54 @@ impl<'a> DesignClearance<'a> {
     }
 }
 
+/// An end of a meridional contour, in the (z, r) half plane.
+#[derive(Debug, Clone, Copy)]
+struct ContourEnd {
+    point: [f64; 2],
+    /// Unit tangent pointing away from the contour.
+    away: [f64; 2],
+    /// Unit channel-side normal.
+    normal: [f64; 2],
+    /// Whether a cap of the hub body (the inlet plane `z = z_max` or the outlet cylinder
+    /// `r = r_max`) passes through the end perpendicular to the tangent: then on the ray
+    /// `e + s·T`, where the distance to the contour jumps from `−s` to `s`, the cap's own
+    /// distance is `s`, and the capped distance does not jump.
+    capped: bool,
+}
+
+impl ContourEnd {
+    /// The end at parameter `t` of `curve`, whose tangent points away from the contour when
+    /// multiplied by `sign` (−1 at the start, +1 at the end of the domain). A degenerate
+    /// tangent leaves `away` zero (no segment then passes the Lipschitz test).
+    /// `z_max`, `r_max`: the caps of the hub body (module docs).
+    fn new(
+        curve: &impeller_model::meridional::MeridionalCurve,
+        t: f64,
+        sign: f64,
+        (z_max, r_max): (f64, f64),
+    ) -> Self {
+        let p = curve.point(t);
+        let d = curve.curve().derivs2(t)[1] * sign;
+        let l = d.norm();
+        let away = if l > 0.0 && l.is_finite() {
+            [d[0] / l, d[1] / l]
+        } else {
+            [0.0, 0.0]
+        };
+        let n = curve.normal(t);
+        // Within 1e-12 (a jump below 1e-9 mm anywhere within 1 m of the end).
+        let on_cap = |k: usize, cap: f64| {
+            away[k] >= 1.0 - 1e-12 && (p[k] - cap).abs() <= 1e-12 * (1.0 + cap.abs())
+        };
+        Self {
+            point: [p[0], p[1]],
+            away,
+            normal: [n[0], n[1]],
+            capped: on_cap(0, z_max) || on_cap(1, r_max),
+        }
+    }
+}
+
 /// No answer yet: infinitely clear.
 const NO_CLEARANCE: Clearance = Clearance {
     distance_mm: f64::INFINITY,
@@ -1234,23 +1414,21 @@ impl Pending {
         }
     }
 
-    /// The run `lo..=hi` with its bound: the blade mesh distance is 1-Lipschitz along the
-    /// axis, so over the run it is at least the lowest point of the two cones
-    /// `D_l − (h − h_l)` and `D_r − (h_r − h)` from the known neighbours; minus the chord and
-    /// the widest sample radius. The bound holds only where the run is outside every blade
-    /// (`≥ c + t/2` from the mesh); otherwise it is −∞.
-    #[allow(clippy::too_many_arguments)]
+    /// The run `lo..=hi` between the samples of known distance `left` and `right` (height,
+    /// value) of a function 1-Lipschitz along the axis, with the bound `bound(valley) − ρ_max`:
+    /// `valley` the lowest point over the run of the two cones `D_l − (h − h_l)` and
+    /// `D_r − (h_r − h)` (the least value the function can take there), `ρ_max` the widest
+    /// sample radius of the run.
     fn range(
         samples: &[(f64, f64, ToolPart)],
         lo: usize,
         hi: usize,
         left: Option<(f64, f64)>,
         right: Option<(f64, f64)>,
-        chord: f64,
-        half_t: f64,
+        bound: impl Fn(f64) -> f64,
     ) -> Self {
         let (ha, hb) = (samples[lo].0, samples[hi].0);
-        let mesh = match (left, right) {
+        let valley = match (left, right) {
             (Some((hl, dl)), Some((hr, dr))) => {
                 let x = (0.5 * (dl - dr + hl + hr)).clamp(ha, hb);
                 (dl - (x - hl)).max(dr - (hr - x))
@@ -1260,17 +1438,12 @@ impl Pending {
             (None, None) => f64::NEG_INFINITY,
         };
         let rho_max = samples[lo..=hi].iter().map(|s| s.1).fold(0.0, f64::max);
-        let bound = if mesh - chord >= half_t {
-            mesh - chord - rho_max
-        } else {
-            f64::NEG_INFINITY
-        };
         Self::Range {
             lo,
             hi,
             left,
             right,
-            bound,
+            bound: bound(valley) - rho_max,
         }
     }
 }

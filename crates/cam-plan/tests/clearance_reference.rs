@@ -171,11 +171,13 @@ fn check(
         let cl = posture(&mut rng, k, ball_radius);
         // The blade sides run on into the hub body, where the largest of their signed
         // distances can read a point as deep inside a blade: the exact blade distance means
-        // something only outside the hub, which a tool inside it has failed already.
-        let inside_hub = q.samples().any(|(h, _)| {
-            h > options.above_mm
-                && q.hub_signed_distance(&(cl.tip + cl.axis.into_inner() * h)) < 0.0
-        });
+        // something only outside the hub, which a tool inside it has failed already (the
+        // hub alone is checked everywhere).
+        let inside_hub = options.parts.blades
+            && q.samples().any(|(h, _)| {
+                h > options.above_mm
+                    && q.hub_signed_distance(&(cl.tip + cl.axis.into_inner() * h)) < 0.0
+            });
         if inside_hub {
             continue;
         }
@@ -273,4 +275,26 @@ fn tapered_t6_above_twice_its_ball_matches_the_reference() {
         400,
     );
     assert!(n >= 100, "only {n} postures within the exact band");
+}
+
+#[test]
+fn hub_alone_matches_the_reference_everywhere() {
+    // Inside the hub body too, where the distance to the contour changes sign beyond its
+    // ends.
+    let n = check(
+        &tapered("T6", 1.0, 3.0),
+        1.0,
+        ClearanceOptions {
+            parts: PartSet {
+                hub: true,
+                blades: false,
+                shroud: false,
+            },
+            sample_tol_mm: TOL,
+            above_mm: 0.0,
+        },
+        9,
+        600,
+    );
+    assert!(n >= 150, "only {n} postures within the exact band");
 }
