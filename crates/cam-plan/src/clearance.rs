@@ -81,6 +81,10 @@ pub const EXACT_BAND_MM: f64 = 1.0;
 /// a coarser one is capped here so the shank/holder answers stay within 0.1 mm.
 pub const MAX_MESH_CHORD_MM: f64 = 0.05;
 
+/// Chord of the whole blade sides' mesh (mm), which only bounds the exact blade distances of
+/// the cutter samples: coarser is cheaper to query, and loosens the bounds by the chord.
+const BOUND_CHORD_MM: f64 = 0.05;
+
 /// Blade thickness grid (u × v samples per pressure side) for the thickest blade `t`.
 const THICKNESS_GRID: (usize, usize) = (24, 8);
 
@@ -240,6 +244,8 @@ pub struct DesignMesh {
     blade_sides: TriMesh,
     /// (row, instance) of each triangle of `blade_sides`.
     side_of: Vec<(Row, usize)>,
+    /// The chord of `blade_sides`.
+    side_chord_mm: f64,
     chord_mm: f64,
     thickest_blade_mm: f64,
 }
@@ -275,6 +281,7 @@ impl DesignMesh {
             ));
         }
         let chord = chord_mm.min(MAX_MESH_CHORD_MM);
+        let side_chord = chord.max(BOUND_CHORD_MM);
         let mesh_err = |e: impeller_model::export::ExportError| {
             PlanError::geometry("-", "design mesh", e.to_string())
         };
@@ -339,7 +346,8 @@ impl DesignMesh {
                 let name = format!("{row:?} blade {side:?} side");
                 let sm = tessellate(blade.side(side), chord, &name).map_err(mesh_err)?;
                 clipped.add_instances(&clip_at_shroud(impeller, &sm), row, set);
-                whole.add_instances(&sm, row, set);
+                let coarse = tessellate(blade.side(side), side_chord, &name).map_err(mesh_err)?;
+                whole.add_instances(&coarse, row, set);
             }
             // Thickest blade: suction-side distance of pressure-side grid points.
             let ps = blade.side(Side::Pressure);
@@ -370,6 +378,7 @@ impl DesignMesh {
             blade_sides,
             side_of,
             chord_mm: chord,
+            side_chord_mm: side_chord,
             thickest_blade_mm: thickest,
         })
     }
@@ -801,13 +810,21 @@ impl<'a> DesignClearance<'a> {
 
     /// The smallest clearance of the tool at `cl` (see the module docs for what it bounds).
     pub fn clearance(&self, cl: &CutterLocation) -> Clearance {
-        self.evaluate(cl, None)
+        self.evaluate(cl, Want::MINIMUM)
     }
 
     /// Whether the tool at `cl` keeps at least `min_clearance_mm` from the design (stops at
     /// the first part that fails).
     pub fn is_clear(&self, cl: &CutterLocation, min_clearance_mm: f64) -> bool {
-        self.evaluate(cl, Some(min_clearance_mm)).distance_mm >= min_clearance_mm
+        self.evaluate(
+            cl,
+            Want {
+                cap: min_clearance_mm,
+                fail_below: min_clearance_mm,
+            },
+        )
+        .distance_mm
+            >= min_clearance_mm
     }
 
     /// Whether the whole motion from `a` to `b` keeps at least `min_clearance_mm − tol_mm` from
@@ -877,7 +894,18 @@ impl<'a> DesignClearance<'a> {
             if queries >= max_queries {
                 return Err(sm);
             }
-            let cm = self.clearance(&at(sm)).distance_mm;
+            // The midpoint's clearance matters only up to the value that settles both
+            // halves; above it, that value itself is the bound the halves need.
+            let settle = 2.0 * floor - c0.min(c1) + 0.5 * span * (s1 - s0);
+            let cm = self
+                .evaluate(
+                    &at(sm),
+                    Want {
+                        cap: settle.max(min_clearance_mm),
+                        fail_below: min_clearance_mm,
+                    },
+                )
+                .distance_mm;
             queries += 1;
             if cm < min_clearance_mm {
                 return Err(sm);
@@ -899,7 +927,7 @@ impl<'a> DesignClearance<'a> {
     pub fn clearance_exhaustive(&self, cl: &CutterLocation) -> Clearance {
         let axis: Vector3 = cl.axis.into_inner();
         let parts = self.options.parts;
-        let c = self.mesh.chord_mm;
+        let c = self.mesh.side_chord_mm;
         let half_t = 0.5 * self.mesh.thickest_blade_mm;
         let mut best = NO_CLEARANCE;
         for &(h, rho, part) in &self.samples {
@@ -937,16 +965,24 @@ impl<'a> DesignClearance<'a> {
                 };
             }
         }
-        self.upper_and_frusta(cl, None, &mut best);
+        self.upper_and_frusta(cl, Want::MINIMUM, &mut best);
         best
     }
 
-    /// The clearance at `cl`; with `stop_below`, returns as soon as a part is found below it.
-    fn evaluate(&self, cl: &CutterLocation, stop_below: Option<f64>) -> Clearance {
+    /// The clearance at `cl` as `want` asks for it: exact below `want.cap`, else `want.cap`
+    /// (a lower bound); returns as soon as a part is found below `want.fail_below`.
+    fn evaluate(&self, cl: &CutterLocation, want: Want) -> Clearance {
+        let mut best = self.evaluate_parts(cl, want);
+        best.distance_mm = best.distance_mm.min(want.cap);
+        best
+    }
+
+    /// [`Self::evaluate`] before the cap: the smallest clearance found, which is above the cap
+    /// (possibly infinite) when nothing comes below it.
+    fn evaluate_parts(&self, cl: &CutterLocation, want: Want) -> Clearance {
         let axis: Vector3 = cl.axis.into_inner();
         let mut best = NO_CLEARANCE;
         // Below this the check fails (−∞: no check, the minimum is wanted).
-        let fail_below = stop_below.unwrap_or(f64::NEG_INFINITY);
         let parts = self.options.parts;
         let first = self
             .samples
@@ -964,37 +1000,34 @@ impl<'a> DesignClearance<'a> {
                         tool_part: part,
                         height_mm: h,
                     };
-                    if best.distance_mm < fail_below {
+                    if want.failed(&best) {
                         return best;
                     }
                 }
             }
         }
-        if parts.hub && !samples.is_empty() && self.hub_search(cl, samples, stop_below, &mut best) {
+        if parts.hub && !samples.is_empty() && self.hub_search(cl, samples, want, &mut best) {
             return best;
         }
-        if parts.blades
-            && !samples.is_empty()
-            && self.blade_search(cl, samples, stop_below, &mut best)
-        {
+        if parts.blades && !samples.is_empty() && self.blade_search(cl, samples, want, &mut best) {
             return best;
         }
-        self.upper_and_frusta(cl, stop_below, &mut best);
+        self.upper_and_frusta(cl, want, &mut best);
         best
     }
 
     /// The hub against the cutter samples `samples` (sorted by height), best first (see the
-    /// module docs): lowers `best`; `true` when it fell below `stop_below`.
+    /// module docs): lowers `best`; `true` when the check `want` failed.
     fn hub_search(
         &self,
         cl: &CutterLocation,
         samples: &[(f64, f64, ToolPart)],
-        stop_below: Option<f64>,
+        want: Want,
         best: &mut Clearance,
     ) -> bool {
         let axis: Vector3 = cl.axis.into_inner();
         let n = samples.len();
-        let failed = |b: &Clearance| stop_below.is_some_and(|m| b.distance_mm < m);
+        let failed = |b: &Clearance| want.failed(b);
         let hub_at = |i: usize, best: &mut Clearance| -> f64 {
             let (h, rho, part) = samples[i];
             let d = self.hub_signed_distance(&(cl.tip + axis * h));
@@ -1035,7 +1068,7 @@ impl<'a> DesignClearance<'a> {
         ));
         let mut failed_now = false;
         while !open.is_empty() {
-            let need = stop_below.map_or(best.distance_mm, |m| m.min(best.distance_mm));
+            let need = want.need(best);
             let mut k = 0;
             for (j, item) in open.iter().enumerate() {
                 if item.bound() < open[k].bound() {
@@ -1109,16 +1142,16 @@ impl<'a> DesignClearance<'a> {
     }
 
     /// The blades against the cutter samples `samples` (sorted by height), best first (see
-    /// the module docs): lowers `best`; `true` when it fell below `stop_below`.
+    /// the module docs): lowers `best`; `true` when the check `want` failed.
     fn blade_search(
         &self,
         cl: &CutterLocation,
         samples: &[(f64, f64, ToolPart)],
-        stop_below: Option<f64>,
+        want: Want,
         best: &mut Clearance,
     ) -> bool {
         let axis: Vector3 = cl.axis.into_inner();
-        let c = self.mesh.chord_mm;
+        let c = self.mesh.side_chord_mm;
         let half_t = 0.5 * self.mesh.thickest_blade_mm;
         let n = samples.len();
         let mut open = SCRATCH.with(|s| s.take());
@@ -1133,7 +1166,7 @@ impl<'a> DesignClearance<'a> {
         let mut failed = false;
         while !open.is_empty() {
             // Only samples that could lower the answer (or fail the check) matter.
-            let need = stop_below.map_or(best.distance_mm, |m| m.min(best.distance_mm));
+            let need = want.need(best);
             let mut k = 0;
             for (j, item) in open.iter().enumerate() {
                 if item.bound() < open[k].bound() {
@@ -1212,7 +1245,7 @@ impl<'a> DesignClearance<'a> {
                     }
                 }
             }
-            if stop_below.is_some_and(|m| best.distance_mm < m) {
+            if want.failed(best) {
                 failed = true;
                 break;
             }
@@ -1223,15 +1256,10 @@ impl<'a> DesignClearance<'a> {
     }
 
     /// The shroud samples above the flutes and the shank and holder frusta (module docs):
-    /// lowers `best`; `true` when it fell below `stop_below`.
-    fn upper_and_frusta(
-        &self,
-        cl: &CutterLocation,
-        stop_below: Option<f64>,
-        best: &mut Clearance,
-    ) -> bool {
+    /// lowers `best`; `true` when the check `want` failed.
+    fn upper_and_frusta(&self, cl: &CutterLocation, want: Want, best: &mut Clearance) -> bool {
         let axis: Vector3 = cl.axis.into_inner();
-        let failed = |b: &Clearance| stop_below.is_some_and(|m| b.distance_mm < m);
+        let failed = |b: &Clearance| want.failed(b);
         if self.options.parts.shroud {
             for &(h, rho, part) in &self.upper_samples {
                 let d = self.shroud_signed_distance(&(cl.tip + axis * h));
@@ -1265,10 +1293,7 @@ impl<'a> DesignClearance<'a> {
                     continue;
                 }
                 // Only contacts that could lower the answer (or fail the check) matter.
-                let reach = match stop_below {
-                    Some(m) => m.min(best.distance_mm),
-                    None => best.distance_mm,
-                };
+                let reach = want.need(best);
                 let prediction = (reach + c).max(0.0);
                 let Ok(Some(k)) =
                     query::contact(&pose, &f.shape, &Pose::IDENTITY, mesh, prediction)
@@ -1326,7 +1351,7 @@ impl<'a> DesignClearance<'a> {
             return true;
         }
         if parts.blades {
-            let far = self.mesh.chord_mm + 0.5 * self.mesh.thickest_blade_mm;
+            let far = self.mesh.side_chord_mm + 0.5 * self.mesh.thickest_blade_mm;
             return self.mesh.side_mesh_distance_within(p, far).is_some();
         }
         false
@@ -1378,6 +1403,31 @@ impl ContourEnd {
             normal: [n[0], n[1]],
             capped: on_cap(0, z_max) || on_cap(1, r_max),
         }
+    }
+}
+
+/// What a query needs: the clearance exactly where it is below `cap` (above, any lower bound
+/// at least `cap` will do), and none at all once it is below `fail_below`.
+#[derive(Debug, Clone, Copy)]
+struct Want {
+    cap: f64,
+    fail_below: f64,
+}
+
+impl Want {
+    /// The exact minimum.
+    const MINIMUM: Self = Self {
+        cap: f64::INFINITY,
+        fail_below: f64::NEG_INFINITY,
+    };
+
+    /// The value below which a sample or part still matters, given the answer so far.
+    fn need(&self, best: &Clearance) -> f64 {
+        self.cap.min(best.distance_mm)
+    }
+
+    fn failed(&self, best: &Clearance) -> bool {
+        best.distance_mm < self.fail_below
     }
 }
 

@@ -298,3 +298,72 @@ fn hub_alone_matches_the_reference_everywhere() {
     );
     assert!(n >= 150, "only {n} postures within the exact band");
 }
+
+#[test]
+fn certified_motions_keep_the_clearance_the_reference_measures() {
+    // Motions from random postures near the design: a motion certified clear must measure
+    // clear along its whole length by the exhaustive reference (within the stated error of
+    // the sampling and of the mesh), and a motion refused must be refused at a posture the
+    // reference finds below the threshold.
+    let tool = tapered("T6", 1.0, 3.0);
+    let options = ClearanceOptions {
+        sample_tol_mm: TOL,
+        above_mm: 2.0,
+        ..ClearanceOptions::default()
+    };
+    let q = DesignClearance::with_mesh(impeller(), mesh(), &tool, options).unwrap();
+    let mut rng = Rng(11);
+    let (mut clear, mut refused) = (0, 0);
+    let mut k = 0;
+    while (clear < 60 || refused < 12) && k < 5000 {
+        k += 1;
+        // Clear ends a few millimetres apart: some motions pass through a blade between.
+        let a = posture(&mut rng, k % 2, 1.0);
+        let axis = rng.tilt(a.axis.into_inner(), 12f64.to_radians());
+        let shift = Vector3::new(
+            rng.range(-5.0, 5.0),
+            rng.range(-5.0, 5.0),
+            rng.range(-5.0, 5.0),
+        );
+        let b = CutterLocation::new(a.tip + shift, axis).unwrap();
+        let min = rng.range(-0.02, 0.1);
+        if q.clearance(&a).distance_mm < min || q.clearance(&b).distance_mm < min {
+            continue;
+        }
+        let tol = 0.01;
+        let at = |s: f64| {
+            CutterLocation::new(
+                a.tip + (b.tip - a.tip) * s,
+                a.axis.slerp(&b.axis, s).into_inner(),
+            )
+            .unwrap()
+        };
+        match q.segment_clearance(&a, &b, min, tol, 100_000) {
+            Ok(()) if clear >= 60 => {}
+            Ok(()) => {
+                clear += 1;
+                let slack = tol + 0.5 * TOL + 2.0 * mesh().chord_mm() + 1e-9;
+                for i in 0..=64 {
+                    let s = f64::from(i) / 64.0;
+                    let r = q.clearance_exhaustive(&at(s)).distance_mm;
+                    assert!(
+                        r >= min - slack,
+                        "motion {k} certified at {min} but the reference reads {r} at {s}"
+                    );
+                }
+            }
+            Err(s) => {
+                refused += 1;
+                let r = q.clearance_exhaustive(&at(s)).distance_mm;
+                assert!(
+                    r < min,
+                    "motion {k} refused at {s} where the reference reads {r} ≥ {min}"
+                );
+            }
+        }
+    }
+    assert!(
+        clear >= 60 && refused >= 12,
+        "{clear} clear, {refused} refused"
+    );
+}
