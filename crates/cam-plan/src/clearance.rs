@@ -246,6 +246,9 @@ pub struct DesignMesh {
     side_of: Vec<(Row, usize)>,
     /// The chord of `blade_sides`.
     side_chord_mm: f64,
+    /// Each row's reference blade (instance 0), both sides whole, in its own frame: the
+    /// blade distance of one instance is bounded by turning the point into that frame.
+    reference_sides: Vec<(Row, TriMesh)>,
     chord_mm: f64,
     thickest_blade_mm: f64,
 }
@@ -340,15 +343,19 @@ impl DesignMesh {
         let mut thickest: f64 = 0.0;
         let rows = std::iter::once((Row::Main, impeller.main()))
             .chain(impeller.splitter().map(|s| (Row::Splitter, s)));
+        let mut reference = Vec::new();
         for (row, set) in rows {
             let blade = set.blade();
+            let mut own = BladeTriangles::default();
             for side in [Side::Pressure, Side::Suction] {
                 let name = format!("{row:?} blade {side:?} side");
                 let sm = tessellate(blade.side(side), chord, &name).map_err(mesh_err)?;
                 clipped.add_instances(&clip_at_shroud(impeller, &sm), row, set);
                 let coarse = tessellate(blade.side(side), side_chord, &name).map_err(mesh_err)?;
                 whole.add_instances(&coarse, row, set);
+                own.add(&coarse, row, 0, &nalgebra::Rotation3::identity());
             }
+            reference.push((row, own));
             // Thickest blade: suction-side distance of pressure-side grid points.
             let ps = blade.side(Side::Pressure);
             let ((u0, u1), (v0, v1)) = ps.domain();
@@ -371,6 +378,10 @@ impl DesignMesh {
         };
         let (blades, blade_of) = blade_mesh(clipped)?;
         let (blade_sides, side_of) = blade_mesh(whole)?;
+        let reference_sides = reference
+            .into_iter()
+            .map(|(row, t)| blade_mesh(t).map(|(m, _)| (row, m)))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             hub,
             blades,
@@ -379,6 +390,7 @@ impl DesignMesh {
             side_of,
             chord_mm: chord,
             side_chord_mm: side_chord,
+            reference_sides,
             thickest_blade_mm: thickest,
         })
     }
@@ -443,20 +455,30 @@ impl BladeTriangles {
         set: &BladeSet,
     ) {
         for k in 0..set.count() {
-            let rot = set.rotation(k);
-            let base = self.vertices.len() as u32;
-            self.vertices.extend(mesh.vertices.iter().map(|v| {
-                let q = rot * v;
-                PVec::new(q.x, q.y, q.z)
-            }));
-            self.triangles.extend(
-                mesh.triangles
-                    .iter()
-                    .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
-            );
-            self.blade_of
-                .extend(std::iter::repeat_n((row, k), mesh.triangles.len()));
+            self.add(mesh, row, k, &set.rotation(k));
         }
+    }
+
+    /// Adds `mesh` turned by `rot` as instance `k` of `row`.
+    fn add(
+        &mut self,
+        mesh: &impeller_model::export::stl::TriMesh,
+        row: Row,
+        k: usize,
+        rot: &nalgebra::Rotation3<f64>,
+    ) {
+        let base = self.vertices.len() as u32;
+        self.vertices.extend(mesh.vertices.iter().map(|v| {
+            let q = rot * v;
+            PVec::new(q.x, q.y, q.z)
+        }));
+        self.triangles.extend(
+            mesh.triangles
+                .iter()
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
+        self.blade_of
+            .extend(std::iter::repeat_n((row, k), mesh.triangles.len()));
     }
 }
 
@@ -748,6 +770,19 @@ impl<'a> DesignClearance<'a> {
     /// Signed distance of the nearest blade (negative inside it) and which blade it is
     /// (exact: NURBS projections on the two instances of each row around `p`).
     pub fn blade_signed_distance(&self, p: &Point3) -> (f64, DesignPart) {
+        self.blade_signed_distance_below(p, f64::INFINITY).0
+    }
+
+    /// [`Self::blade_signed_distance`] where only distances below `floor` matter: a blade
+    /// instance whose whole-sides mesh (turned into the reference blade's frame) keeps `p` at
+    /// least `c + max(t/2, floor)` away is outside it by at least `floor`, and is not
+    /// projected on. Returns the least exact distance of the other instances and whether
+    /// any was left out: the answer is exact when it is below `floor` or none was.
+    fn blade_signed_distance_below(&self, p: &Point3, floor: f64) -> ((f64, DesignPart), bool) {
+        let c = self.mesh.side_chord_mm;
+        let cap = c + (0.5 * self.mesh.thickest_blade_mm).max(floor);
+        let cap = cap + 1e-9 * (1.0 + cap.abs());
+        let mut skipped = false;
         let d_shroud = self.impeller.shroud().signed_distance(&p.coords);
         let mut best = (f64::INFINITY, DesignPart::Hub);
         for (row, angles) in &self.rows {
@@ -762,23 +797,37 @@ impl<'a> DesignClearance<'a> {
             let pitch = set.pitch_rad();
             let rel = (p.y.atan2(p.x) - angles.angle_near(p)).rem_euclid(std::f64::consts::TAU);
             let k0 = ((rel / pitch).floor() as usize) % n;
+            let own = self
+                .mesh
+                .reference_sides
+                .iter()
+                .find(|(r, _)| r == row)
+                .map(|(_, m)| m)
+                .filter(|_| cap.is_finite());
             for k in [k0, (k0 + 1) % n] {
                 let local = set.rotation(k).inverse() * p.coords;
+                let part = DesignPart::Blade {
+                    row: *row,
+                    index: k,
+                };
+                if let Some(mesh) = own {
+                    let q = PVec::new(local.x, local.y, local.z);
+                    let near =
+                        CompositeShapeRef(mesh).project_local_point_and_get_location(q, cap, false);
+                    if near.is_none() {
+                        skipped = true;
+                        continue;
+                    }
+                }
                 let (_, dp) = blade_side_distance(set.blade(), Side::Pressure, &local, None);
                 let (_, ds) = blade_side_distance(set.blade(), Side::Suction, &local, None);
                 let d = dp.max(ds).max(d_shroud);
                 if d < best.0 {
-                    best = (
-                        d,
-                        DesignPart::Blade {
-                            row: *row,
-                            index: k,
-                        },
-                    );
+                    best = (d, part);
                 }
             }
         }
-        best
+        (best, skipped)
     }
 
     /// Signed distance of the selected design parts at `p` (negative inside material; for
@@ -1179,8 +1228,11 @@ impl<'a> DesignClearance<'a> {
             match open.swap_remove(k) {
                 Pending::Exact { index, .. } => {
                     let (h, rho, part) = samples[index];
-                    let (d, dp) = self.blade_signed_distance(&(cl.tip + axis * h));
-                    if d - rho < best.distance_mm {
+                    let ((d, dp), skipped) =
+                        self.blade_signed_distance_below(&(cl.tip + axis * h), need + rho);
+                    // A left-out blade is only known to be at least `need` away: nothing to
+                    // record unless an exact distance came below that.
+                    if (d < need + rho || !skipped) && d - rho < best.distance_mm {
                         *best = Clearance {
                             distance_mm: d - rho,
                             design_part: dp,
