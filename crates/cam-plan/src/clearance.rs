@@ -773,61 +773,90 @@ impl<'a> DesignClearance<'a> {
         self.blade_signed_distance_below(p, f64::INFINITY).0
     }
 
-    /// [`Self::blade_signed_distance`] where only distances below `floor` matter: a blade
-    /// instance whose whole-sides mesh (turned into the reference blade's frame) keeps `p` at
-    /// least `c + max(t/2, floor)` away is outside it by at least `floor`, and is not
-    /// projected on. Returns the least exact distance of the other instances and whether
-    /// any was left out: the answer is exact when it is below `floor` or none was.
+    /// [`Self::blade_signed_distance`] where only distances below `floor` matter. The
+    /// candidate instances are projected on nearest in polar angle first; an instance whose
+    /// whole-sides mesh (turned into the reference blade's frame) keeps `p` at least
+    /// `c + max(t/2, x)` away, `x` the smaller of `floor` and the least distance so far, is
+    /// outside it by at least `x` and is not projected on. Returns the least exact distance
+    /// of the projected instances and whether one was left out only by the floor: the answer
+    /// is exact when it is below `floor` or none was.
     fn blade_signed_distance_below(&self, p: &Point3, floor: f64) -> ((f64, DesignPart), bool) {
+        self.blade_distance_of_candidates(p, floor, true)
+    }
+
+    /// [`Self::blade_signed_distance`] projecting on every candidate instance (no mesh
+    /// bound): the reference the tests hold the pruned distance to.
+    #[doc(hidden)]
+    pub fn blade_signed_distance_exhaustive(&self, p: &Point3) -> (f64, DesignPart) {
+        self.blade_distance_of_candidates(p, f64::INFINITY, false).0
+    }
+
+    /// The distance of the two instances of each row around `p` (see
+    /// [`Self::blade_signed_distance_below`]; `prune` false projects on all of them).
+    fn blade_distance_of_candidates(
+        &self,
+        p: &Point3,
+        floor: f64,
+        prune: bool,
+    ) -> ((f64, DesignPart), bool) {
         let c = self.mesh.side_chord_mm;
-        let cap = c + (0.5 * self.mesh.thickest_blade_mm).max(floor);
-        let cap = cap + 1e-9 * (1.0 + cap.abs());
-        let mut skipped = false;
-        let d_shroud = self.impeller.shroud().signed_distance(&p.coords);
-        let mut best = (f64::INFINITY, DesignPart::Hub);
-        for (row, angles) in &self.rows {
-            let set = match row {
-                Row::Main => self.impeller.main(),
-                Row::Splitter => match self.impeller.splitter() {
-                    Some(s) => s,
-                    None => continue,
-                },
+        let half_t = 0.5 * self.mesh.thickest_blade_mm;
+        // The two instances of each row around `p`, nearest in polar angle first.
+        let mut candidates: [Option<(f64, Row, usize)>; 4] = [None; 4];
+        for (slot, (row, angles)) in self.rows.iter().enumerate().take(2) {
+            let Some(set) = self.row_set(*row) else {
+                continue;
             };
             let n = set.count();
             let pitch = set.pitch_rad();
             let rel = (p.y.atan2(p.x) - angles.angle_near(p)).rem_euclid(std::f64::consts::TAU);
             let k0 = ((rel / pitch).floor() as usize) % n;
-            let own = self
-                .mesh
-                .reference_sides
-                .iter()
-                .find(|(r, _)| r == row)
-                .map(|(_, m)| m)
-                .filter(|_| cap.is_finite());
-            for k in [k0, (k0 + 1) % n] {
-                let local = set.rotation(k).inverse() * p.coords;
-                let part = DesignPart::Blade {
-                    row: *row,
-                    index: k,
-                };
-                if let Some(mesh) = own {
-                    let q = PVec::new(local.x, local.y, local.z);
-                    let near =
-                        CompositeShapeRef(mesh).project_local_point_and_get_location(q, cap, false);
-                    if near.is_none() {
-                        skipped = true;
-                        continue;
-                    }
+            let behind = rel - k0 as f64 * pitch;
+            candidates[2 * slot] = Some((behind, *row, k0));
+            candidates[2 * slot + 1] = Some((pitch - behind, *row, (k0 + 1) % n));
+        }
+        candidates.sort_by(|a, b| {
+            let key = |x: &Option<(f64, Row, usize)>| x.map_or(f64::INFINITY, |x| x.0);
+            key(a).total_cmp(&key(b))
+        });
+        let d_shroud = self.impeller.shroud().signed_distance(&p.coords);
+        let mut best = (f64::INFINITY, DesignPart::Hub);
+        let mut skipped = false;
+        for &(_, row, k) in candidates.iter().flatten() {
+            let Some(set) = self.row_set(row) else {
+                continue;
+            };
+            let local = set.rotation(k).inverse() * p.coords;
+            // An instance the mesh keeps `c + max(t/2, x)` away is outside it by at least
+            // `x`: it cannot come below the floor nor the best distance so far.
+            let cap = c + half_t.max(floor.min(best.0));
+            let cap = cap + 1e-9 * (1.0 + cap.abs());
+            let mesh = self.mesh.reference_sides.iter().find(|(r, _)| *r == row);
+            if let Some((_, mesh)) = mesh.filter(|_| prune && cap.is_finite()) {
+                let q = PVec::new(local.x, local.y, local.z);
+                let near =
+                    CompositeShapeRef(mesh).project_local_point_and_get_location(q, cap, false);
+                if near.is_none() {
+                    skipped |= floor < best.0;
+                    continue;
                 }
-                let (_, dp) = blade_side_distance(set.blade(), Side::Pressure, &local, None);
-                let (_, ds) = blade_side_distance(set.blade(), Side::Suction, &local, None);
-                let d = dp.max(ds).max(d_shroud);
-                if d < best.0 {
-                    best = (d, part);
-                }
+            }
+            let (_, dp) = blade_side_distance(set.blade(), Side::Pressure, &local, None);
+            let (_, ds) = blade_side_distance(set.blade(), Side::Suction, &local, None);
+            let d = dp.max(ds).max(d_shroud);
+            if d < best.0 {
+                best = (d, DesignPart::Blade { row, index: k });
             }
         }
         (best, skipped)
+    }
+
+    /// The blade set of `row`.
+    fn row_set(&self, row: Row) -> Option<&BladeSet> {
+        match row {
+            Row::Main => Some(self.impeller.main()),
+            Row::Splitter => self.impeller.splitter(),
+        }
     }
 
     /// Signed distance of the selected design parts at `p` (negative inside material; for
@@ -999,7 +1028,7 @@ impl<'a> DesignClearance<'a> {
                 let b = if dm - c - half_t >= rho + EXACT_BAND_MM {
                     (dm - c, dp)
                 } else {
-                    self.blade_signed_distance(&p)
+                    self.blade_signed_distance_exhaustive(&p)
                 };
                 if b.0 < d.0 {
                     d = b;

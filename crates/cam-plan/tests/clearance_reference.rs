@@ -367,3 +367,33 @@ fn certified_motions_keep_the_clearance_the_reference_measures() {
         "{clear} clear, {refused} refused"
     );
 }
+
+#[test]
+fn pruned_blade_distance_is_the_exhaustive_one() {
+    // Around the blades (inside them too) and across the channels: the projections the mesh
+    // bounds leave out never hold the nearest blade.
+    let q = DesignClearance::with_mesh(
+        impeller(),
+        mesh(),
+        &tapered("T6", 1.0, 3.0),
+        ClearanceOptions {
+            sample_tol_mm: TOL,
+            ..ClearanceOptions::default()
+        },
+    )
+    .unwrap();
+    let mut rng = Rng(12);
+    let mut near = 0;
+    for k in 0..600 {
+        let cl = posture(&mut rng, k % 2, 1.0);
+        let p = cl.tip + cl.axis.into_inner() * rng.range(0.0, 12.0);
+        let (fast, part) = q.blade_signed_distance(&p);
+        let (reference, reference_part) = q.blade_signed_distance_exhaustive(&p);
+        assert!(
+            fast == reference,
+            "{p:?}: {fast} ({part:?}) vs {reference} ({reference_part:?})"
+        );
+        near += usize::from(reference.abs() < 1.0);
+    }
+    assert!(near >= 100, "only {near} points within 1 mm of a blade");
+}
