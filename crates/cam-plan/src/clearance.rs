@@ -14,31 +14,62 @@
 //!   exact query costs four blade-side projections however many blades there are.
 //!
 //! A [`DesignMesh`] triangulates the design within a chord tolerance `c` (hub surface with its
-//! inlet disc and outlet cylinder, every blade side; parry BVH): the true surfaces lie within
-//! `c` of the mesh.
+//! inlet disc and outlet cylinder, every blade side clipped at the shroud contour; parry BVH):
+//! the true surfaces lie within `c` of the mesh. It also holds the blade sides whole (as far
+//! as the exact side distances measure, past the shroud too) at a coarser chord `c_b ≥ c`
+//! ([`BOUND_CHORD_MM`]), for every instance and for each row's reference blade alone: these
+//! only bound the exact distances from below (`d_m − c_b`, `d_m` the unsigned distance to that
+//! mesh), and only where the point is outside every blade, which `d_m − c_b ≥ t/2` shows (`t`
+//! the thickest blade: a point inside a blade is within `t/2` of a side).
 //!
 //! **Cutter** (the fluted part, `0 ≤ h ≤ L`): a solid of revolution of radius `ρ(h)` about the
 //! axis. Its cross-section at height `h` is a disc inside the ball of radius `ρ(h)` about
 //! `c(h) = tip + h·axis`, so `d(c(h)) − ρ(h)` (`d` the design's signed distance) bounds the
-//! disc's clearance from below. The query takes the minimum over sample heights: the ball
+//! disc's clearance from below. The answer is the minimum over sample heights: the ball
 //! centre of ball and tapered-ball ends (where the ball is the cutter's end exactly), then a
 //! grid up the flutes with a step `s ≤ min(ρ/2, √(2·ρ·tol))`; between two samples the union of
-//! balls misses a rim band of depth `≤ s²/(4ρ) ≤ tol/2`. `d` is exact (NURBS) where it matters:
-//! the blade distance is first bounded with the mesh (unsigned distance `d_m` to the blade
-//! sides, BVH, O(log T)); when `d_m − c − t/2 ≥ ρ + EXACT_BAND_MM` (`t` the thickest blade) the
-//! ball centre is outside every blade and `d_m − c` is used (a lower bound at least
-//! `EXACT_BAND_MM` beyond the ball), and likewise when the centre is outside every blade and
-//! the bound already shows the sample cannot lower the minimum found so far (nor fail
-//! `is_clear`); otherwise the exact NURBS distance. So the minimum is exact wherever it lies
-//! within the band. The hub distance is
-//! always exact (a meridional curve projection).
+//! balls misses a rim band of depth `≤ s²/(4ρ) ≤ tol/2`. Each sample's value is
+//! `min(d_hub, d_shroud, d_blade) − ρ` with the hub and shroud distances exact (meridional
+//! projections), the blade distance exact (NURBS projections) within [`EXACT_BAND_MM`] of the
+//! ball and the mesh bound `d_m − c_b` beyond it (`d_m − c_b − t/2 ≥ ρ + EXACT_BAND_MM`).
+//!
+//! The minimum is found without evaluating most samples, by best-first branch and bound over
+//! runs of consecutive samples, using that a distance is 1-Lipschitz along the axis:
+//! `|d(c(h)) − d(c(h'))| ≤ |h − h'|`. A run between two samples of known distance `D_l`, `D_r`
+//! has every distance at least the lowest point of the cones `D_l − (h − h_l)` and
+//! `D_r − (h_r − h)` over it, so its clearance is at least that less its widest radius; a run
+//! whose bound is not below the least clearance found so far (or a check's threshold) holds
+//! no sample that could lower the answer or fail the check, and is dropped whole. Runs are
+//! split at their middle sample, the lowest bound first:
+//! - hub: the samples at both ends, then middles. The capped hub distance is 1-Lipschitz
+//!   except across the rays beyond an end `e` of the contour on its material side
+//!   (`e + s·T`, `T` the tangent pointing away), where the distance to the contour jumps from
+//!   `−s` to `s`; at an end where the inlet plane or the outlet cylinder passes through `e`
+//!   perpendicular to `T`, the cap reads `s` there and nothing jumps (so on the fixtures'
+//!   hubs everywhere). Otherwise the search runs only when the axis segment's meridional
+//!   trace stays out of the quadrant `(x − e)·T ≥ 0, (x − e)·n ≤ 0` beyond that end (checked
+//!   in O(1): `z` is linear along the segment and `r` convex), and every sample is evaluated
+//!   if not;
+//! - blades: the middle sample's mesh distance (BVH point query capped where the whole run
+//!   would be dropped: nothing within the cap drops it at once); a sample whose mesh bound
+//!   already shows it cannot lower the answer keeps the bound, one beyond the band takes it
+//!   as its value, and the others wait, bounded, for their exact distance, also taken lowest
+//!   bound first. An exact distance projects on the two instances of each row around the
+//!   point nearest in polar angle first, and leaves out an instance its row's reference mesh
+//!   (the point turned into that blade's frame) keeps `c_b + max(t/2, x)` away, `x` the
+//!   least distance so far or the value below which the sample matters.
+//!
+//! So the answer is the minimum over every sample exactly as an exhaustive evaluation would
+//! give it wherever that minimum lies within [`EXACT_BAND_MM`] of a blade, and a lower bound of
+//! it elsewhere (`DesignClearance::clearance_exhaustive` keeps the exhaustive evaluation for
+//! the tests that check so).
 //!
 //! **Shank and holder**: the frusta of [`cam_core::Cutter::frusta`] above the flutes, each as
 //! a convex polyhedron circumscribing it (polygon rings whose sides stay within `c` of the
 //! circle), placed at the posture and measured against the hub and blade meshes with parry's
 //! contact query (signed: negative = penetration depth), minus `c` for the mesh. A frustum
 //! buried entirely inside material (no mesh crossing) is caught by the exact signed distance
-//! at its axis midpoint. Unlike balls as wide as the holder, this does not reach down the axis
+//! at its axis midpoint (unless the hub distance and the blade mesh show that point outside). Unlike balls as wide as the holder, this does not reach down the axis
 //! by the holder's radius: a holder 5 mm above a plane is 5 mm clear.
 //!
 //! Stated error: the answer is a lower bound of the true clearance, tighter than `tol/2`
@@ -51,9 +82,14 @@
 //! operations whose tools touch a floor with a flat bottom (plunge roughing) ask for the blades
 //! only ([`ClearanceOptions::parts`]).
 //!
-//! Cost per posture: O(L / s) mesh point queries and hub projections, exact blade projections
-//! only for samples within the band of a blade, and one BVH contact query per frustum;
-//! [`DesignClearance::is_clear`] stops at the first failing part.
+//! Cost per posture: O(log(L / s)) hub projections and capped BVH point queries when the tool
+//! is clear of the design by more than its sampling's Lipschitz slack (far from everything:
+//! a few µs), up to O(L / s) of each plus exact projections for the samples near the minimum
+//! when a long stretch of the flutes runs close to a blade; one BVH contact query per frustum
+//! and mesh. [`DesignClearance::is_clear`] prunes against its threshold and stops at the first
+//! failing part; [`DesignClearance::segment_clearance`] asks each midpoint only up to the
+//! value that settles both halves of its interval. No allocation per query (the open runs
+//! live in a per-thread buffer).
 //!
 //! Dependency: parry3d-f64 (the workspace's chosen BVH and convex-shape queries).
 
@@ -81,9 +117,10 @@ pub const EXACT_BAND_MM: f64 = 1.0;
 /// a coarser one is capped here so the shank/holder answers stay within 0.1 mm.
 pub const MAX_MESH_CHORD_MM: f64 = 0.05;
 
-/// Chord of the whole blade sides' mesh (mm), which only bounds the exact blade distances of
-/// the cutter samples: coarser is cheaper to query, and loosens the bounds by the chord.
-const BOUND_CHORD_MM: f64 = 0.05;
+/// Coarsest chord (mm) of the mesh of the whole blade sides, which only bounds the exact blade
+/// distances of the cutter samples from below (a finer design chord is kept): a coarser mesh
+/// is cheaper to query and loosens the bounds by its chord, leaving more exact projections.
+pub const BOUND_CHORD_MM: f64 = 0.05;
 
 /// Blade thickness grid (u × v samples per pressure side) for the thickest blade `t`.
 const THICKNESS_GRID: (usize, usize) = (24, 8);
