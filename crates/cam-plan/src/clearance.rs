@@ -942,6 +942,24 @@ impl<'a> DesignClearance<'a> {
             >= min_clearance_mm
     }
 
+    /// [`Self::clearance`] when it is at least `min_clearance_mm`, else `None`: one query where
+    /// [`Self::is_clear`] followed by [`Self::clearance`] would take two (it stops at the
+    /// first part found below `min_clearance_mm`, and otherwise finds the minimum).
+    pub fn clearance_if_clear(
+        &self,
+        cl: &CutterLocation,
+        min_clearance_mm: f64,
+    ) -> Option<Clearance> {
+        let c = self.evaluate(
+            cl,
+            Want {
+                cap: f64::INFINITY,
+                fail_below: min_clearance_mm,
+            },
+        );
+        (c.distance_mm >= min_clearance_mm).then_some(c)
+    }
+
     /// Whether the whole motion from `a` to `b` keeps at least `min_clearance_mm − tol_mm` from
     /// the design: tip on the straight line, tool axis on the great circle (the motion a
     /// five-axis controller makes between two blocks, up to the post's linearisation

@@ -203,6 +203,12 @@ fn check(
                 r >= m,
                 "posture {k} {cl:?}: is_clear({m}) disagrees with the reference {reference:?}"
             );
+            let once = q.clearance_if_clear(&cl, m);
+            assert_eq!(
+                once.map(|c| c.distance_mm),
+                (r >= m).then_some(f),
+                "posture {k} {cl:?}: clearance_if_clear({m}) is not is_clear then clearance"
+            );
         }
     }
     in_band
