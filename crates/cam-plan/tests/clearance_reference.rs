@@ -403,3 +403,36 @@ fn pruned_blade_distance_is_the_exhaustive_one() {
     }
     assert!(near >= 100, "only {near} points within 1 mm of a blade");
 }
+
+#[test]
+fn bull_nose_and_flat_end_against_the_blades_match_the_reference() {
+    // Plunge roughing asks for the blades only, with flat-bottomed tools.
+    for (seed, shape) in [
+        (
+            13,
+            CutterShape::BullNose {
+                radius: 1.5,
+                corner_radius: 0.5,
+            },
+        ),
+        (14, CutterShape::FlatEnd { radius: 1.5 }),
+    ] {
+        let mut tool = ball(1.5);
+        tool.cutter.shape = shape;
+        let n = check(
+            &tool,
+            1.5,
+            ClearanceOptions {
+                parts: PartSet::BLADES,
+                sample_tol_mm: TOL,
+                above_mm: 0.0,
+            },
+            seed,
+            200,
+        );
+        assert!(
+            n >= 40,
+            "{shape:?}: only {n} postures within the exact band"
+        );
+    }
+}
