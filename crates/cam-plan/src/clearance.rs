@@ -18,31 +18,62 @@
 //!   exact query costs four blade-side projections however many blades there are.
 //!
 //! A [`DesignMesh`] triangulates the design within a chord tolerance `c` (hub surface with its
-//! inlet disc and outlet cylinder, every blade side; parry BVH): the true surfaces lie within
-//! `c` of the mesh.
+//! inlet disc and outlet cylinder, every blade side clipped at the shroud contour; parry BVH):
+//! the true surfaces lie within `c` of the mesh. It also holds the blade sides whole (as far
+//! as the exact side distances measure, past the shroud too) at a coarser chord `c_b ≥ c`
+//! ([`BOUND_CHORD_MM`]), for every instance and for each row's reference blade alone: these
+//! only bound the exact distances from below (`d_m − c_b`, `d_m` the unsigned distance to that
+//! mesh), and only where the point is outside every blade, which `d_m − c_b ≥ t/2` shows (`t`
+//! the thickest blade: a point inside a blade is within `t/2` of a side).
 //!
 //! **Cutter** (the fluted part, `0 ≤ h ≤ L`): a solid of revolution of radius `ρ(h)` about the
 //! axis. Its cross-section at height `h` is a disc inside the ball of radius `ρ(h)` about
 //! `c(h) = tip + h·axis`, so `d(c(h)) − ρ(h)` (`d` the design's signed distance) bounds the
-//! disc's clearance from below. The query takes the minimum over sample heights: the ball
+//! disc's clearance from below. The answer is the minimum over sample heights: the ball
 //! centre of ball and tapered-ball ends (where the ball is the cutter's end exactly), then a
 //! grid up the flutes with a step `s ≤ min(ρ/2, √(2·ρ·tol))`; between two samples the union of
-//! balls misses a rim band of depth `≤ s²/(4ρ) ≤ tol/2`. `d` is exact (NURBS) where it matters:
-//! the blade distance is first bounded with the mesh (unsigned distance `d_m` to the blade
-//! sides, BVH, O(log T)); when `d_m − c − t/2 ≥ ρ + EXACT_BAND_MM` (`t` the thickest blade) the
-//! ball centre is outside every blade and `d_m − c` is used (a lower bound at least
-//! `EXACT_BAND_MM` beyond the ball), and likewise when the centre is outside every blade and
-//! the bound already shows the sample cannot lower the minimum found so far (nor fail
-//! `is_clear`); otherwise the exact NURBS distance. So the minimum is exact wherever it lies
-//! within the band. The hub distance is
-//! always exact (a meridional curve projection).
+//! balls misses a rim band of depth `≤ s²/(4ρ) ≤ tol/2`. Each sample's value is
+//! `min(d_hub, d_shroud, d_blade) − ρ` with the hub and shroud distances exact (meridional
+//! projections), the blade distance exact (NURBS projections) within [`EXACT_BAND_MM`] of the
+//! ball and the mesh bound `d_m − c_b` beyond it (`d_m − c_b − t/2 ≥ ρ + EXACT_BAND_MM`).
+//!
+//! The minimum is found without evaluating most samples, by best-first branch and bound over
+//! runs of consecutive samples, using that a distance is 1-Lipschitz along the axis:
+//! `|d(c(h)) − d(c(h'))| ≤ |h − h'|`. A run between two samples of known distance `D_l`, `D_r`
+//! has every distance at least the lowest point of the cones `D_l − (h − h_l)` and
+//! `D_r − (h_r − h)` over it, so its clearance is at least that less its widest radius; a run
+//! whose bound is not below the least clearance found so far (or a check's threshold) holds
+//! no sample that could lower the answer or fail the check, and is dropped whole. Runs are
+//! split at their middle sample, the lowest bound first:
+//! - hub: the samples at both ends, then middles. The capped hub distance is 1-Lipschitz
+//!   except across the rays beyond an end `e` of the contour on its material side
+//!   (`e + s·T`, `T` the tangent pointing away), where the distance to the contour jumps from
+//!   `−s` to `s`; at an end where the inlet plane or the outlet cylinder passes through `e`
+//!   perpendicular to `T`, the cap reads `s` there and nothing jumps (so on the fixtures'
+//!   hubs everywhere). Otherwise the search runs only when the axis segment's meridional
+//!   trace stays out of the quadrant `(x − e)·T ≥ 0, (x − e)·n ≤ 0` beyond that end (checked
+//!   in O(1): `z` is linear along the segment and `r` convex), and every sample is evaluated
+//!   if not;
+//! - blades: the middle sample's mesh distance (BVH point query capped where the whole run
+//!   would be dropped: nothing within the cap drops it at once); a sample whose mesh bound
+//!   already shows it cannot lower the answer keeps the bound, one beyond the band takes it
+//!   as its value, and the others wait, bounded, for their exact distance, also taken lowest
+//!   bound first. An exact distance projects on the two instances of each row around the
+//!   point nearest in polar angle first, and leaves out an instance its row's reference mesh
+//!   (the point turned into that blade's frame) keeps `c_b + max(t/2, x)` away, `x` the
+//!   least distance so far or the value below which the sample matters.
+//!
+//! So the answer is the minimum over every sample exactly as an exhaustive evaluation would
+//! give it wherever that minimum lies within [`EXACT_BAND_MM`] of a blade, and a lower bound of
+//! it elsewhere (`DesignClearance::clearance_exhaustive` keeps the exhaustive evaluation for
+//! the tests that check so).
 //!
 //! **Shank and holder**: the frusta of [`cam_core::Cutter::frusta`] above the flutes, each as
 //! a convex polyhedron circumscribing it (polygon rings whose sides stay within `c` of the
 //! circle), placed at the posture and measured against the hub and blade meshes with parry's
 //! contact query (signed: negative = penetration depth), minus `c` for the mesh. A frustum
 //! buried entirely inside material (no mesh crossing) is caught by the exact signed distance
-//! at its axis midpoint. Unlike balls as wide as the holder, this does not reach down the axis
+//! at its axis midpoint (unless the hub distance and the blade mesh show that point outside). Unlike balls as wide as the holder, this does not reach down the axis
 //! by the holder's radius: a holder 5 mm above a plane is 5 mm clear.
 //!
 //! Stated error: the answer is a lower bound of the true clearance, tighter than `tol/2`
@@ -55,9 +86,14 @@
 //! operations whose tools touch a floor with a flat bottom (plunge roughing) ask for the blades
 //! only ([`ClearanceOptions::parts`]).
 //!
-//! Cost per posture: O(L / s) mesh point queries and hub projections, exact blade projections
-//! only for samples within the band of a blade, and one BVH contact query per frustum;
-//! [`DesignClearance::is_clear`] stops at the first failing part.
+//! Cost per posture: O(log(L / s)) hub projections and capped BVH point queries when the tool
+//! is clear of the design by more than its sampling's Lipschitz slack (far from everything:
+//! a few µs), up to O(L / s) of each plus exact projections for the samples near the minimum
+//! when a long stretch of the flutes runs close to a blade; one BVH contact query per frustum
+//! and mesh. [`DesignClearance::is_clear`] prunes against its threshold and stops at the first
+//! failing part; [`DesignClearance::segment_clearance`] asks each midpoint only up to the
+//! value that settles both halves of its interval. No allocation per query (the open runs
+//! live in a per-thread buffer).
 //!
 //! Dependency: parry3d-f64 (the workspace's chosen BVH and convex-shape queries).
 
@@ -68,7 +104,7 @@ use impeller_model::query::blade_side_distance;
 use impeller_model::{BladeSet, Impeller, Side};
 use parry3d_f64::math::{Pose, Rotation, Vector as PVec};
 use parry3d_f64::query::{self, PointQueryWithLocation};
-use parry3d_f64::shape::{ConvexPolyhedron, TriMesh};
+use parry3d_f64::shape::{CompositeShapeRef, ConvexPolyhedron, TriMesh};
 use std::sync::Arc;
 
 /// Default sampling tolerance of the swept balls (mm): the largest rim band between two
@@ -84,6 +120,11 @@ pub const EXACT_BAND_MM: f64 = 1.0;
 /// Coarsest chord of the design mesh (mm): a finer `sample_tol_mm` makes the mesh follow it,
 /// a coarser one is capped here so the shank/holder answers stay within 0.1 mm.
 pub const MAX_MESH_CHORD_MM: f64 = 0.05;
+
+/// Coarsest chord (mm) of the mesh of the whole blade sides, which only bounds the exact blade
+/// distances of the cutter samples from below (a finer design chord is kept): a coarser mesh
+/// is cheaper to query and loosens the bounds by its chord, leaving more exact projections.
+pub const BOUND_CHORD_MM: f64 = 0.05;
 
 /// Blade thickness grid (u × v samples per pressure side) for the thickest blade `t`.
 const THICKNESS_GRID: (usize, usize) = (24, 8);
@@ -245,6 +286,16 @@ pub struct DesignMesh {
     blades: TriMesh,
     /// (row, instance) of each blade triangle.
     blade_of: Vec<(Row, usize)>,
+    /// The blade sides whole, including where they reach past the shroud contour (the exact
+    /// side distances measure to them there).
+    blade_sides: TriMesh,
+    /// (row, instance) of each triangle of `blade_sides`.
+    side_of: Vec<(Row, usize)>,
+    /// The chord of `blade_sides`.
+    side_chord_mm: f64,
+    /// Each row's reference blade (instance 0), both sides whole, in its own frame: the
+    /// blade distance of one instance is bounded by turning the point into that frame.
+    reference_sides: Vec<(Row, TriMesh)>,
     chord_mm: f64,
     thickest_blade_mm: f64,
 }
@@ -280,6 +331,7 @@ impl DesignMesh {
             ));
         }
         let chord = chord_mm.min(MAX_MESH_CHORD_MM);
+        let side_chord = chord.max(BOUND_CHORD_MM);
         let mesh_err = |e: impeller_model::export::ExportError| {
             PlanError::geometry("-", "design mesh", e.to_string())
         };
@@ -330,35 +382,27 @@ impl DesignMesh {
         let hub = TriMesh::new(hub_v, hub_t)
             .map_err(|e| PlanError::geometry("-", "hub mesh", format!("{e:?}")))?;
 
-        let mut vertices: Vec<PVec> = Vec::new();
-        let mut triangles: Vec<[u32; 3]> = Vec::new();
-        let mut blade_of = Vec::new();
+        // Every instance of each row's sides: clipped at the shroud (the material, for the
+        // shank and holder) and whole (as far as the exact side distances reach, for the
+        // cutter samples' bounds).
+        let mut clipped = BladeTriangles::default();
+        let mut whole = BladeTriangles::default();
         let mut thickest: f64 = 0.0;
         let rows = std::iter::once((Row::Main, impeller.main()))
             .chain(impeller.splitter().map(|s| (Row::Splitter, s)));
+        let mut reference = Vec::new();
         for (row, set) in rows {
             let blade = set.blade();
+            let mut own = BladeTriangles::default();
             for side in [Side::Pressure, Side::Suction] {
                 let name = format!("{row:?} blade {side:?} side");
-                let sm = clip_at_shroud(
-                    impeller,
-                    &tessellate(blade.side(side), chord, &name).map_err(mesh_err)?,
-                );
-                for k in 0..set.count() {
-                    let rot = set.rotation(k);
-                    let base = vertices.len() as u32;
-                    vertices.extend(sm.vertices.iter().map(|v| {
-                        let q = rot * v;
-                        PVec::new(q.x, q.y, q.z)
-                    }));
-                    triangles.extend(
-                        sm.triangles
-                            .iter()
-                            .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
-                    );
-                    blade_of.extend(std::iter::repeat_n((row, k), sm.triangles.len()));
-                }
+                let sm = tessellate(blade.side(side), chord, &name).map_err(mesh_err)?;
+                clipped.add_instances(&clip_at_shroud(impeller, &sm), row, set);
+                let coarse = tessellate(blade.side(side), side_chord, &name).map_err(mesh_err)?;
+                whole.add_instances(&coarse, row, set);
+                own.add(&coarse, row, 0, &nalgebra::Rotation3::identity());
             }
+            reference.push((row, own));
             // Thickest blade: suction-side distance of pressure-side grid points.
             let ps = blade.side(Side::Pressure);
             let ((u0, u1), (v0, v1)) = ps.domain();
@@ -374,13 +418,26 @@ impl DesignMesh {
                 }
             }
         }
-        let blades = TriMesh::new(vertices, triangles)
-            .map_err(|e| PlanError::geometry("-", "blade mesh", format!("{e:?}")))?;
+        let blade_mesh = |t: BladeTriangles| {
+            TriMesh::new(t.vertices, t.triangles)
+                .map(|m| (m, t.blade_of))
+                .map_err(|e| PlanError::geometry("-", "blade mesh", format!("{e:?}")))
+        };
+        let (blades, blade_of) = blade_mesh(clipped)?;
+        let (blade_sides, side_of) = blade_mesh(whole)?;
+        let reference_sides = reference
+            .into_iter()
+            .map(|(row, t)| blade_mesh(t).map(|(m, _)| (row, m)))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             hub,
             blades,
             blade_of,
+            blade_sides,
+            side_of,
             chord_mm: chord,
+            side_chord_mm: side_chord,
+            reference_sides,
             thickest_blade_mm: thickest,
         })
     }
@@ -393,6 +450,23 @@ impl DesignMesh {
     /// The thickest blade found (mm).
     pub fn thickest_blade_mm(&self) -> f64 {
         self.thickest_blade_mm
+    }
+
+    /// Unsigned distance from `p` to the nearest triangle of the whole blade sides and the
+    /// blade it belongs to when it is below `max_dist`, else `None` (the search prunes every
+    /// BVH node beyond `max_dist`: cheap far from the blades). O(log T).
+    fn side_mesh_distance_within(&self, p: &Point3, max_dist: f64) -> Option<(f64, DesignPart)> {
+        let q = pv(p);
+        let (tri, proj, _) = CompositeShapeRef(&self.blade_sides)
+            .project_local_point_and_get_location(q, max_dist, false)?;
+        let part = self
+            .side_of
+            .get(tri as usize)
+            .map_or(DesignPart::Hub, |&(row, index)| DesignPart::Blade {
+                row,
+                index,
+            });
+        Some(((proj.point - q).length(), part))
     }
 
     /// Unsigned distance from `p` to the nearest blade side triangle and the blade it
@@ -408,6 +482,50 @@ impl DesignMesh {
                 index,
             });
         ((proj.point - q).length(), part)
+    }
+}
+
+/// Triangles of blade sides copied to every instance of their rows.
+#[derive(Default)]
+struct BladeTriangles {
+    vertices: Vec<PVec>,
+    triangles: Vec<[u32; 3]>,
+    blade_of: Vec<(Row, usize)>,
+}
+
+impl BladeTriangles {
+    /// Adds `mesh` (of the reference blade) at every instance of `set`.
+    fn add_instances(
+        &mut self,
+        mesh: &impeller_model::export::stl::TriMesh,
+        row: Row,
+        set: &BladeSet,
+    ) {
+        for k in 0..set.count() {
+            self.add(mesh, row, k, &set.rotation(k));
+        }
+    }
+
+    /// Adds `mesh` turned by `rot` as instance `k` of `row`.
+    fn add(
+        &mut self,
+        mesh: &impeller_model::export::stl::TriMesh,
+        row: Row,
+        k: usize,
+        rot: &nalgebra::Rotation3<f64>,
+    ) {
+        let base = self.vertices.len() as u32;
+        self.vertices.extend(mesh.vertices.iter().map(|v| {
+            let q = rot * v;
+            PVec::new(q.x, q.y, q.z)
+        }));
+        self.triangles.extend(
+            mesh.triangles
+                .iter()
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
+        self.blade_of
+            .extend(std::iter::repeat_n((row, k), mesh.triangles.len()));
     }
 }
 
@@ -501,6 +619,8 @@ pub struct DesignClearance<'a> {
     mesh: Arc<DesignMesh>,
     hub_z_max: f64,
     hub_r_max: f64,
+    /// The two ends of the hub contour.
+    hub_ends: [ContourEnd; 2],
     rows: Vec<(Row, RowAngles)>,
     /// Largest distance of a tool point from the tip (top of the holder plus its radius):
     /// the lever arm of a change of tool axis in [`DesignClearance::segment_clearance`].
@@ -606,6 +726,8 @@ impl<'a> DesignClearance<'a> {
             }
             h = next;
         }
+        // By height: the blade search bisects runs of neighbouring samples.
+        samples.sort_by(|a, b| a.0.total_cmp(&b.0));
         let chord = mesh.chord_mm;
         let frusta = c
             .frusta(chord)
@@ -652,6 +774,10 @@ impl<'a> DesignClearance<'a> {
             mesh,
             hub_z_max: a[0].max(b[0]),
             hub_r_max: a[1].max(b[1]),
+            hub_ends: [
+                ContourEnd::new(hub, t0, -1.0, (a[0].max(b[0]), a[1].max(b[1]))),
+                ContourEnd::new(hub, t1, 1.0, (a[0].max(b[0]), a[1].max(b[1]))),
+            ],
             rows,
             reach_mm: top + widest,
         })
@@ -691,80 +817,110 @@ impl<'a> DesignClearance<'a> {
     /// Signed distance of the nearest blade (negative inside it) and which blade it is
     /// (exact: NURBS projections on the two instances of each row around `p`).
     pub fn blade_signed_distance(&self, p: &Point3) -> (f64, DesignPart) {
-        let d_shroud = self.impeller.shroud().signed_distance(&p.coords);
-        let mut best = (f64::INFINITY, DesignPart::Hub);
-        for (row, angles) in &self.rows {
-            let set = match row {
-                Row::Main => self.impeller.main(),
-                Row::Splitter => match self.impeller.splitter() {
-                    Some(s) => s,
-                    None => continue,
-                },
+        self.blade_signed_distance_below(p, f64::INFINITY).0
+    }
+
+    /// [`Self::blade_signed_distance`] where only distances below `floor` matter. The
+    /// candidate instances are projected on nearest in polar angle first; an instance whose
+    /// whole-sides mesh (turned into the reference blade's frame) keeps `p` at least
+    /// `c + max(t/2, x)` away, `x` the smaller of `floor` and the least distance so far, is
+    /// outside it by at least `x` and is not projected on. Returns the least exact distance
+    /// of the projected instances and whether one was left out only by the floor: the answer
+    /// is exact when it is below `floor` or none was.
+    fn blade_signed_distance_below(&self, p: &Point3, floor: f64) -> ((f64, DesignPart), bool) {
+        self.blade_distance_of_candidates(p, floor, true)
+    }
+
+    /// [`Self::blade_signed_distance`] projecting on every candidate instance (no mesh
+    /// bound): the reference the tests hold the pruned distance to.
+    #[doc(hidden)]
+    pub fn blade_signed_distance_exhaustive(&self, p: &Point3) -> (f64, DesignPart) {
+        self.blade_distance_of_candidates(p, f64::INFINITY, false).0
+    }
+
+    /// The distance of the two instances of each row around `p` (see
+    /// [`Self::blade_signed_distance_below`]; `prune` false projects on all of them).
+    fn blade_distance_of_candidates(
+        &self,
+        p: &Point3,
+        floor: f64,
+        prune: bool,
+    ) -> ((f64, DesignPart), bool) {
+        let c = self.mesh.side_chord_mm;
+        let half_t = 0.5 * self.mesh.thickest_blade_mm;
+        // The two instances of each row around `p`, nearest in polar angle first.
+        let mut candidates: [Option<(f64, Row, usize)>; 4] = [None; 4];
+        for (slot, (row, angles)) in self.rows.iter().enumerate().take(2) {
+            let Some(set) = self.row_set(*row) else {
+                continue;
             };
             let n = set.count();
             let pitch = set.pitch_rad();
             let rel = (p.y.atan2(p.x) - angles.angle_near(p)).rem_euclid(std::f64::consts::TAU);
             let k0 = ((rel / pitch).floor() as usize) % n;
-            for k in [k0, (k0 + 1) % n] {
-                let local = set.rotation(k).inverse() * p.coords;
-                let (sp, dp) = blade_side_distance(set.blade(), Side::Pressure, &local, None);
-                let (_, ds) = blade_side_distance(set.blade(), Side::Suction, &local, None);
-                let ((u0, u1), _) = set.blade().side(Side::Pressure).domain();
-                let end = usize::from(sp.u > 0.5 * (u0 + u1));
-                let d = impeller_model::query::blade_solid_distance(
-                    dp,
-                    ds,
-                    d_shroud,
-                    angles.edge_half_gaps[end],
-                );
-                if d < best.0 {
-                    best = (
-                        d,
-                        DesignPart::Blade {
-                            row: *row,
-                            index: k,
-                        },
-                    );
+            let behind = rel - k0 as f64 * pitch;
+            candidates[2 * slot] = Some((behind, *row, k0));
+            candidates[2 * slot + 1] = Some((pitch - behind, *row, (k0 + 1) % n));
+        }
+        candidates.sort_by(|a, b| {
+            let key = |x: &Option<(f64, Row, usize)>| x.map_or(f64::INFINITY, |x| x.0);
+            key(a).total_cmp(&key(b))
+        });
+        let d_shroud = self.impeller.shroud().signed_distance(&p.coords);
+        let mut best = (f64::INFINITY, DesignPart::Hub);
+        let mut skipped = false;
+        for &(_, row, k) in candidates.iter().flatten() {
+            let Some(set) = self.row_set(row) else {
+                continue;
+            };
+            let local = set.rotation(k).inverse() * p.coords;
+            // An instance the mesh keeps `c + max(t/2, x)` away is outside it by at least
+            // `x`: it cannot come below the floor nor the best distance so far.
+            let cap = c + half_t.max(floor.min(best.0));
+            let cap = cap + 1e-9 * (1.0 + cap.abs());
+            let mesh = self.mesh.reference_sides.iter().find(|(r, _)| *r == row);
+            if let Some((_, mesh)) = mesh.filter(|_| prune && cap.is_finite()) {
+                let q = PVec::new(local.x, local.y, local.z);
+                let near =
+                    CompositeShapeRef(mesh).project_local_point_and_get_location(q, cap, false);
+                if near.is_none() {
+                    skipped |= floor < best.0;
+                    continue;
                 }
             }
+            let (sp, dp) = blade_side_distance(set.blade(), Side::Pressure, &local, None);
+            let (_, ds) = blade_side_distance(set.blade(), Side::Suction, &local, None);
+            let ((u0, u1), _) = set.blade().side(Side::Pressure).domain();
+            let end = usize::from(sp.u > 0.5 * (u0 + u1));
+            let half_gap = self
+                .rows
+                .iter()
+                .find(|(r, _)| *r == row)
+                .map_or(half_t, |(_, angles)| angles.edge_half_gaps[end]);
+            let d = impeller_model::query::blade_solid_distance(dp, ds, d_shroud, half_gap);
+            if d < best.0 {
+                best = (d, DesignPart::Blade { row, index: k });
+            }
         }
-        best
+        (best, skipped)
     }
 
-    /// The blade distance a ball of radius `rho` about `p` needs: exact within
-    /// [`EXACT_BAND_MM`] of the ball, else the mesh's lower bound (see the module docs);
-    /// also using the mesh bound when it shows the
-    /// ball's clearance `d − ρ` is at least `need` (it cannot lower a minimum already at
-    /// `need`, nor fail a check against it).
-    fn blade_distance_below(&self, p: &Point3, rho: f64, need: f64) -> (f64, DesignPart) {
-        let (dm, part) = self.mesh.blade_mesh_distance(p);
-        let c = self.mesh.chord_mm;
-        let outside = dm - c - 0.5 * self.mesh.thickest_blade_mm >= 0.0;
-        if (outside && dm - c - rho >= need)
-            || dm - c - 0.5 * self.mesh.thickest_blade_mm >= rho + EXACT_BAND_MM
-        {
-            (dm - c, part)
-        } else {
-            self.blade_signed_distance(p)
+    /// The blade set of `row`.
+    fn row_set(&self, row: Row) -> Option<&BladeSet> {
+        match row {
+            Row::Main => Some(self.impeller.main()),
+            Row::Splitter => self.impeller.splitter(),
         }
     }
 
     /// Signed distance of the selected design parts at `p` (negative inside material; for
     /// the shroud, negative beyond it) and the nearest part. Exact (NURBS).
     pub fn design_signed_distance(&self, p: &Point3) -> (f64, DesignPart) {
-        self.design_distance_for(p, f64::INFINITY)
+        self.parts_signed_distance(&self.options.parts, p)
     }
 
-    /// [`DesignClearance::design_signed_distance`] for a ball of radius `rho` about `p`:
-    /// blade distances more than [`EXACT_BAND_MM`] beyond the ball may be mesh lower bounds.
-    fn design_distance_for(&self, p: &Point3, rho: f64) -> (f64, DesignPart) {
-        self.design_distance_below(p, rho, f64::INFINITY)
-    }
-
-    /// [`DesignClearance::design_distance_for`] where only clearances `d − ρ` below `need`
-    /// must be exact (see [`DesignClearance::blade_distance_below`]).
-    fn design_distance_below(&self, p: &Point3, rho: f64, need: f64) -> (f64, DesignPart) {
-        let parts = self.options.parts;
+    /// [`Self::design_signed_distance`] of the parts `parts`.
+    fn parts_signed_distance(&self, parts: &PartSet, p: &Point3) -> (f64, DesignPart) {
         let mut best = (f64::INFINITY, DesignPart::Hub);
         if parts.hub {
             best = (self.hub_signed_distance(p), DesignPart::Hub);
@@ -776,11 +932,7 @@ impl<'a> DesignClearance<'a> {
             }
         }
         if parts.blades {
-            let b = if rho.is_finite() {
-                self.blade_distance_below(p, rho, need.min(best.0 - rho))
-            } else {
-                self.blade_signed_distance(p)
-            };
+            let b = self.blade_signed_distance(p);
             if b.0 < best.0 {
                 best = b;
             }
@@ -790,13 +942,39 @@ impl<'a> DesignClearance<'a> {
 
     /// The smallest clearance of the tool at `cl` (see the module docs for what it bounds).
     pub fn clearance(&self, cl: &CutterLocation) -> Clearance {
-        self.evaluate(cl, None)
+        self.evaluate(cl, Want::MINIMUM)
     }
 
     /// Whether the tool at `cl` keeps at least `min_clearance_mm` from the design (stops at
     /// the first part that fails).
     pub fn is_clear(&self, cl: &CutterLocation, min_clearance_mm: f64) -> bool {
-        self.evaluate(cl, Some(min_clearance_mm)).distance_mm >= min_clearance_mm
+        self.evaluate(
+            cl,
+            Want {
+                cap: min_clearance_mm,
+                fail_below: min_clearance_mm,
+            },
+        )
+        .distance_mm
+            >= min_clearance_mm
+    }
+
+    /// [`Self::clearance`] when it is at least `min_clearance_mm`, else `None`: one query where
+    /// [`Self::is_clear`] followed by [`Self::clearance`] would take two (it stops at the
+    /// first part found below `min_clearance_mm`, and otherwise finds the minimum).
+    pub fn clearance_if_clear(
+        &self,
+        cl: &CutterLocation,
+        min_clearance_mm: f64,
+    ) -> Option<Clearance> {
+        let c = self.evaluate(
+            cl,
+            Want {
+                cap: f64::INFINITY,
+                fail_below: min_clearance_mm,
+            },
+        );
+        (c.distance_mm >= min_clearance_mm).then_some(c)
     }
 
     /// Whether the whole motion from `a` to `b` keeps at least `min_clearance_mm − tol_mm` from
@@ -866,7 +1044,18 @@ impl<'a> DesignClearance<'a> {
             if queries >= max_queries {
                 return Err(sm);
             }
-            let cm = self.clearance(&at(sm)).distance_mm;
+            // The midpoint's clearance matters only up to the value that settles both
+            // halves; above it, that value itself is the bound the halves need.
+            let settle = 2.0 * floor - c0.min(c1) + 0.5 * span * (s1 - s0);
+            let cm = self
+                .evaluate(
+                    &at(sm),
+                    Want {
+                        cap: settle.max(min_clearance_mm),
+                        fail_below: min_clearance_mm,
+                    },
+                )
+                .distance_mm;
             queries += 1;
             if cm < min_clearance_mm {
                 return Err(sm);
@@ -877,72 +1066,387 @@ impl<'a> DesignClearance<'a> {
         Ok(())
     }
 
-    /// The clearance at `cl`; with `stop_below`, returns as soon as a part is found below it.
-    fn evaluate(&self, cl: &CutterLocation, stop_below: Option<f64>) -> Clearance {
+    /// The clearance of the reference method: every cutter sample measured, with the exact
+    /// blade distance wherever the blade mesh comes within [`EXACT_BAND_MM`] of its ball (else
+    /// the mesh's lower bound, as in [`Self::clearance`]) and no pruning; then the shroud
+    /// samples and the shank and holder frusta as [`Self::clearance`] measures them. The
+    /// fast query is a lower bound of this answer and equals it where it lies within
+    /// [`EXACT_BAND_MM`]; kept for the tests that check so. Cost: O(L / s) mesh queries and
+    /// as many exact blade projections as samples in the band.
+    #[doc(hidden)]
+    pub fn clearance_exhaustive(&self, cl: &CutterLocation) -> Clearance {
         let axis: Vector3 = cl.axis.into_inner();
-        let mut best = Clearance {
-            distance_mm: f64::INFINITY,
-            design_part: DesignPart::Hub,
-            tool_part: ToolPart::Cutter,
-            height_mm: 0.0,
-        };
-        let failed = |b: &Clearance| stop_below.is_some_and(|m| b.distance_mm < m);
+        let parts = self.options.parts;
+        let c = self.mesh.side_chord_mm;
+        let half_t = 0.5 * self.mesh.thickest_blade_mm;
+        let mut best = NO_CLEARANCE;
         for &(h, rho, part) in &self.samples {
             if h <= self.options.above_mm {
                 continue;
             }
-            // Exact only where this sample could lower the answer (or fail the check).
-            let need = stop_below.map_or(best.distance_mm, |m| m.min(best.distance_mm));
-            let (d, dp) = self.design_distance_below(&(cl.tip + axis * h), rho, need);
-            if d - rho < best.distance_mm {
+            let p = cl.tip + axis * h;
+            let mut d = self.parts_signed_distance(
+                &PartSet {
+                    blades: false,
+                    ..parts
+                },
+                &p,
+            );
+            if parts.blades {
+                let (dm, dp) = self
+                    .mesh
+                    .side_mesh_distance_within(&p, f64::INFINITY)
+                    .unwrap_or((f64::INFINITY, DesignPart::Hub));
+                let b = if dm - c - half_t >= rho + EXACT_BAND_MM {
+                    (dm - c, dp)
+                } else {
+                    self.blade_signed_distance_exhaustive(&p)
+                };
+                if b.0 < d.0 {
+                    d = b;
+                }
+            }
+            if d.0 - rho < best.distance_mm {
                 best = Clearance {
-                    distance_mm: d - rho,
-                    design_part: dp,
+                    distance_mm: d.0 - rho,
+                    design_part: d.1,
                     tool_part: part,
                     height_mm: h,
                 };
-                if failed(&best) {
-                    return best;
-                }
             }
         }
-        if self.options.parts.shroud {
-            for &(h, rho, part) in &self.upper_samples {
-                let d = self.shroud_signed_distance(&(cl.tip + axis * h));
-                if d - rho < best.distance_mm {
+        self.upper_and_frusta(cl, Want::MINIMUM, &mut best);
+        best
+    }
+
+    /// The clearance at `cl` as `want` asks for it: exact below `want.cap`, else `want.cap`
+    /// (a lower bound); returns as soon as a part is found below `want.fail_below`.
+    fn evaluate(&self, cl: &CutterLocation, want: Want) -> Clearance {
+        let mut best = self.evaluate_parts(cl, want);
+        best.distance_mm = best.distance_mm.min(want.cap);
+        best
+    }
+
+    /// [`Self::evaluate`] before the cap: the smallest clearance found, which is above the cap
+    /// (possibly infinite) when nothing comes below it.
+    fn evaluate_parts(&self, cl: &CutterLocation, want: Want) -> Clearance {
+        let axis: Vector3 = cl.axis.into_inner();
+        let mut best = NO_CLEARANCE;
+        // Below this the check fails (−∞: no check, the minimum is wanted).
+        let parts = self.options.parts;
+        let first = self
+            .samples
+            .partition_point(|s| s.0 <= self.options.above_mm);
+        let samples = &self.samples[first..];
+        // The exact and cheap parts first (a meridional projection each): they fix a bound
+        // the blade search below prunes with, and fail a check early.
+        if parts.shroud {
+            for &(h, rho, part) in samples {
+                let ds = self.shroud_signed_distance(&(cl.tip + axis * h));
+                if ds - rho < best.distance_mm {
                     best = Clearance {
-                        distance_mm: d - rho,
+                        distance_mm: ds - rho,
                         design_part: DesignPart::Shroud,
                         tool_part: part,
                         height_mm: h,
                     };
-                    if failed(&best) {
+                    if want.failed(&best) {
                         return best;
                     }
                 }
             }
         }
-        if self.frusta.is_empty() || !(self.options.parts.hub || self.options.parts.blades) {
+        if parts.hub && !samples.is_empty() && self.hub_search(cl, samples, want, &mut best) {
             return best;
+        }
+        if parts.blades && !samples.is_empty() && self.blade_search(cl, samples, want, &mut best) {
+            return best;
+        }
+        self.upper_and_frusta(cl, want, &mut best);
+        best
+    }
+
+    /// The hub against the cutter samples `samples` (sorted by height), best first (see the
+    /// module docs): lowers `best`; `true` when the check `want` failed.
+    fn hub_search(
+        &self,
+        cl: &CutterLocation,
+        samples: &[(f64, f64, ToolPart)],
+        want: Want,
+        best: &mut Clearance,
+    ) -> bool {
+        let axis: Vector3 = cl.axis.into_inner();
+        let n = samples.len();
+        let failed = |b: &Clearance| want.failed(b);
+        let hub_at = |i: usize, best: &mut Clearance| -> f64 {
+            let (h, rho, part) = samples[i];
+            let d = self.hub_signed_distance(&(cl.tip + axis * h));
+            if d - rho < best.distance_mm {
+                *best = Clearance {
+                    distance_mm: d - rho,
+                    design_part: DesignPart::Hub,
+                    tool_part: part,
+                    height_mm: h,
+                };
+            }
+            d
+        };
+        let (first, last) = (samples[0].0, samples[n - 1].0);
+        if n < 3 || !self.hub_is_lipschitz_on(&(cl.tip + axis * first), &(cl.tip + axis * last)) {
+            for i in 0..n {
+                hub_at(i, best);
+                if failed(best) {
+                    return true;
+                }
+            }
+            return false;
+        }
+        let d0 = hub_at(0, best);
+        let d1 = hub_at(n - 1, best);
+        if failed(best) {
+            return true;
+        }
+        let mut open = SCRATCH.with(|s| s.take());
+        open.clear();
+        open.push(Pending::range(
+            samples,
+            1,
+            n - 2,
+            Some((first, d0)),
+            Some((last, d1)),
+            |valley| valley,
+        ));
+        let mut failed_now = false;
+        while !open.is_empty() {
+            let need = want.need(best);
+            let mut k = 0;
+            for (j, item) in open.iter().enumerate() {
+                if item.bound() < open[k].bound() {
+                    k = j;
+                }
+            }
+            if open[k].bound() >= need {
+                break;
+            }
+            if let Pending::Range {
+                lo,
+                hi,
+                left,
+                right,
+                ..
+            } = open.swap_remove(k)
+            {
+                let m = lo + (hi - lo) / 2;
+                let anchor = Some((samples[m].0, hub_at(m, best)));
+                if failed(best) {
+                    failed_now = true;
+                    break;
+                }
+                if m > lo {
+                    open.push(Pending::range(samples, lo, m - 1, left, anchor, |v| v));
+                }
+                if m < hi {
+                    open.push(Pending::range(samples, m + 1, hi, anchor, right, |v| v));
+                }
+            }
+        }
+        open.clear();
+        SCRATCH.with(|s| s.replace(open));
+        failed_now
+    }
+
+    /// Whether the hub's signed distance is 1-Lipschitz along the segment `p0 p1` (module
+    /// docs): at each end `e` of the contour that no cap covers, the meridional trace of the
+    /// segment stays out of the quadrant beyond the end on the material side,
+    /// `(x − e)·T ≥ 0` and `(x − e)·n ≤ 0` (`T` the tangent pointing away from the contour,
+    /// `n` the channel-side normal), where the sign of the distance to the contour jumps on
+    /// the ray `e + s·T`. O(1).
+    fn hub_is_lipschitz_on(&self, p0: &Point3, p1: &Point3) -> bool {
+        let zr = |p: &Point3| [p.z, p.x.hypot(p.y)];
+        let (a, b) = (zr(p0), zr(p1));
+        // Least radius along the segment: its distance from the axis.
+        let (dx, dy) = (p1.x - p0.x, p1.y - p0.y);
+        let l2 = dx * dx + dy * dy;
+        let s = if l2 > 0.0 {
+            (-(p0.x * dx + p0.y * dy) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let r_min = (p0.x + s * dx).hypot(p0.y + s * dy);
+        // Largest value along the segment of g = w·((z, r) − e): z is linear in the segment
+        // parameter and r convex, so g is convex when w_r ≥ 0 (largest at an end), and
+        // below its linear part plus w_r·(r_min − e_r) otherwise.
+        let sup = |w: [f64; 2], e: [f64; 2]| -> f64 {
+            let lin = |q: [f64; 2], r: f64| w[0] * (q[0] - e[0]) + w[1] * (r - e[1]);
+            if w[1] >= 0.0 {
+                lin(a, a[1]).max(lin(b, b[1]))
+            } else {
+                lin(a, r_min).max(lin(b, r_min))
+            }
+        };
+        self.hub_ends.iter().all(|end| {
+            end.capped
+                || sup(end.away, end.point) < 0.0
+                || sup([-end.normal[0], -end.normal[1]], end.point) < 0.0
+        })
+    }
+
+    /// The blades against the cutter samples `samples` (sorted by height), best first (see
+    /// the module docs): lowers `best`; `true` when the check `want` failed.
+    fn blade_search(
+        &self,
+        cl: &CutterLocation,
+        samples: &[(f64, f64, ToolPart)],
+        want: Want,
+        best: &mut Clearance,
+    ) -> bool {
+        let axis: Vector3 = cl.axis.into_inner();
+        let c = self.mesh.side_chord_mm;
+        let half_t = 0.5 * self.mesh.thickest_blade_mm;
+        let n = samples.len();
+        let mut open = SCRATCH.with(|s| s.take());
+        open.clear();
+        open.push(Pending::Range {
+            lo: 0,
+            hi: n - 1,
+            left: None,
+            right: None,
+            bound: f64::NEG_INFINITY,
+        });
+        let mut failed = false;
+        while !open.is_empty() {
+            // Only samples that could lower the answer (or fail the check) matter.
+            let need = want.need(best);
+            let mut k = 0;
+            for (j, item) in open.iter().enumerate() {
+                if item.bound() < open[k].bound() {
+                    k = j;
+                }
+            }
+            if open[k].bound() >= need {
+                break;
+            }
+            match open.swap_remove(k) {
+                Pending::Exact { index, .. } => {
+                    let (h, rho, part) = samples[index];
+                    let ((d, dp), skipped) =
+                        self.blade_signed_distance_below(&(cl.tip + axis * h), need + rho);
+                    // A left-out blade is only known to be at least `need` away: nothing to
+                    // record unless an exact distance came below that.
+                    if (d < need + rho || !skipped) && d - rho < best.distance_mm {
+                        *best = Clearance {
+                            distance_mm: d - rho,
+                            design_part: dp,
+                            tool_part: part,
+                            height_mm: h,
+                        };
+                    }
+                }
+                Pending::Range {
+                    lo,
+                    hi,
+                    left,
+                    right,
+                    ..
+                } => {
+                    let m = lo + (hi - lo) / 2;
+                    let (h, rho, part) = samples[m];
+                    let reach = (h - samples[lo].0).max(samples[hi].0 - h);
+                    let rho_max = samples[lo..=hi].iter().map(|s| s.1).fold(rho, f64::max);
+                    // Beyond this, no sample of the range is inside a blade or below `need`.
+                    let cap = c + half_t.max(need + rho_max) + reach;
+                    let Some((dm, dp)) = self
+                        .mesh
+                        .side_mesh_distance_within(&(cl.tip + axis * h), cap + 1e-9 * (1.0 + cap))
+                    else {
+                        continue;
+                    };
+                    let outside = dm - c - half_t >= 0.0;
+                    if (outside && dm - c - rho >= need) || dm - c - half_t >= rho + EXACT_BAND_MM {
+                        if dm - c - rho < best.distance_mm {
+                            *best = Clearance {
+                                distance_mm: dm - c - rho,
+                                design_part: dp,
+                                tool_part: part,
+                                height_mm: h,
+                            };
+                        }
+                    } else {
+                        open.push(Pending::Exact {
+                            index: m,
+                            bound: if outside {
+                                dm - c - rho
+                            } else {
+                                f64::NEG_INFINITY
+                            },
+                        });
+                    }
+                    let anchor = Some((h, dm));
+                    // The mesh bound holds only where the run is outside every blade.
+                    let bound = |valley: f64| {
+                        if valley - c >= half_t {
+                            valley - c
+                        } else {
+                            f64::NEG_INFINITY
+                        }
+                    };
+                    if m > lo {
+                        open.push(Pending::range(samples, lo, m - 1, left, anchor, bound));
+                    }
+                    if m < hi {
+                        open.push(Pending::range(samples, m + 1, hi, anchor, right, bound));
+                    }
+                }
+            }
+            if want.failed(best) {
+                failed = true;
+                break;
+            }
+        }
+        open.clear();
+        SCRATCH.with(|s| s.replace(open));
+        failed
+    }
+
+    /// The shroud samples above the flutes and the shank and holder frusta (module docs):
+    /// lowers `best`; `true` when the check `want` failed.
+    fn upper_and_frusta(&self, cl: &CutterLocation, want: Want, best: &mut Clearance) -> bool {
+        let axis: Vector3 = cl.axis.into_inner();
+        let failed = |b: &Clearance| want.failed(b);
+        if self.options.parts.shroud {
+            for &(h, rho, part) in &self.upper_samples {
+                let d = self.shroud_signed_distance(&(cl.tip + axis * h));
+                if d - rho < best.distance_mm {
+                    *best = Clearance {
+                        distance_mm: d - rho,
+                        design_part: DesignPart::Shroud,
+                        tool_part: part,
+                        height_mm: h,
+                    };
+                    if failed(best) {
+                        return true;
+                    }
+                }
+            }
+        }
+        if self.frusta.is_empty() || !(self.options.parts.hub || self.options.parts.blades) {
+            return false;
         }
         let a = PVec::new(axis.x, axis.y, axis.z);
         let pose = Pose::from_parts(pv(&cl.tip), Rotation::from_rotation_arc(PVec::Z, a));
         let c = self.mesh.chord_mm;
+        let meshes = [
+            (self.options.parts.hub, &self.mesh.hub, false),
+            (self.options.parts.blades, &self.mesh.blades, true),
+        ];
         for f in &self.frusta {
-            let mut meshes: Vec<(&TriMesh, bool)> = Vec::with_capacity(2);
-            if self.options.parts.hub {
-                meshes.push((&self.mesh.hub, false));
-            }
-            if self.options.parts.blades {
-                meshes.push((&self.mesh.blades, true));
-            }
             let mut crossed = false;
-            for (mesh, blades) in meshes {
+            for &(wanted, mesh, blades) in &meshes {
+                if !wanted {
+                    continue;
+                }
                 // Only contacts that could lower the answer (or fail the check) matter.
-                let reach = match stop_below {
-                    Some(m) => m.min(best.distance_mm),
-                    None => best.distance_mm,
-                };
+                let reach = want.need(best);
                 let prediction = (reach + c).max(0.0);
                 let Ok(Some(k)) =
                     query::contact(&pose, &f.shape, &Pose::IDENTITY, mesh, prediction)
@@ -953,7 +1457,7 @@ impl<'a> DesignClearance<'a> {
                 let d = k.dist - c;
                 if d < best.distance_mm {
                     let at = Point3::new(k.point2.x, k.point2.y, k.point2.z);
-                    best = Clearance {
+                    *best = Clearance {
                         distance_mm: d,
                         design_part: if blades {
                             self.mesh.blade_mesh_distance(&at).1
@@ -963,28 +1467,192 @@ impl<'a> DesignClearance<'a> {
                         tool_part: f.part,
                         height_mm: (at - cl.tip).dot(&axis).max(0.0),
                     };
-                    if failed(&best) {
-                        return best;
+                    if failed(best) {
+                        return true;
                     }
                 }
             }
-            // A frustum buried inside material crosses no mesh triangle.
-            if !crossed {
+            // A frustum buried inside material crosses no mesh triangle; its axis midpoint is
+            // then inside, which the hub distance and the blade mesh rule out cheaply first.
+            if !crossed && self.may_be_inside(&(cl.tip + axis * f.h_mid)) {
                 let mid = cl.tip + axis * f.h_mid;
-                let (d, dp) = self.design_distance_for(&mid, f.r_mid);
+                let (d, dp) = self.design_signed_distance(&mid);
                 if d < 0.0 && d - f.r_mid < best.distance_mm {
-                    best = Clearance {
+                    *best = Clearance {
                         distance_mm: d - f.r_mid,
                         design_part: dp,
                         tool_part: f.part,
                         height_mm: f.h_mid,
                     };
-                    if failed(&best) {
-                        return best;
+                    if failed(best) {
+                        return true;
                     }
                 }
             }
         }
-        best
+        false
     }
+
+    /// Whether `p` may lie inside the selected material: `false` only when the hub distance
+    /// is positive and the blade mesh keeps `p` outside every blade (`d_m − c ≥ t/2`).
+    fn may_be_inside(&self, p: &Point3) -> bool {
+        let parts = self.options.parts;
+        if parts.hub && self.hub_signed_distance(p) < 0.0 {
+            return true;
+        }
+        if parts.shroud && self.shroud_signed_distance(p) < 0.0 {
+            return true;
+        }
+        if parts.blades {
+            let far = self.mesh.side_chord_mm + 0.5 * self.mesh.thickest_blade_mm;
+            return self.mesh.side_mesh_distance_within(p, far).is_some();
+        }
+        false
+    }
+}
+
+/// An end of a meridional contour, in the (z, r) half plane.
+#[derive(Debug, Clone, Copy)]
+struct ContourEnd {
+    point: [f64; 2],
+    /// Unit tangent pointing away from the contour.
+    away: [f64; 2],
+    /// Unit channel-side normal.
+    normal: [f64; 2],
+    /// Whether a cap of the hub body (the inlet plane `z = z_max` or the outlet cylinder
+    /// `r = r_max`) passes through the end perpendicular to the tangent: then on the ray
+    /// `e + s·T`, where the distance to the contour jumps from `−s` to `s`, the cap's own
+    /// distance is `s`, and the capped distance does not jump.
+    capped: bool,
+}
+
+impl ContourEnd {
+    /// The end at parameter `t` of `curve`, whose tangent points away from the contour when
+    /// multiplied by `sign` (−1 at the start, +1 at the end of the domain). A degenerate
+    /// tangent leaves `away` zero (no segment then passes the Lipschitz test).
+    /// `z_max`, `r_max`: the caps of the hub body (module docs).
+    fn new(
+        curve: &impeller_model::meridional::MeridionalCurve,
+        t: f64,
+        sign: f64,
+        (z_max, r_max): (f64, f64),
+    ) -> Self {
+        let p = curve.point(t);
+        let d = curve.curve().derivs2(t)[1] * sign;
+        let l = d.norm();
+        let away = if l > 0.0 && l.is_finite() {
+            [d[0] / l, d[1] / l]
+        } else {
+            [0.0, 0.0]
+        };
+        let n = curve.normal(t);
+        // Within 1e-12 (a jump below 1e-9 mm anywhere within 1 m of the end).
+        let on_cap = |k: usize, cap: f64| {
+            away[k] >= 1.0 - 1e-12 && (p[k] - cap).abs() <= 1e-12 * (1.0 + cap.abs())
+        };
+        Self {
+            point: [p[0], p[1]],
+            away,
+            normal: [n[0], n[1]],
+            capped: on_cap(0, z_max) || on_cap(1, r_max),
+        }
+    }
+}
+
+/// What a query needs: the clearance exactly where it is below `cap` (above, any lower bound
+/// at least `cap` will do), and none at all once it is below `fail_below`.
+#[derive(Debug, Clone, Copy)]
+struct Want {
+    cap: f64,
+    fail_below: f64,
+}
+
+impl Want {
+    /// The exact minimum.
+    const MINIMUM: Self = Self {
+        cap: f64::INFINITY,
+        fail_below: f64::NEG_INFINITY,
+    };
+
+    /// The value below which a sample or part still matters, given the answer so far.
+    fn need(&self, best: &Clearance) -> f64 {
+        self.cap.min(best.distance_mm)
+    }
+
+    fn failed(&self, best: &Clearance) -> bool {
+        best.distance_mm < self.fail_below
+    }
+}
+
+/// No answer yet: infinitely clear.
+const NO_CLEARANCE: Clearance = Clearance {
+    distance_mm: f64::INFINITY,
+    design_part: DesignPart::Hub,
+    tool_part: ToolPart::Cutter,
+    height_mm: 0.0,
+};
+
+/// Open work of the blade search: a run of cutter samples not yet looked at, or one sample
+/// whose blade distance must be computed exactly; each with a lower bound of the clearance it
+/// can still give (−∞ when nothing bounds it yet).
+#[derive(Debug, Clone, Copy)]
+enum Pending {
+    /// Samples `lo..=hi`, between the samples of known blade mesh distance `left` and `right`
+    /// (height, distance).
+    Range {
+        lo: usize,
+        hi: usize,
+        left: Option<(f64, f64)>,
+        right: Option<(f64, f64)>,
+        bound: f64,
+    },
+    /// Sample `index`, whose mesh bound came within the exact band.
+    Exact { index: usize, bound: f64 },
+}
+
+impl Pending {
+    fn bound(&self) -> f64 {
+        match self {
+            Self::Range { bound, .. } | Self::Exact { bound, .. } => *bound,
+        }
+    }
+
+    /// The run `lo..=hi` between the samples of known distance `left` and `right` (height,
+    /// value) of a function 1-Lipschitz along the axis, with the bound `bound(valley) − ρ_max`:
+    /// `valley` the lowest point over the run of the two cones `D_l − (h − h_l)` and
+    /// `D_r − (h_r − h)` (the least value the function can take there), `ρ_max` the widest
+    /// sample radius of the run.
+    fn range(
+        samples: &[(f64, f64, ToolPart)],
+        lo: usize,
+        hi: usize,
+        left: Option<(f64, f64)>,
+        right: Option<(f64, f64)>,
+        bound: impl Fn(f64) -> f64,
+    ) -> Self {
+        let (ha, hb) = (samples[lo].0, samples[hi].0);
+        let valley = match (left, right) {
+            (Some((hl, dl)), Some((hr, dr))) => {
+                let x = (0.5 * (dl - dr + hl + hr)).clamp(ha, hb);
+                (dl - (x - hl)).max(dr - (hr - x))
+            }
+            (Some((hl, dl)), None) => dl - (hb - hl),
+            (None, Some((hr, dr))) => dr - (hr - ha),
+            (None, None) => f64::NEG_INFINITY,
+        };
+        let rho_max = samples[lo..=hi].iter().map(|s| s.1).fold(0.0, f64::max);
+        Self::Range {
+            lo,
+            hi,
+            left,
+            right,
+            bound: bound(valley) - rho_max,
+        }
+    }
+}
+
+thread_local! {
+    /// The blade search's open list, kept between queries of a thread (no allocation per
+    /// query once grown).
+    static SCRATCH: std::cell::RefCell<Vec<Pending>> = const { std::cell::RefCell::new(Vec::new()) };
 }

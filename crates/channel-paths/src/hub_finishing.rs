@@ -379,11 +379,14 @@ impl Planner<'_> {
                 continue;
             };
             let want = if fallback.is_none() { min } else { self.tol };
-            if !self.upper.is_clear(&cl, want) || !self.blades_only.is_clear(&cl, want) {
+            // One query per part set: stops below `want`, else the clearance itself.
+            let Some(upper) = self.upper.clearance_if_clear(&cl, want) else {
                 continue;
-            }
-            let clearance = self.upper.clearance(&cl).distance_mm;
-            let blade_clearance = self.blades_only.clearance(&cl).distance_mm;
+            };
+            let Some(blades) = self.blades_only.clearance_if_clear(&cl, want) else {
+                continue;
+            };
+            let (clearance, blade_clearance) = (upper.distance_mm, blades.distance_mm);
             let p = Posture {
                 cl,
                 clearance,
