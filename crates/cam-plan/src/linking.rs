@@ -405,7 +405,7 @@ impl Linker {
         let a = cl.axis.into_inner();
         if check
             .profile
-            .is_some_and(|top| self.axis_retract_is_clear(cl, top))
+            .is_some_and(|top| self.axis_retract_is_clear(cl, top, check))
         {
             return (a, true);
         }
@@ -501,28 +501,26 @@ impl Linker {
     /// the shape of the tool alone: for a tool whose radius never shrinks from the tip up
     /// ([`LinkCheck::profile`] = `(h_top, r_top)`), the tool moved by `t` along its axis
     /// covers nothing the tool at `cl` does not, except a cylinder of radius `r_top` from
-    /// `h_top` to `h_top + t` above the tip. That cylinder is clear when its axis stays more
-    /// than `r_top` (plus the 1 mm sampling step) outside the blank's bounding capped
-    /// cylinder, which contains the design. Then the move is never closer to the design
-    /// than the cutting posture itself. O(t) point tests; `false` without a blank.
-    fn axis_retract_is_clear(&self, cl: &CutterLocation, (h_top, r_top): (f64, f64)) -> bool {
-        let Some(blank) = &self.blank else {
-            return false;
-        };
+    /// `h_top` to `h_top + t` above the tip. That cylinder is clear when every point of its
+    /// axis, sampled every 1 mm, is farther than `r_top + 1 mm` from the design (the signed
+    /// distance is 1-Lipschitz, so the 1 mm covers the points between samples). Then the move
+    /// is never closer to the design than the cutting posture itself. O(t) distance queries.
+    fn axis_retract_is_clear(
+        &self,
+        cl: &CutterLocation,
+        (h_top, r_top): (f64, f64),
+        check: &LinkCheck<'_>,
+    ) -> bool {
         let a = cl.axis.into_inner();
         let t = self.surface.exit_distance(&cl.tip, &a);
         if !t.is_finite() || self.exit_point(cl, &a).is_none() {
             return false;
         }
-        let (z0, z1) = blank.z_range();
-        let r_max = blank.max_radius();
         let step = 1.0;
         let n = (t / step).ceil() as usize;
         (0..=n).all(|i| {
             let q = cl.tip + a * (h_top + t * i as f64 / n.max(1) as f64);
-            let dr = (q.x.hypot(q.y) - r_max).max(0.0);
-            let dz = (z0 - q.z).max(q.z - z1).max(0.0);
-            dr.hypot(dz) > r_top + step
+            check.clearance.design_signed_distance(&q).0 > r_top + step
         })
     }
 

@@ -4,8 +4,8 @@
 //!
 //! `cargo bench -p impeller-cam --bench plan -- --warm-up-time 1 --measurement-time 3`
 //!
-//! Until operation crates are registered the default job has no `[[operations]]`, and the
-//! figure is the cost of reading its CL files alone.
+//! The default job is paper 003's process plan on impeller-8+8 (channel roughing, hub
+//! finishing, blade finishing, blade-root finishing; operations plan in parallel).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -40,19 +40,47 @@ fn default_job_is_the_impeller_8_8_fixture_job() {
     assert_eq!(r["impeller"]["splitter_blade_count"], 8);
     let d = r["impeller"]["blade_tip_diameter_mm"].as_f64().unwrap();
     assert!((d - 77.0).abs() < 0.5, "{d}");
-    // The fixture job's CL file (embedded), posted and verified like every operation.
+    // The fixture job's process plan (paper 003, Table 1), planned, posted and verified.
     let ops = r["operations"].as_array().unwrap();
-    assert_eq!(ops.len(), 1, "{ops:?}");
-    assert_eq!(ops[0]["name"], "TOP_RING");
-    assert_eq!(ops[0]["kind"], "cl_import");
+    let kinds: Vec<(&str, &str)> = ops
+        .iter()
+        .map(|o| (o["name"].as_str().unwrap(), o["kind"].as_str().unwrap()))
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            ("rough", "channel_roughing"),
+            ("hub-finish", "hub_finishing"),
+            ("blade-finish", "flank_finishing"),
+            ("blade-root", "blade_root_finishing"),
+        ]
+    );
+    for o in ops {
+        assert!(o["moves"].as_u64().unwrap() > 100, "{o}");
+        assert!(o["plan_ms"].as_f64().unwrap() > 0.0, "{o}");
+        assert_eq!(o["uncertified_links"], 0.0, "{o}");
+    }
+    // The turned blank: the shroud's outlet radius, not the file's Ø79 cylinder.
+    let sr = r["impeller"]["stock_radius_mm"].as_f64().unwrap();
+    assert!((sr - 38.5).abs() < 0.02, "{sr}");
     assert_eq!(r["post"]["written"], true);
     assert!(out.join("program.ngc").is_file());
+    // Verified from the written program, one operation per header, without defects.
+    assert_eq!(r["verification"]["source"], "program");
+    assert_eq!(r["verification"]["collisions"], 0);
+    assert!(r["verification"]["defects"].as_array().unwrap().is_empty());
     for k in ["model_ms", "plan_ms", "post_ms", "verify_ms", "total_ms"] {
         assert!(r["timings_ms"][k].as_f64().is_some(), "{k}");
     }
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains("<svg") && html.contains("Meridional view"));
-    assert!(html.contains("TOP_RING: top view") && html.contains("TOP_RING: meridional view"));
+    for name in ["rough", "hub-finish", "blade-finish", "blade-root"] {
+        assert!(
+            html.contains(&format!("{name}: top view"))
+                && html.contains(&format!("{name}: meridional view")),
+            "{name}"
+        );
+    }
 }
 
 /// A five-axis ring cut in the stock above the impeller's shroud contour (r = 30 mm, top
@@ -356,7 +384,21 @@ fn finishing_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
         ops[1]
     );
     assert_eq!(r["post"]["limit_violations"], 0);
-    assert!(r["post"]["max_linearisation_error_mm"].as_f64().unwrap() <= 0.005 + 1e-9);
+    let post_err = |name: &str| {
+        r["post"]["operations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|o| o["name"] == name)
+            .unwrap()["max_linearisation_error_mm"]
+            .as_f64()
+            .unwrap()
+    };
+    // The finishing pass is linearised within linearisation_tol, tip and flute top.
+    assert!(post_err("blade-finish") <= 0.005 + 1e-9);
+    // The semi-finishing sweep past the table's axis at the radial trailing edge: the flute
+    // top cannot follow it on xyzac-trt, and the post says so (1.03 mm measured).
+    assert!(post_err("blade-semi") > 0.1);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains("blade-finish: top view"));
     rs274_accepts(
@@ -490,7 +532,8 @@ fn flank_finishing_refuses_a_path_outside_its_tolerance() {
 fn progress_goes_to_stderr_as_lines_off_a_terminal_and_not_at_all_with_quiet() {
     // Off a terminal (as here) the stage lines are printed and no progress bar is drawn (no
     // cursor control); with --quiet neither, while the summary line stays.
-    let job = repo().join("fixtures/impeller-8+8/job.toml");
+    // A short job (the ring CL data); the stage lines do not depend on the operations.
+    let job = ring_job_with("progress-job", &ring_cl(), "");
     let out = scratch("progress");
     let run = |quiet: bool| {
         let mut c = cli();
@@ -514,5 +557,5 @@ fn progress_goes_to_stderr_as_lines_off_a_terminal_and_not_at_all_with_quiet() {
     let quiet = run(true);
     assert!(!quiet.contains("planning operations"), "{quiet}");
     assert!(!quiet.contains('\u{1b}'), "{quiet}");
-    assert!(quiet.contains("impeller-8+8: 1 operation(s)"), "{quiet}");
+    assert!(quiet.contains(": 1 operation(s)"), "{quiet}");
 }

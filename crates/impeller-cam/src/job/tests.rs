@@ -59,8 +59,23 @@ fn default_job_is_the_fixture_job_with_its_tools() {
     let machine = job.machine.clone().unwrap();
     assert!(job.is_embedded(&machine));
     assert!(job.read_text(&machine).unwrap().contains("xyzac-trt"));
-    assert_eq!(job.cl_files.len(), 1);
-    assert!(job.read_text(&job.cl_files[0]).unwrap().contains("GOTO/"));
+    // The process plan: four operations, their tools, from the turned blank; no CL files.
+    let ops: Vec<(&str, &str, &str)> = job
+        .operations
+        .iter()
+        .map(|o| (o.name.as_str(), o.kind.as_str(), o.tool.as_str()))
+        .collect();
+    assert_eq!(
+        ops,
+        [
+            ("rough", "channel_roughing", "T5-taper-ball-r1.5"),
+            ("hub-finish", "hub_finishing", "T6-taper-ball-r1"),
+            ("blade-finish", "flank_finishing", "T6-taper-ball-r1"),
+            ("blade-root", "blade_root_finishing", "T7-ball-d2"),
+        ]
+    );
+    assert_eq!(job.stock.start, crate::job::StockStartKind::Turned);
+    assert!(job.cl_files.is_empty());
 }
 
 /// A test-only kind whose builder checks its one key, `depth_mm` (never planned here).
