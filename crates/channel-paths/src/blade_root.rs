@@ -32,7 +32,13 @@
 //! the largest ball radius (bisection, same shank and holder, flutes of the ball's radius)
 //! that is accessible there.
 //!
-//! Cost: O(stations · (regula-falsi iterations + steps · tool samples · design distance)).
+//! Positions: `stations` uniform in the side's u parameter, then positions inserted by
+//! bisection (at most 6 levels per gap) wherever the spine point halfway
+//! between two positions lies farther than `machining_tol` from the chord of their ball
+//! centres, which the ball follows between them (around a rounded leading edge the spine
+//! turns tightly).
+//!
+//! Cost: O(positions · (regula-falsi iterations + steps · tool samples · design distance)).
 
 use cam_core::{CutterLocation, Move, ToolPath};
 use cam_plan::{
@@ -55,6 +61,8 @@ const DEFAULT_STATIONS: usize = 120;
 const DEFAULT_STEP_DEG: f64 = 1.5;
 /// Iterations of the regula-falsi root and of the bisection for the largest ball.
 const ROOT_ITERS: usize = 200;
+/// Bisection levels of the stations inserted between two uniform ones (2^6 = 64 per gap).
+const MAX_REFINE_DEPTH: u32 = 6;
 /// Bisection steps of the largest accessible ball radius (2^-12 of the radius).
 const RADIUS_BISECTIONS: usize = 12;
 /// Samples of the v range searched for the spine bracket.
@@ -452,10 +460,8 @@ pub fn plan_side(
     let ((u0, u1), _) = s.domain();
     let plus = blade.plus_theta_side() == side;
     let neighbour = if plus { next } else { prev };
-    let mut out = Vec::with_capacity(stations);
-    for k in 0..stations {
-        let u = u0 + (u1 - u0) * k as f64 / (stations - 1) as f64;
-        let place = || format!("{label}, {side:?} side, station {k}/{stations} (u = {u:.4})");
+    let position_at = |u: f64, station: &str| -> Result<RootPosition, PlanError> {
+        let place = || format!("{label}, {side:?} side, station {station} (u = {u:.4})");
         let (centre, spine_c, nb, nh) = spine(imp, blade, side, u, r).ok_or_else(|| {
             PlanError::geometry(
                 operation,
@@ -473,7 +479,7 @@ pub fn plan_side(
                 clearance,
             } => {
                 let (overcut, undercut) = deviations(ctx, &centre, &spine_c, &nb, &nh, r);
-                out.push(RootPosition {
+                Ok(RootPosition {
                     centre,
                     axis,
                     steps,
@@ -481,7 +487,7 @@ pub fn plan_side(
                     clearance,
                     overcut,
                     undercut,
-                });
+                })
             }
             Search::None { c_max } => {
                 // Largest accessible ball radius here: bisection with the same shank and
@@ -503,7 +509,7 @@ pub fn plan_side(
                         hi = mid;
                     }
                 }
-                return Err(PlanError::geometry(
+                Err(PlanError::geometry(
                     operation,
                     format!(
                         "{}, ball centre ({:.3}, {:.3}, {:.3})",
@@ -528,10 +534,46 @@ pub fn plan_side(
                             r
                         )
                     },
-                ));
+                ))
             }
         }
+    };
+    // Uniform stations, then stations inserted where the chord between two ball centres
+    // strays from the root curve (the spine) by more than the machining tolerance at its
+    // midpoint: around a rounded leading edge the spine turns on a radius of the ball plus
+    // the nose, and 40 uniform stations left 0.12 mm there (verifier, 0.1 mm).
+    let tol = ctx.tolerances.machining_tol;
+    let mut out: Vec<(f64, RootPosition)> = Vec::with_capacity(stations);
+    for k in 0..stations {
+        let u = u0 + (u1 - u0) * k as f64 / (stations - 1) as f64;
+        out.push((u, position_at(u, &format!("{k}/{stations}"))?));
     }
+    let mut refined: Vec<(f64, RootPosition)> = Vec::with_capacity(out.len());
+    for w in out.windows(2) {
+        refined.push(w[0]);
+        let mut stack = vec![(w[0], w[1], 0u32)];
+        let mut inserted: Vec<(f64, RootPosition)> = Vec::new();
+        while let Some((a, b, depth)) = stack.pop() {
+            let um = 0.5 * (a.0 + b.0);
+            let Some((cm, ..)) = spine(imp, blade, side, um, r) else {
+                continue;
+            };
+            let off = point_segment_distance(&cm, &a.1.centre, &b.1.centre);
+            if off <= tol || depth >= MAX_REFINE_DEPTH {
+                continue;
+            }
+            let m = (um, position_at(um, &format!("inserted at u = {um:.5}"))?);
+            inserted.push(m);
+            stack.push((m, b, depth + 1));
+            stack.push((a, m, depth + 1));
+        }
+        inserted.sort_by(|x, y| x.0.total_cmp(&y.0));
+        refined.extend(inserted);
+    }
+    if let Some(last) = out.last() {
+        refined.push(*last);
+    }
+    let out: Vec<RootPosition> = refined.into_iter().map(|(_, p)| p).collect();
     Ok(out)
 }
 
@@ -617,4 +659,16 @@ impl Operation for BladeRootFinishing {
             notes: Vec::new(),
         })
     }
+}
+
+/// Distance from `p` to the segment `[a, b]`.
+fn point_segment_distance(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let ab = b - a;
+    let l2 = ab.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * t)).norm()
 }

@@ -39,8 +39,39 @@ fn centres_are_at_ball_radius_from_hub_and_blade_and_accessible() {
             1.5f64.to_radians(),
         )
         .unwrap();
-        assert_eq!(pos.len(), 8);
-        for p in &pos {
+        // 8 uniform stations, refined where the chord strays from the root curve.
+        assert!(pos.len() > 8, "{} positions", pos.len());
+        // Between two positions the ball centre runs on their chord: its midpoint stays within
+        // machining_tol of both offset surfaces (the distances are 1-Lipschitz, so a chord
+        // within tol of the root curve keeps them within tol of the ball radius).
+        // (Midpoints within a ball radius of the hub's inlet plane are left out: beyond the
+        // end of the hub contour its signed distance is not the offset surface's.)
+        let tol = c.tol.machining_tol;
+        let hub = c.imp.hub().meridional();
+        let z_inlet = hub
+            .point_at_fraction(0.0)
+            .x
+            .max(hub.point_at_fraction(1.0).x);
+        let mut checked = 0;
+        for w in pos.windows(2) {
+            let mid = 0.5 * (w[0].centre + w[1].centre);
+            if mid.z > z_inlet - 1.0 {
+                continue;
+            }
+            checked += 1;
+            let dh = c.imp.hub().signed_distance(&mid);
+            let (_, db) = blade_side_distance(&order[0], side, &mid, None);
+            assert!(
+                (dh - 1.0).abs() <= tol + 1e-9,
+                "chord midpoint hub distance {dh}"
+            );
+            assert!(
+                (db - 1.0).abs() <= tol + 1e-9,
+                "chord midpoint blade distance {db}"
+            );
+        }
+        assert!(checked >= 6, "{checked} chords checked");
+        for p in pos.iter().filter(|p| p.centre.z <= z_inlet - 1.0) {
             let dh = c.imp.hub().signed_distance(&p.centre);
             let (_, db) = blade_side_distance(&order[0], side, &p.centre, None);
             assert!((dh - 1.0).abs() < 1e-6, "hub distance {dh}");
