@@ -125,7 +125,6 @@ fn unknown_keys_and_bad_values_are_errors() {
 }
 
 #[test]
-#[ignore = "several minutes in the debug profile; run with --ignored"]
 fn narrow_impeller_is_finished_or_names_the_largest_ball() {
     let c = support::Ctx::new("impeller-30-narrow", 1.0);
     let cl = c.clearance();
