@@ -1,6 +1,6 @@
 //! Moves and tool paths, with path length and cutting-time estimates.
 
-use crate::{CamError, CutterLocation};
+use crate::{CamError, CutterLocation, Point3};
 use serde::{Deserialize, Serialize};
 
 /// What a move does; decides the rate it runs at.
@@ -149,6 +149,18 @@ impl ToolPath {
             )
         })
     }
+}
+
+/// Distance (mm) from `p` to the segment `[a, b]` (to `a` when the segment is a point). O(1).
+pub fn point_segment_distance(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    let ab = b - a;
+    let l2 = ab.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * t)).norm()
 }
 
 #[cfg(test)]

@@ -1219,12 +1219,7 @@ impl<'a> DesignClearance<'a> {
         let mut failed_now = false;
         while !open.is_empty() {
             let need = want.need(best);
-            let mut k = 0;
-            for (j, item) in open.iter().enumerate() {
-                if item.bound() < open[k].bound() {
-                    k = j;
-                }
-            }
+            let k = Pending::lowest(&open);
             if open[k].bound() >= need {
                 break;
             }
@@ -1317,12 +1312,7 @@ impl<'a> DesignClearance<'a> {
         while !open.is_empty() {
             // Only samples that could lower the answer (or fail the check) matter.
             let need = want.need(best);
-            let mut k = 0;
-            for (j, item) in open.iter().enumerate() {
-                if item.bound() < open[k].bound() {
-                    k = j;
-                }
-            }
+            let k = Pending::lowest(&open);
             if open[k].bound() >= need {
                 break;
             }
@@ -1611,6 +1601,18 @@ enum Pending {
 }
 
 impl Pending {
+    /// Index of the item with the lowest bound in a non-empty work list (the first of equal
+    /// ones).
+    fn lowest(open: &[Pending]) -> usize {
+        let mut k = 0;
+        for (j, item) in open.iter().enumerate() {
+            if item.bound() < open[k].bound() {
+                k = j;
+            }
+        }
+        k
+    }
+
     fn bound(&self) -> f64 {
         match self {
             Self::Range { bound, .. } | Self::Exact { bound, .. } => *bound,

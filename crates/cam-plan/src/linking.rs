@@ -174,19 +174,8 @@ impl Linker {
     /// error when the axis points down into the impeller and never leaves (axis with
     /// `a_z ≤ 0` inside the cylinder's radius).
     pub fn retract_point(&self, cl: &CutterLocation) -> Result<CutterLocation, PlanError> {
-        let a = cl.axis.into_inner();
-        let t = self.surface.exit_distance(&cl.tip, &a);
-        if !t.is_finite() {
-            return Err(PlanError::geometry(
-                "-",
-                format!("tip ({:.3}, {:.3}, {:.3})", cl.tip.x, cl.tip.y, cl.tip.z),
-                "the tool axis never leaves the safety surface",
-            ));
-        }
-        Ok(CutterLocation {
-            tip: cl.tip + a * t,
-            axis: cl.axis,
-        })
+        self.exit_point(cl, &cl.axis.into_inner())
+            .ok_or_else(|| no_exit(cl))
     }
 
     /// The point where a straight move from `cl` along the unit direction `dir` (the tool
@@ -288,25 +277,7 @@ impl Linker {
     /// a first cutting move) and appends the retract along the last move's axis, when `path`
     /// has moves and its ends lie inside the surface.
     pub fn close(&self, path: &mut ToolPath, approach_mm: f64) -> Result<(), PlanError> {
-        let Some(last) = path.moves.last().copied() else {
-            return Ok(());
-        };
-        if path
-            .moves
-            .first()
-            .is_some_and(|m| self.surface.contains(&m.cl.tip))
-        {
-            self.close_start(path, approach_mm)?;
-        }
-        if self.surface.contains(&last.cl.tip) {
-            let end = self.retract_point(&last.cl)?;
-            path.moves.push(Move {
-                kind: MoveKind::Retract,
-                cl: end,
-                feed_mm_per_min: None,
-            });
-        }
-        Ok(())
+        self.close_with(path, approach_mm, |cl| cl.axis.into_inner())
     }
 
     /// The moves from `from` to the start `to` of the next path: retract along `from`'s axis
@@ -319,33 +290,11 @@ impl Linker {
         to: &CutterLocation,
         approach_mm: f64,
     ) -> Result<Vec<Move>, PlanError> {
-        let out = self.retract_point(from)?;
-        let inn = self.retract_point(to)?;
-        let mut moves = Vec::new();
-        if (out.tip - from.tip).norm() >= SAME_POSTURE_MM {
-            moves.push(Move {
-                kind: MoveKind::Retract,
-                cl: out,
-                feed_mm_per_min: None,
-            });
-        }
-        moves.extend(self.travel(&out, &inn));
-        let inside = (inn.tip - to.tip).norm();
-        if inside >= SAME_POSTURE_MM {
-            let a = self.rapid_approach_end(to, inside, approach_mm);
-            if a < inside {
-                moves.push(Move::rapid(CutterLocation {
-                    tip: to.tip + to.axis.into_inner() * a,
-                    axis: to.axis,
-                }));
-            }
-            moves.push(Move {
-                kind: MoveKind::Plunge,
-                cl: *to,
-                feed_mm_per_min: None,
-            });
-        }
-        Ok(moves)
+        self.connect_along(
+            (from, &from.axis.into_inner()),
+            (to, &to.axis.into_inner()),
+            approach_mm,
+        )
     }
 
     /// [`Linker::connect`] with the retract from `from` along the unit direction `out_dir`
@@ -465,14 +414,24 @@ impl Linker {
         approach_mm: f64,
         check: &LinkCheck<'_>,
     ) -> Result<(), PlanError> {
+        self.close_with(path, approach_mm, |cl| self.checked_direction(cl, check))
+    }
+
+    /// Appends the retract from the last move and prepends the approach to the first, each
+    /// along `dir` of that posture, where they lie inside the safety surface.
+    fn close_with(
+        &self,
+        path: &mut ToolPath,
+        approach_mm: f64,
+        dir: impl Fn(&CutterLocation) -> Vector3,
+    ) -> Result<(), PlanError> {
         let (Some(first), Some(last)) = (path.moves.first().copied(), path.moves.last().copied())
         else {
             return Ok(());
         };
         if self.surface.contains(&last.cl.tip) {
-            let d = self.checked_direction(&last.cl, check);
             let end = self
-                .exit_point(&last.cl, &d)
+                .exit_point(&last.cl, &dir(&last.cl))
                 .ok_or_else(|| no_exit(&last.cl))?;
             path.moves.push(Move {
                 kind: MoveKind::Retract,
@@ -481,8 +440,7 @@ impl Linker {
             });
         }
         if self.surface.contains(&first.cl.tip) {
-            let d = self.checked_direction(&first.cl, check);
-            self.close_start_along(path, &d, approach_mm)?;
+            self.close_start_along(path, &dir(&first.cl), approach_mm)?;
         }
         Ok(())
     }
@@ -512,10 +470,10 @@ impl Linker {
         check: &LinkCheck<'_>,
     ) -> bool {
         let a = cl.axis.into_inner();
-        let t = self.surface.exit_distance(&cl.tip, &a);
-        if !t.is_finite() || self.exit_point(cl, &a).is_none() {
+        let Some(out) = self.exit_point(cl, &a) else {
             return false;
-        }
+        };
+        let t = (out.tip - cl.tip).norm();
         let step = 1.0;
         let n = (t / step).ceil() as usize;
         (0..=n).all(|i| {
@@ -548,9 +506,22 @@ impl Linker {
                 )
             })
             .collect();
+        self.join_with(name, tool, &paths, &ends, approach_mm)
+    }
+
+    /// `paths` (none empty) joined in order, the approach to each path's first move and the
+    /// retract from its last along the directions `ends[i]` (the join of [`Linker::join`]).
+    fn join_with(
+        &self,
+        name: &str,
+        tool: &str,
+        paths: &[&ToolPath],
+        ends: &[(Vector3, Vector3)],
+        approach_mm: f64,
+    ) -> Result<ToolPath, PlanError> {
         let mut out = ToolPath::new(name, tool);
         let mut last_dir = Vector3::z();
-        for (p, (in_dir, end_dir)) in paths.iter().zip(&ends) {
+        for (p, (in_dir, end_dir)) in paths.iter().zip(ends) {
             let first = p.moves[0];
             if let Some(last) = out.moves.last() {
                 let link =
@@ -632,65 +603,17 @@ impl Linker {
         paths: &[ToolPath],
         approach_mm: f64,
     ) -> Result<ToolPath, PlanError> {
-        let mut out = ToolPath::new(name, tool);
-        for p in paths {
-            let Some(first) = p.moves.first() else {
-                continue;
-            };
-            match out.moves.last() {
-                Some(last) => {
-                    let link = self.connect(&last.cl, &first.cl, approach_mm)?;
-                    out.moves.extend(link);
-                    out.moves.extend_from_slice(&p.moves[1..]);
-                }
-                None => {
-                    let mut head = p.clone();
-                    if self.surface.contains(&first.cl.tip) {
-                        self.close_start(&mut head, approach_mm)?;
-                    }
-                    out.moves = head.moves;
-                }
-            }
-        }
-        if let Some(last) = out.moves.last().copied() {
-            if self.surface.contains(&last.cl.tip) {
-                out.moves.push(Move {
-                    kind: MoveKind::Retract,
-                    cl: self.retract_point(&last.cl)?,
-                    feed_mm_per_min: None,
-                });
-            }
-        }
-        Ok(out)
-    }
-
-    /// Prepends the approach from the safety surface along the first move's axis.
-    fn close_start(&self, path: &mut ToolPath, approach_mm: f64) -> Result<(), PlanError> {
-        let Some(first) = path.moves.first().copied() else {
-            return Ok(());
-        };
-        let start = self.retract_point(&first.cl)?;
-        let inside = (start.tip - first.cl.tip).norm();
-        let mut head = vec![Move::rapid(start)];
-        let a = self.rapid_approach_end(&first.cl, inside, approach_mm);
-        if a < inside {
-            head.push(Move::rapid(CutterLocation {
-                tip: first.cl.tip + first.cl.axis.into_inner() * a,
-                axis: first.cl.axis,
-            }));
-        }
-        if first.kind == MoveKind::Feed {
-            head.push(Move {
-                kind: MoveKind::Plunge,
-                cl: first.cl,
-                feed_mm_per_min: None,
-            });
-            head.extend_from_slice(&path.moves[1..]);
-        } else {
-            head.extend_from_slice(&path.moves);
-        }
-        path.moves = head;
-        Ok(())
+        let paths: Vec<&ToolPath> = paths.iter().filter(|p| !p.moves.is_empty()).collect();
+        let ends: Vec<(Vector3, Vector3)> = paths
+            .iter()
+            .map(|p| {
+                (
+                    p.moves[0].cl.axis.into_inner(),
+                    p.moves[p.moves.len() - 1].cl.axis.into_inner(),
+                )
+            })
+            .collect();
+        self.join_with(name, tool, &paths, &ends, approach_mm)
     }
 }
 
@@ -738,7 +661,8 @@ fn no_exit(cl: &CutterLocation) -> PlanError {
     PlanError::geometry(
         "-",
         format!("tip ({:.3}, {:.3}, {:.3})", cl.tip.x, cl.tip.y, cl.tip.z),
-        "no move from here reaches the safety surface with the tool outside it",
+        "no move from here (along the tool axis, or the direction the link check chose) \
+         reaches the safety surface with the tool outside it",
     )
 }
 

@@ -558,7 +558,11 @@ pub fn plan_side(
             let Some((cm, ..)) = spine(imp, blade, side, um, r) else {
                 continue;
             };
-            let off = point_segment_distance(&cm, &a.1.centre, &b.1.centre);
+            let off = cam_core::path::point_segment_distance(
+                &Point3::from(cm),
+                &Point3::from(a.1.centre),
+                &Point3::from(b.1.centre),
+            );
             if off <= tol || depth >= MAX_REFINE_DEPTH {
                 continue;
             }
@@ -659,16 +663,4 @@ impl Operation for BladeRootFinishing {
             notes: Vec::new(),
         })
     }
-}
-
-/// Distance from `p` to the segment `[a, b]`.
-fn point_segment_distance(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
 }

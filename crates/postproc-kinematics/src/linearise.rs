@@ -11,6 +11,7 @@
 use crate::error::KinematicsError;
 use crate::joints::Joints;
 use crate::machine::Machine;
+pub use cam_core::path::point_segment_distance;
 use cam_core::{CutterLocation, Point3, UnitVector3};
 
 /// Spherical linear interpolation of two unit tool axes (`s ∈ [0,1]`); falls back to
@@ -34,18 +35,6 @@ pub fn interpolate_cl(a: &CutterLocation, b: &CutterLocation, s: f64) -> CutterL
         tip: Point3::from(a.tip.coords + (b.tip.coords - a.tip.coords) * s),
         axis: slerp_axis(&a.axis, &b.axis, s),
     }
-}
-
-/// Distance from `p` to the segment `[a, b]` (mm).
-pub fn point_segment_distance(p: &Point3, a: &Point3, b: &Point3) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
 }
 
 /// Largest distance (mm) of the tool tip from the intended segment `[cl0.tip, cl1.tip]` while
