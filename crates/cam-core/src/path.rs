@@ -151,16 +151,10 @@ impl ToolPath {
     }
 }
 
-/// Distance (mm) from `p` to the segment `[a, b]` (to `a` when the segment is a point). O(1).
+/// Distance (mm) from `p` to the segment `[a, b]` (to `a` when the segment is a point):
+/// `nurbs::discretise::point_segment_distance` on workpiece points. O(1).
 pub fn point_segment_distance(p: &Point3, a: &Point3, b: &Point3) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
+    nurbs::discretise::point_segment_distance(&p.coords, &a.coords, &b.coords)
 }
 
 #[cfg(test)]

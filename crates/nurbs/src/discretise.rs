@@ -320,8 +320,9 @@ pub fn discretise_by_parameter<const D: usize>(
         .collect())
 }
 
-/// Distance from `p` to the segment `[a, b]`.
-fn point_segment_distance<const D: usize>(
+/// Distance from `p` to the segment `[a, b]` in any dimension (to `a` when the segment is a
+/// point). O(D).
+pub fn point_segment_distance<const D: usize>(
     p: &SVector<f64, D>,
     a: &SVector<f64, D>,
     b: &SVector<f64, D>,
