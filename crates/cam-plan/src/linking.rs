@@ -174,8 +174,16 @@ impl Linker {
     /// error when the axis points down into the impeller and never leaves (axis with
     /// `a_z ≤ 0` inside the cylinder's radius).
     pub fn retract_point(&self, cl: &CutterLocation) -> Result<CutterLocation, PlanError> {
-        self.exit_point(cl, &cl.axis.into_inner())
-            .ok_or_else(|| no_exit(cl))
+        self.leave(cl, &cl.axis.into_inner())
+    }
+
+    /// Where a move from `cl` along `dir` reaches the safety surface ([`Linker::exit_point`]);
+    /// `cl` itself when it already lies on or outside the surface.
+    fn leave(&self, cl: &CutterLocation, dir: &Vector3) -> Result<CutterLocation, PlanError> {
+        if !self.surface.contains(&cl.tip) {
+            return Ok(*cl);
+        }
+        self.exit_point(cl, dir).ok_or_else(|| no_exit(cl))
     }
 
     /// The point where a straight move from `cl` along the unit direction `dir` (the tool
@@ -306,10 +314,8 @@ impl Linker {
         (to, in_dir): (&CutterLocation, &Vector3),
         approach_mm: f64,
     ) -> Result<Vec<Move>, PlanError> {
-        let out = self
-            .exit_point(from, out_dir)
-            .ok_or_else(|| no_exit(from))?;
-        let inn = self.exit_point(to, in_dir).ok_or_else(|| no_exit(to))?;
+        let out = self.leave(from, out_dir)?;
+        let inn = self.leave(to, in_dir)?;
         let mut moves = Vec::new();
         if (out.tip - from.tip).norm() >= SAME_POSTURE_MM {
             moves.push(Move {
