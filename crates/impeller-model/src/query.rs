@@ -2,19 +2,15 @@
 //!
 //! Blade sides are queried globally with the `nurbs` crate's `SurfaceProjector` (cached per
 //! blade); hub and shroud exactly through their meridional contours. [`closest_point`] is the
-//! local solver used where a good start is known (thickness, ruled deviations):
-//! closest point on a NURBS surface (NURBS Book §6.1, point inversion): minimise |S(u,v) − p|²
-//! by Newton's method on the stationarity conditions f = (S − p)·S_u = 0, g = (S − p)·S_v = 0
-//! with Jacobian [[|S_u|² + r·S_uu, S_u·S_v + r·S_uv], [·, |S_v|² + r·S_vv]], r = S − p,
-//! parameters clamped to the domain (a boundary minimum is then found with the clamped
-//! coordinate fixed). Without a hint the start is the best of a 24 × 24 parameter grid; with a
-//! hint (e.g. the same (u, v) on the opposite side) Newton starts there. Converges
-//! quadratically near a regular minimum; stops at |Δ(u,v)| < 1e-13 of the domain or 40 steps.
+//! local query used where a good start is known (thickness, ruled deviations): the `nurbs`
+//! crate's bound-constrained Newton ([`nurbs::closest::local_closest_point`], NURBS Book §6.1
+//! point inversion) from the hint, or without a hint from the best of a 24 × 24 parameter grid.
+//! It converges quadratically near a regular minimum and is local, not certified global.
 //! The signed distance takes the sign of (p − S)·n_out with the outward normal of the side.
 
 use crate::blade::{Blade, Side};
 use crate::impeller::Impeller;
-use nalgebra::{Matrix2, Vector2, Vector3};
+use nalgebra::Vector3;
 use nurbs::NurbsSurface;
 
 /// A point found on a surface.
@@ -35,8 +31,8 @@ const SEED_GRID: usize = 24;
 /// Closest point of `s` to `p` (see module docs), optionally starting from `hint` = (u, v).
 pub fn closest_point(s: &NurbsSurface, p: &Vector3<f64>, hint: Option<(f64, f64)>) -> SurfacePoint {
     let ((u0, u1), (v0, v1)) = s.domain();
-    let (mut u, mut v) = match hint {
-        Some((u, v)) => (u.clamp(u0, u1), v.clamp(v0, v1)),
+    let start = match hint {
+        Some(h) => h,
         None => {
             let mut best = (u0, v0, f64::INFINITY);
             for i in 0..=SEED_GRID {
@@ -52,52 +48,12 @@ pub fn closest_point(s: &NurbsSurface, p: &Vector3<f64>, hint: Option<(f64, f64)
             (best.0, best.1)
         }
     };
-    let tol = 1e-13 * ((u1 - u0) + (v1 - v0));
-    for _ in 0..40 {
-        let d = s.derivs2(u, v);
-        let r = d.p - p;
-        let f = Vector2::new(r.dot(&d.su), r.dot(&d.sv));
-        let j = Matrix2::new(
-            d.su.norm_squared() + r.dot(&d.suu),
-            d.su.dot(&d.sv) + r.dot(&d.suv),
-            d.su.dot(&d.sv) + r.dot(&d.suv),
-            d.sv.norm_squared() + r.dot(&d.svv),
-        );
-        // Newton step, or a gradient step when the Hessian is not positive definite.
-        let step = match j.try_inverse() {
-            Some(inv) if j.determinant() > 0.0 && j[(0, 0)] > 0.0 => -(inv * f),
-            _ => {
-                let g = Vector2::new(
-                    f[0] / d.su.norm_squared().max(1e-300),
-                    f[1] / d.sv.norm_squared().max(1e-300),
-                );
-                -g * 0.5
-            }
-        };
-        let un = (u + step[0]).clamp(u0, u1);
-        let vn = (v + step[1]).clamp(v0, v1);
-        let moved = (un - u).abs() + (vn - v).abs();
-        // Never accept a step that increases the distance: halve it instead.
-        let mut cand = (un, vn);
-        let d0 = r.norm_squared();
-        for _ in 0..20 {
-            if (s.point(cand.0, cand.1) - p).norm_squared() <= d0 {
-                break;
-            }
-            cand = (0.5 * (cand.0 + u), 0.5 * (cand.1 + v));
-        }
-        u = cand.0;
-        v = cand.1;
-        if moved < tol {
-            break;
-        }
-    }
-    let q = s.point(u, v);
+    let l = nurbs::closest::local_closest_point(s, p, start);
     SurfacePoint {
-        u,
-        v,
-        point: q,
-        distance: (q - p).norm(),
+        u: l.u,
+        v: l.v,
+        point: l.point,
+        distance: l.distance,
     }
 }
 

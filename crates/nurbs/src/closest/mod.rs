@@ -7,11 +7,14 @@
 //!   hint, certified flag) shared with the other crates' shapes.
 //! * [`closest_point_on_surface`], [`closest_point_on_curve`] — one-off conveniences that
 //!   build the projector and answer one query.
+//! * [`local_closest_point`] — bound-constrained Newton from a known start (local, not
+//!   certified), for callers that already hold a good start.
 
 pub(crate) mod bezier;
 mod curve;
 mod curve_cert;
 pub(crate) mod decompose;
+mod local;
 mod newton;
 mod query;
 mod surface;
@@ -22,6 +25,7 @@ pub(crate) mod surface_bounds {
 }
 
 pub use curve::{closest_point_on_curve, CurvePoint, CurveProjector};
+pub use local::local_closest_point;
 pub use query::{PointProjection, PointQuery};
 pub use surface::{SurfacePoint, SurfaceProjector};
 
