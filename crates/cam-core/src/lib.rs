@@ -15,6 +15,7 @@ pub mod assembly;
 pub mod contact;
 pub mod cutter;
 pub mod envelope;
+mod envelope_query;
 pub mod error;
 pub mod guide;
 pub mod location;
