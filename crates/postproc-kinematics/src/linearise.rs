@@ -132,7 +132,8 @@ const EXCESS_ROTARY_TRAVEL: f64 = 1e-2;
 /// It is not reduced by further bisection (it is bounded by the ends' own angular distance),
 /// so it is reported: a flank cutter's flutes cut beside the path there (3° off the great
 /// circle put a tapered ball 0.56 mm into a blade of impeller-8+8 on xyzac-trt, where the
-/// semi-finishing sweep passes 1° from the table's axis).
+/// semi-finishing sweep passes 1.9° from the table's axis, until the post's solution choice
+/// kept the branch there so that the ends lie on one branch and the exact midpoints apply).
 fn midpoint_posture(
     machine: &Machine,
     cl0: &CutterLocation,
@@ -152,7 +153,18 @@ fn midpoint_posture(
     // An exact midpoint that repeats an end (a turn about the singular direction, where the
     // inverse holds the rotary angle) would never split the turn: interpolate it instead.
     let stuck = whole > 1e-12 && (a < 1e-12 || b < 1e-12);
-    if !stuck && a + b <= whole + EXCESS_ROTARY_TRAVEL {
+    // The rotate axis must not travel more than between the ends (a branch change through
+    // the pole, ends a few degrees apart, whose exact midpoint swings it by 90°). The tilt may
+    // dip toward the pole and back by as much as the rotate axis turns: ends on one branch
+    // either side of the pole, rotate axis turned by nearly 180°, whose exact midpoint lies
+    // nearer the pole than either end.
+    let rot = |p: &Joints, q: &Joints| (q.rotate - p.rotate).abs();
+    let tilt = |p: &Joints, q: &Joints| (q.tilt - p.tilt).abs();
+    let rotate_excess = rot(j0, &jm) + rot(&jm, j1) - rot(j0, j1);
+    let tilt_excess = tilt(j0, &jm) + tilt(&jm, j1) - tilt(j0, j1);
+    let exact =
+        rotate_excess <= EXCESS_ROTARY_TRAVEL && tilt_excess <= EXCESS_ROTARY_TRAVEL + rot(j0, j1);
+    if !stuck && (a + b <= whole + EXCESS_ROTARY_TRAVEL || exact) {
         return Ok((mid, jm, 0.0));
     }
     let (t, r) = (0.5 * (j0.tilt + j1.tilt), 0.5 * (j0.rotate + j1.rotate));

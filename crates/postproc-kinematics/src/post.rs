@@ -6,6 +6,7 @@ use crate::error::{KinematicsError, PostError};
 use crate::feed::inverse_time_feed;
 use crate::joints::AxisId;
 use crate::joints::Joints;
+use crate::kinematics::LIMIT_SLACK;
 use crate::linearise::{segment_deviation, subdivide, LinearisationSettings};
 use crate::machine::{Machine, RotaryMode};
 use crate::reverse_motion::{
@@ -535,6 +536,11 @@ fn solve_group(
                 .inverse_best_effort(&m.cl, tl, Some(&prev))
                 .map_err(|source| PostError::Block { index, source })?,
         };
+        if index > range.start && m.kind != MoveKind::Rapid {
+            if let Some(e) = keep_branch_near_pole(machine, options, &prev_cl, &prev, &m.cl, &j) {
+                j = e;
+            }
+        }
         let mut unwound = false;
         if options.unwind_on_rapid && continuous && m.kind == MoveKind::Rapid {
             unwound = machine.unwind(&mut j);
@@ -553,6 +559,75 @@ fn solve_group(
     Ok((out, problems))
 }
 
+/// The posture that keeps the solution branch where the nearest posture `b` changes it
+/// through the singular direction, when that is better for the cut; `None` to keep `b`.
+///
+/// Near the singular direction a change of branch is a small rotary step (the tilt changes
+/// sign through the pole, the rotate axis stays), so the nearest-posture choice takes it.
+/// Joint interpolation then swings the axis through the pole instead of around it: the tip
+/// stays on its line but the flutes leave the path by about `h·sin δ` at the checked height
+/// `h`, where `δ` is how far the intended sweep passes from the pole. Where that exceeds the
+/// linearisation tolerance ([`flips_off_the_sweep`]), both moves are linearised
+/// ([`crate::linearise::subdivide`]) and the branch-keeping posture (the end of the exact
+/// sweep, [`sweep_end`], which turns the rotate axis around the pole) is taken when it meets
+/// the tolerance, the branch change does not, and it lies within the limits. The swing
+/// cannot always be followed: passing a hundredth of a degree from the pole the rotate axis
+/// turns by up to 180° within micrometres of tip travel, and the table's swing moves the tip
+/// more than bisection to the depth limit resolves; there the branch change stays and its
+/// deviation is reported. Rapids are not held to the flute height.
+fn keep_branch_near_pole(
+    machine: &Machine,
+    options: &PostOptions,
+    cla: &CutterLocation,
+    a: &Joints,
+    clb: &CutterLocation,
+    b: &Joints,
+) -> Option<Joints> {
+    let tl = options.tool_length;
+    if large_rotary_step(a, b) || !flips_off_the_sweep(options, cla, clb) {
+        return None;
+    }
+    let end = sweep_end(machine, tl, cla, a, clb)?;
+    if end.rotary_travel(b) < 1e-6 || machine.check_limits(&end, LIMIT_SLACK).is_err() {
+        return None;
+    }
+    let tol = options.linearisation_tol?;
+    let flip = linearised_deviation(machine, options, cla, a, clb, b);
+    (flip > tol && linearised_deviation(machine, options, cla, a, clb, &end) <= tol).then_some(end)
+}
+
+/// The largest deviation (tip and checked flute height) left after linearising the move
+/// `a → b` with the options' settings (`∞` when the kinematics fail on the way).
+fn linearised_deviation(
+    machine: &Machine,
+    options: &PostOptions,
+    cla: &CutterLocation,
+    a: &Joints,
+    clb: &CutterLocation,
+    b: &Joints,
+) -> f64 {
+    let settings = LinearisationSettings {
+        tol: options.linearisation_tol.unwrap_or(f64::INFINITY),
+        height: options.check_height_mm,
+        samples: options.linearisation_samples,
+        max_depth: options.max_subdivision_depth,
+    };
+    let mut out = Vec::new();
+    match subdivide(
+        machine,
+        cla,
+        a,
+        clb,
+        b,
+        options.tool_length,
+        &settings,
+        &mut out,
+    ) {
+        Ok(last) => out.iter().fold(last, |m, x| m.max(x.2)),
+        Err(_) => f64::INFINITY,
+    }
+}
+
 /// Whether the move from `a` (at `cla`) to `b` (at `clb`) is a reconfiguration: a rotary step
 /// larger than [`RECONFIGURATION_STEP_RAD`] on either axis that does not follow the intended
 /// tool-axis sweep. A large step can be legitimate: where the sweep passes close to the
@@ -560,6 +635,7 @@ fn solve_group(
 /// and linearisation tracks that swing with exact intermediate postures. A change of the
 /// solution branch (e.g. the tilt sign) in the middle of a move cannot be tracked: the tool
 /// would swing away from the intended orientations.
+/// (A branch change through the pole is a small step: see [`keep_branch_near_pole`].)
 fn is_reconfiguration(
     machine: &Machine,
     tool_length: f64,
@@ -570,6 +646,50 @@ fn is_reconfiguration(
 ) -> bool {
     large_rotary_step(a, b) && !follows_sweep(machine, tool_length, cla, a, clb, b)
 }
+
+/// Smallest angle (rad) between the great-circle arc of tool axes from `a` to `b` and the
+/// singular direction `±Z` (the rotary table's or head's axis in the part frame).
+pub fn sweep_pole_angle(a: &nalgebra::UnitVector3<f64>, b: &nalgebra::UnitVector3<f64>) -> f64 {
+    let end_angle = |v: &nalgebra::UnitVector3<f64>| v.z.abs().clamp(-1.0, 1.0).acos();
+    let mut best = end_angle(a).min(end_angle(b));
+    let n = a.cross(b);
+    let nn = n.norm();
+    if nn > 1e-15 {
+        let n = n / nn;
+        for z in [nalgebra::Vector3::z(), -nalgebra::Vector3::z()] {
+            // The point of the great circle nearest the pole, and whether it lies on the arc.
+            let p = z - n * z.dot(&n);
+            if p.norm() < 1e-15 {
+                continue;
+            }
+            let inside = a.cross(&p).dot(&n) >= 0.0 && p.cross(b).dot(&n) >= 0.0;
+            if inside {
+                best = best.min(z.dot(&n).abs().clamp(0.0, 1.0).asin());
+            }
+        }
+    }
+    best
+}
+
+/// Whether a move's intended axis sweep passes the singular direction closely enough that a
+/// branch change through the pole (joint interpolation through `±Z` instead of around it)
+/// would move the checked flute height off the path by more than the linearisation tolerance:
+/// `check_height_mm · sin δ > linearisation_tol` with `δ` = [`sweep_pole_angle`]. Never with
+/// the tip alone checked (the tip stays exact either way) or without linearisation control.
+fn flips_off_the_sweep(options: &PostOptions, cla: &CutterLocation, clb: &CutterLocation) -> bool {
+    let Some(tol) = options.linearisation_tol else {
+        return false;
+    };
+    if options.check_height_mm <= 0.0 || cla.axis.angle(&clb.axis) < 1e-12 {
+        return false;
+    }
+    let delta = sweep_pole_angle(&cla.axis, &clb.axis);
+    options.check_height_mm * delta.sin() > tol && delta < MAX_FLIP_POLE_ANGLE
+}
+
+/// Beyond this angle from the pole (rad) a branch change is a large rotary step anyway
+/// ([`RECONFIGURATION_STEP_RAD`] covers it).
+const MAX_FLIP_POLE_ANGLE: f64 = std::f64::consts::FRAC_PI_4;
 
 /// A rotary step above [`RECONFIGURATION_STEP_RAD`] on either axis.
 fn large_rotary_step(a: &Joints, b: &Joints) -> bool {
