@@ -50,10 +50,9 @@ fn spec(params: &str) -> OperationSpec {
     }
 }
 
-/// ≈4.5 min in the dev profile (every location runs the design clearance query), hence
-/// ignored in the default suite: `cargo test -p channel-paths --test roughing -- --ignored`.
+/// A ball end, one level on the hub offset (about 2 s in the dev profile): the scallop
+/// measured over the machinable region within the target, clear of the blades.
 #[test]
-#[ignore = "slow in the dev profile; see the doc comment"]
 fn rough_default_impeller_within_scallop_and_clear_of_blades() {
     let imp = impeller_model::fixtures::default_impeller().unwrap();
     let stock = imp.stock().clone();
@@ -117,7 +116,7 @@ fn rough_default_impeller_within_scallop_and_clear_of_blades() {
 ///   (discrete cutter positions);
 /// - the unmachinable area is reported, positive and a small part of the level area.
 ///
-/// About 40 s in the dev profile (short holder, two levels).
+/// About 6 s in the dev profile (short holder, two levels, coarse ball sampling).
 #[test]
 fn rough_tapered_ball_trimmed_to_where_the_cutter_fits() {
     let imp = impeller_model::fixtures::default_impeller().unwrap();

@@ -1436,8 +1436,11 @@ fn inside(shape: &CutterShape, flute: f64, cl: &CutterLocation, x: &Vector3<f64>
 
 /// Largest scallop over a grid of the lane `region` (its machinable region): from each grid
 /// point of the level, the distance along the level normal to the first cutter position of
-/// `runs` (module docs), at most `cap`. Each run is a sequence of consecutive locations joined
-/// by cutting motions, densified to a quarter radius. O(grid · dense locations).
+/// `runs` (module docs), at most `cap`: the ray is marched at a quarter of the ball radius
+/// and the first entry bisected (40 steps); a cutter crossed by the ray over less than a
+/// march step may be missed, which only reads more. Each run is a sequence of consecutive
+/// locations joined by cutting motions, densified to a quarter radius.
+/// O(grid · (cap / step) · dense locations near the point).
 fn measure_scallop(
     shape: &CutterShape,
     flute: f64,
@@ -1497,11 +1500,24 @@ fn measure_scallop(
             if hit(0.0) {
                 continue;
             }
-            if !hit(cap) {
+            // March up the ray at a quarter radius to the first position inside a cutter
+            // (a ray may pass above or beside the cutters: the cap alone does not tell),
+            // then bisect between the last miss and the first hit.
+            let step = (0.25 * reach).max(1e-3).min(cap);
+            let mut lo = 0.0;
+            let mut first_hit = None;
+            while lo < cap {
+                let t = (lo + step).min(cap);
+                if hit(t) {
+                    first_hit = Some(t);
+                    break;
+                }
+                lo = t;
+            }
+            let Some(mut hi) = first_hit else {
                 worst = worst.max(cap);
                 continue;
-            }
-            let (mut lo, mut hi) = (0.0, cap);
+            };
             for _ in 0..40 {
                 let m = 0.5 * (lo + hi);
                 if hit(m) {
