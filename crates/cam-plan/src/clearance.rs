@@ -792,6 +792,11 @@ impl<'a> DesignClearance<'a> {
         }
     }
 
+    /// The options of this query.
+    pub fn options(&self) -> ClearanceOptions {
+        self.options
+    }
+
     /// The design mesh (shareable with [`DesignClearance::with_mesh`]).
     pub fn mesh(&self) -> &Arc<DesignMesh> {
         &self.mesh

@@ -13,42 +13,75 @@
 //!    between levels exceeds `depth_of_cut_mm` anywhere along the channel.
 //! 3. On each level the boundaries are where the offset ruled sides meet the level
 //!    ([`impeller_model::levels::offset_surface_on_level`]), the area(s) between them are
-//!    planned in the developed plane ([`super::plan2d`]) with the path interval that leaves
+//!    trimmed to where the cutter fits (step 4) and planned in the developed plane
+//!    ([`super::plan2d`]) with the path interval that leaves
 //!    `scallop_mm` on the level: the exact inverse of the scallop construction of
 //!    [`cam_core::contact`] at the level's largest convex curvature across the channel
 //!    (`κ = N_r / r`), capped by the process' `width_of_cut_mm`.
-//! 4. Each path point is put on the level; the tool axis interpolates the rulings of the two
-//!    ruled blades bounding the area at the point's cross-channel fraction (leaning with the
-//!    blades), limited to `max_tilt_deg` from the level normal, averaged over
+//! 4. **Where the cutter fits.** On each grid section of an area the cutter alone (ball and
+//!    flutes, the tool without shank and holder, [`cam_plan::DesignClearance`] against the
+//!    blades) must keep `fit_min = blade_allowance − machining_tol/2` from the true blades
+//!    with one of the candidate axes of step 5. The offset of step 1 is measured in the level
+//!    for the cutter's slab only: it does not hold the flutes above the slab, which widen
+//!    (tapered ends) and reach into the channel above along the blades' rulings (issue 11:
+//!    every location the earlier planner skipped on impeller-8+8 was a flute sample 2–9 mm
+//!    above the tip against the nearest blade), nor the ball's centre where the level is not
+//!    perpendicular to the blade (the ball touching the level sits `r·sin β` nearer a blade
+//!    leaning by `β` from the level normal). The section is sampled
+//!    across at `min(step/2, 0.5 mm)` and each end between a fitting and a blocked sample is
+//!    bisected 6 times (the kept end fits; within `2⁻⁶` of the sample spacing). A ball end
+//!    whose centre (`p + r·n`, whatever the axis) is nearer than `r + fit_min` to a blade
+//!    rules the point out at once. Sections with the same number of fitting intervals, each
+//!    overlapping its neighbour's, form *lanes*: graph regions planned like an area (paths,
+//!    baseline, scallop). What is left (between the offset sides but outside every lane) is
+//!    not machinable by this cutter at this level: it is no path point, and its developed
+//!    area is reported (`unmachinable_area_mm2`, of `level_area_mm2`).
+//! 5. Each path point is put on the level; the wanted tool axis interpolates the rulings of
+//!    the two ruled blades bounding the area at the point's cross-channel fraction (leaning
+//!    with the blades), limited to `max_tilt_deg` from the level normal, averaged over
 //!    `axis_smoothing` neighbours along the path; the cutter location touches the level there
-//!    ([`cam_core::contact_location`]); every location is checked with the design clearance
-//!    query (cutter, shank, holder against hub and true blades) and, if not clear, retried
-//!    with the axis along the level normal; a location clear in neither posture is left
-//!    uncut (the path is split there, linked over the safety surface, and counted in
-//!    `skipped_locations`), so no emitted location gouges the design. The motion between two
-//!    consecutive locations (and every link move inside an area) is checked as a whole with
+//!    ([`cam_core::contact_location`]). A posture is accepted when the cutter keeps `fit_min`
+//!    from the blades and the whole tool (cutter, shank, holder) is clear of hub and blades
+//!    by the design clearance query; tried in order: the smoothed axis, the unsmoothed one,
+//!    then leaned away from the nearer side in steps of 3° up to 12°, led along the flow by
+//!    ±3°, ±6°, both combined, leaned toward the nearer side by 3° and 6°, and the level
+//!    normal (each limited to `max_tilt_deg`); one with the machining tolerance to spare is
+//!    preferred. A point with no posture is left uncut (the path is split there, linked over
+//!    the safety surface) and counted in `skipped_locations`, by reason:
+//!    `skipped_cutter_blocked` (the cutter fits with no axis: between the fit samples) or
+//!    `skipped_shank_or_holder`. The motion between two consecutive postures (and every link
+//!    move inside a lane) is certified as a whole with
 //!    [`cam_plan::DesignClearance::segment_clearance_between`] (certified bisection, within
-//!    half the machining tolerance); a motion that is not clear gets one planned midpoint
-//!    and, if a half is still not clear, the path is split there (`split_motions`).
+//!    half the machining tolerance); a motion that is not gets a planned posture at its planar
+//!    midpoint (first axis: the mean of the end axes), recursively up to 4 levels
+//!    (`bridge_postures`), and the path is split only when that fails (`split_motions`).
 //!
 //! Metrics: `path_length_mm` (pipeline), `triangle_path_length_mm` and
 //! `isoparametric_path_length_mm` (cutting paths of all channels, measured in space on the
-//! levels), `saving_ratio = 1 − triangle / isoparametric`, `max_scallop_mm` (measured: rays
-//! along the level normal from a grid of points of every area to the first cutter position
-//! of the level, the cutters taken at locations densified to a quarter radius), `levels`,
-//! `paths`, `min_blade_clearance_mm` (clearance query against the true blades).
+//! levels; the baseline over the same lanes), `saving_ratio = 1 − triangle / isoparametric`,
+//! `max_scallop_mm` (measured over the machinable region: rays along the level normal from a
+//! grid of points of every lane to the first cutter position of the level, the cutters taken
+//! at the emitted locations of every lane of the level densified to a quarter radius along
+//! each cut), `levels`, `paths`, `min_blade_clearance_mm` (clearance query against the true
+//! blades), `level_area_mm2` and `unmachinable_area_mm2` (developed areas over all levels and
+//! channels, trapezoidal on the area grids), the skip, split and bridge counts above.
+//!
+//! Cost: per level O(sections · (width / scan + 12) · candidates) cutter queries for the fit
+//! (most sections need one query per sample: the ball test and the first axis settle them),
+//! O(points · candidates) posture queries (mostly one or two) and O(points · 2⁴) motion
+//! checks in the worst case. Levels run in parallel (rayon).
 
 use super::plan2d::{self, Linking, Path2, Region};
 use crate::accessibility::limit_tilt;
 use cam_core::{contact_location, CutterLocation, CutterShape, Move, MoveKind, ToolPath};
 use cam_plan::{
-    ClearanceOptions, Metrics, Operation, OperationSpec, PartSet, PlanContext, PlanError,
-    PlannedOperation, Plot, PlotKind, PlotSeries,
+    ClearanceOptions, DesignClearance, Metrics, Operation, OperationSpec, PartSet, PlanContext,
+    PlanError, PlannedOperation, Plot, PlotKind, PlotSeries,
 };
 use impeller_model::levels::{depth_level, offset_surface_on_level, DepthLevel, LevelSpacing};
 use impeller_model::ruled::ruled_approximation;
 use impeller_model::{Blade, Impeller, Side};
-use nalgebra::{Unit, Vector3};
+use nalgebra::{Rotation3, Unit, Vector3};
 use nurbs::NurbsSurface;
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -69,6 +102,23 @@ const MAX_POINT_SPACING_MM: f64 = 1.0;
 
 /// Grid of scallop measurement per area and level (along × across the flow).
 const SCALLOP_GRID: (usize, usize) = (40, 16);
+
+/// Largest spacing (mm) of the cross-channel samples of where the cutter fits on each grid
+/// section (half the path interval when that is finer).
+const FIT_SCAN_MAX_MM: f64 = 0.5;
+
+/// Bisections refining each end of a fitting interval (to `2⁻⁶` of the sample spacing, the kept end on the fitting side).
+const FIT_BISECTIONS: usize = 6;
+
+/// Angular step of the axis search (degrees) and its number of steps in lean (across the
+/// flow, away from the nearer side) and in lead (along the flow, both ways).
+const AXIS_STEP_DEG: f64 = 3.0;
+const LEAN_STEPS: usize = 4;
+const LEAD_STEPS: usize = 2;
+
+/// Levels of planned intermediate postures between two postures (up to `2^d − 1` per
+/// motion) before a motion is split.
+const BRIDGE_DEPTH: usize = 4;
 
 /// Depth samples along the channel used to find its largest depth.
 const DEPTH_SAMPLES: usize = 65;
@@ -153,20 +203,153 @@ struct Tab {
     ruled: usize,
 }
 
-/// One planned area of one level.
-struct AreaPlan {
-    level: usize,
-    tri: Vec<Path2>,
-    iso: Vec<Path2>,
-    links: Vec<Path2>,
+/// An area of one level as bounded by the offset ruled sides, before trimming: the region
+/// whose boundaries and rulings define the tool axis (module docs, step 5) of its lanes.
+struct Field {
     region: Region,
     left: Tab,
     right: Tab,
 }
 
+/// One planned lane (a graph region where the cutter fits) of one area of one level.
+struct AreaPlan {
+    level: usize,
+    /// Index of the area's [`Field`] in its level.
+    field: usize,
+    tri: Vec<Path2>,
+    iso: Vec<Path2>,
+    links: Vec<Path2>,
+    region: Region,
+}
+
 struct LevelPlan {
     level: DepthLevel,
+    fields: Vec<Field>,
     areas: Vec<AreaPlan>,
+    /// Developed area between the offset ruled sides (mm²).
+    area_mm2: f64,
+    /// Developed area of the planned lanes (mm²).
+    planned_mm2: f64,
+}
+
+/// The cutter alone (ball and flutes: the tool without shank and holder) against the blades:
+/// the query that decides where the cutter fits (module docs, step 4).
+struct FitQuery<'a> {
+    cutter: DesignClearance<'a>,
+    shape: CutterShape,
+    /// Radius of a ball end (ball or tapered ball): its centre touching the level at `p`
+    /// with normal `n` is `p + r·n` whatever the axis, so a centre closer than `r + fit_min`
+    /// to a blade rules out every axis with one exact distance.
+    ball: Option<f64>,
+}
+
+impl FitQuery<'_> {
+    /// Whether the ball (if the cutter has one) touching the level at `p` (normal `n`) keeps
+    /// `fit_min` from the blades (exact blade distance of its centre). O(1) projections.
+    fn ball_fits(&self, p: &Vector3<f64>, n: &Vector3<f64>, fit_min: f64) -> bool {
+        self.ball.is_none_or(|r| {
+            let c = cam_plan::Point3::from(p + n * r);
+            self.cutter.blade_signed_distance(&c).0 - r >= fit_min
+        })
+    }
+}
+
+/// The tool axes of one area (module docs, step 5).
+struct Axes<'a> {
+    lv: &'a DepthLevel,
+    field: &'a Field,
+    bounds: &'a [Bound],
+    max_tilt: f64,
+    /// Level number (for error places).
+    level: usize,
+}
+
+impl Axes<'_> {
+    /// Point of the level and its unit normal at planar `q = (s, y)`.
+    fn point_of(&self, q: [f64; 2]) -> (Vector3<f64>, Vector3<f64>) {
+        let theta = q[1] / self.lv.radius_at(q[0]);
+        self.lv.at_developed(q[0], theta)
+    }
+
+    /// Cross-channel fraction of `q` in the field (0 on the left side, 1 on the right).
+    fn fraction(&self, q: [f64; 2]) -> f64 {
+        let (l, r) = self.field.region.bounds(q[0]);
+        if r > l {
+            ((q[1] - l) / (r - l)).clamp(0.0, 1.0)
+        } else {
+            0.5
+        }
+    }
+
+    /// The wanted axis: the rulings of the two sides bounding the field interpolated at the
+    /// fraction of `q`, limited to `max_tilt` from the level normal `n`. O(1).
+    fn wanted(&self, q: [f64; 2], n: &Vector3<f64>) -> Vector3<f64> {
+        let f = self.fraction(q);
+        let ruling = |b: usize, u: f64| {
+            let r = &self.bounds[b].ruled;
+            (r.point(u, 1.0) - r.point(u, 0.0)).normalize()
+        };
+        let reg = &self.field.region;
+        let ul = interp(&reg.s, &self.field.left.u, q[0]);
+        let ur = interp(&reg.s, &self.field.right.u, q[0]);
+        let a =
+            ruling(self.field.left.ruled, ul) * (1.0 - f) + ruling(self.field.right.ruled, ur) * f;
+        limit_tilt(a.try_normalize(1e-12).unwrap_or(*n), n, self.max_tilt)
+    }
+
+    /// Candidate axes at `q` (point `p`, normal `n`), in the order tried (module docs,
+    /// step 5): the wanted axis; leaned away from the nearer side by `k·AXIS_STEP_DEG`
+    /// (`k ≤ LEAN_STEPS`); led forward and back along the flow (`≤ LEAD_STEPS`); both; leaned
+    /// toward the nearer side (`≤ 2` steps); the level normal. Each limited to `max_tilt`
+    /// from `n`. O(LEAN_STEPS · LEAD_STEPS).
+    fn candidates(&self, q: [f64; 2], p: &Vector3<f64>, n: &Vector3<f64>) -> Vec<Vector3<f64>> {
+        let a0 = self.wanted(q, n);
+        // Circumferential direction (increasing y), flow tangent and cross direction.
+        let e_y = Vector3::new(-p.y, p.x, 0.0)
+            .try_normalize(1e-12)
+            .unwrap_or_else(|| n.cross(&Vector3::x()));
+        let t = e_y.cross(n).try_normalize(1e-12).unwrap_or(e_y);
+        let c = n.cross(&t);
+        // Lean about the flow tangent: the sign that moves the axis toward +y, flipped when
+        // the nearer side is the right one.
+        let toward_plus_y = if t.cross(&a0).dot(&e_y) >= 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
+        let away = if self.fraction(q) < 0.5 {
+            toward_plus_y
+        } else {
+            -toward_plus_y
+        };
+        let step = AXIS_STEP_DEG.to_radians();
+        let turn = |lean: f64, lead: f64| {
+            let r = Rotation3::from_axis_angle(&Unit::new_normalize(c), lead)
+                * Rotation3::from_axis_angle(&Unit::new_normalize(t), lean);
+            limit_tilt(r * a0, n, self.max_tilt)
+        };
+        let mut out = vec![a0];
+        for k in 1..=LEAN_STEPS {
+            out.push(turn(away * step * k as f64, 0.0));
+        }
+        for j in 1..=LEAD_STEPS {
+            for sign in [1.0, -1.0] {
+                out.push(turn(0.0, sign * step * j as f64));
+            }
+        }
+        for k in 1..=LEAN_STEPS {
+            for j in 1..=LEAD_STEPS {
+                for sign in [1.0, -1.0] {
+                    out.push(turn(away * step * k as f64, sign * step * j as f64));
+                }
+            }
+        }
+        for k in 1..=2 {
+            out.push(turn(-away * step * k as f64, 0.0));
+        }
+        out.push(*n);
+        out
+    }
 }
 
 impl Operation for ChannelRoughing {
@@ -322,6 +505,35 @@ impl ChannelRoughing {
             depth = depth.max((shroud.point_at_fraction(m) - h).norm());
         }
         let n_levels = ((depth / doc).ceil() as usize).max(1);
+        // The cutter alone against the blades (module docs, step 4): the tool cut at its
+        // flute length, without holder, sampled as the context's query (so that the whole
+        // tool's clearance bounds the cutter's from below sample by sample).
+        let mut cutter_tool = ctx.tool.clone();
+        cutter_tool.cutter.overall_length = cutter_tool.cutter.flute_length;
+        cutter_tool.cutter.holder.clear();
+        let fit = FitQuery {
+            cutter: DesignClearance::with_mesh(
+                imp,
+                ctx.clearance.mesh().clone(),
+                &cutter_tool,
+                ClearanceOptions {
+                    parts: PartSet::BLADES,
+                    above_mm: 0.0,
+                    ..ctx.clearance.options()
+                },
+            )
+            .map_err(|e| self.geo("cutter fit query", e.to_string()))?,
+            shape,
+            ball: match shape {
+                CutterShape::BallEnd { radius }
+                | CutterShape::TaperedBallEnd {
+                    ball_radius: radius,
+                    ..
+                } => Some(radius),
+                _ => None,
+            },
+        };
+        let fit_min = ctx.process.blade_allowance_mm - 0.5 * ctx.tolerances.machining_tol;
         let levels: Vec<Result<LevelPlan, PlanError>> = (1..=n_levels)
             .into_par_iter()
             .map(|j| {
@@ -331,7 +543,7 @@ impl ChannelRoughing {
                 };
                 let level =
                     depth_level(imp, spacing).map_err(|e| PlanError::model(&self.name, e))?;
-                self.plan_level(ctx, j, level, &bounds)
+                self.plan_level(ctx, j, level, &bounds, &fit, fit_min)
             })
             .collect();
         let levels: Vec<LevelPlan> = levels.into_iter().collect::<Result<_, _>>()?;
@@ -347,7 +559,7 @@ impl ChannelRoughing {
         });
         let per_level: Vec<Result<LevelCl, PlanError>> = levels
             .par_iter()
-            .map(|lp| self.locate_level(ctx, lp, &bounds, &blades_only, doc))
+            .map(|lp| self.locate_level(ctx, lp, &bounds, &blades_only, &fit, fit_min, doc))
             .collect();
         let per_level: Vec<LevelCl> = per_level.into_iter().collect::<Result<_, _>>()?;
 
@@ -360,16 +572,22 @@ impl ChannelRoughing {
         let mut min_clear = f64::INFINITY;
         let mut max_scallop: f64 = 0.0;
         let mut n_paths = 0usize;
-        let mut skipped = 0usize;
+        let mut skipped_cutter = 0usize;
+        let mut skipped_tool = 0usize;
         let mut split = 0usize;
+        let mut bridged = 0usize;
+        let area_mm2: f64 = levels.iter().map(|l| l.area_mm2).sum();
+        let planned_mm2: f64 = levels.iter().map(|l| l.planned_mm2).sum();
         for lc in &per_level {
             tri_len += lc.tri_len;
             iso_len += lc.iso_len;
             min_clear = min_clear.min(lc.min_blade_clearance);
             max_scallop = max_scallop.max(lc.max_scallop);
             n_paths += lc.paths;
-            skipped += lc.skipped;
+            skipped_cutter += lc.skipped_cutter;
+            skipped_tool += lc.skipped_tool;
             split += lc.split_motions;
+            bridged += lc.bridge_postures;
             for area in &lc.moves {
                 let Some(first) = area.first() else { continue };
                 if let Some(prev) = last {
@@ -403,17 +621,30 @@ impl ChannelRoughing {
             .count("levels", n_levels)
             .count("paths", n_paths * count)
             .number("min_blade_clearance_mm", min_clear)
-            .count("skipped_locations", skipped * count)
-            .count("split_motions", split * count);
+            .number("level_area_mm2", area_mm2 * k)
+            .number(
+                "unmachinable_area_mm2",
+                (area_mm2 - planned_mm2).max(0.0) * k,
+            )
+            .count("skipped_locations", (skipped_cutter + skipped_tool) * count)
+            .count("skipped_cutter_blocked", skipped_cutter * count)
+            .count("skipped_shank_or_holder", skipped_tool * count)
+            .count("split_motions", split * count)
+            .count("bridge_postures", bridged * count);
         let plots = self.plot(&levels);
         Ok(PlannedOperation {
             paths,
             metrics,
             plots,
             notes: vec![format!(
-                "{n_levels} levels of ≤ {doc} mm; {} bounding sides (ruled, offset {:.3} mm)",
+                "{n_levels} levels of ≤ {doc} mm; {} bounding sides (ruled, offset {:.3} mm); \
+                 the cutter does not fit with {:.3} mm from the blades on {:.0} of {:.0} mm² \
+                 of the levels (all channels), left unplanned",
                 bounds.len(),
-                bounds.first().map_or(0.0, |b| b.offset.abs())
+                bounds.first().map_or(0.0, |b| b.offset.abs()),
+                fit_min,
+                (area_mm2 - planned_mm2).max(0.0) * k,
+                area_mm2 * k,
             )],
         })
     }
@@ -424,6 +655,8 @@ impl ChannelRoughing {
         j: usize,
         level: DepthLevel,
         bounds: &[Bound],
+        fit: &FitQuery<'_>,
+        fit_min: f64,
     ) -> Result<LevelPlan, PlanError> {
         let place = |b: &Bound| format!("level {j}, {}", b.label);
         let mut curves = Vec::with_capacity(bounds.len());
@@ -489,6 +722,9 @@ impl ChannelRoughing {
             specs.push((0, 1, s_lo, s_hi));
         }
         let mut areas = Vec::new();
+        let mut fields: Vec<Field> = Vec::new();
+        let mut area_mm2 = 0.0;
+        let mut planned_mm2 = 0.0;
         for (a, b, s0, s1) in specs {
             if s1 <= s0 {
                 continue;
@@ -506,34 +742,40 @@ impl ChannelRoughing {
                 let turn = tau * level.radius_at(si);
                 *ry = ly + (*ry - ly + 0.5 * turn).rem_euclid(turn) - 0.5 * turn;
             }
-            // The tool fits where the offset boundaries do not cross: plan every run of
-            // grid points with right ≥ left as its own area (narrower parts are left for
-            // the next tool / operation and counted in the notes of the caller).
-            let mut i = 0;
-            while i < n {
-                if right.y[i] < left.y[i] {
-                    i += 1;
-                    continue;
-                }
-                let start = i;
-                while i < n && right.y[i] >= left.y[i] {
-                    i += 1;
-                }
-                if i - start < 2 {
-                    continue;
-                }
-                let cut = |t: &Tab| Tab {
-                    y: t.y[start..i].to_vec(),
-                    u: t.u[start..i].to_vec(),
-                    ruled: t.ruled,
-                };
+            let field = Field {
+                region: Region {
+                    s,
+                    left: left.y.clone(),
+                    right: right.y.clone(),
+                },
+                left,
+                right,
+            };
+            area_mm2 += trapezoid(&field.region.s, |i| {
+                (field.region.right[i] - field.region.left[i]).max(0.0)
+            });
+            // Trim by where the cutter fits (module docs, step 4): the fitting intervals of
+            // every grid section, then lanes of sections with the same number of intervals.
+            let axes = Axes {
+                lv: &level,
+                field: &field,
+                bounds,
+                max_tilt: self.params.max_tilt_deg.to_radians(),
+                level: j,
+            };
+            let scan = (0.5 * step).min(FIT_SCAN_MAX_MM);
+            let mut sections: Vec<Vec<(f64, f64)>> = Vec::with_capacity(n);
+            for i in 0..n {
+                sections.push(self.fit_intervals(fit, &axes, i, scan, fit_min)?);
+            }
+            let area_place = format!("level {j}, area {} / {}", bounds[a].label, bounds[b].label);
+            for (lo, hi, lane) in lanes(&sections) {
                 let region = Region {
-                    s: s[start..i].to_vec(),
-                    left: left.y[start..i].to_vec(),
-                    right: right.y[start..i].to_vec(),
+                    s: field.region.s[lo..hi].to_vec(),
+                    left: sections[lo..hi].iter().map(|x| x[lane].0).collect(),
+                    right: sections[lo..hi].iter().map(|x| x[lane].1).collect(),
                 };
-                let area_place =
-                    format!("level {j}, area {} / {}", bounds[a].label, bounds[b].label);
+                planned_mm2 += trapezoid(&region.s, |i| region.right[i] - region.left[i]);
                 let tri = plan2d::triangle(&region, step)
                     .map_err(|e| self.geo(&area_place, e.to_string()))?;
                 let iso = plan2d::isoparametric(&region, step)
@@ -541,16 +783,107 @@ impl ChannelRoughing {
                 let (tri, links) = plan2d::link(tri, self.params.linking);
                 areas.push(AreaPlan {
                     level: j,
+                    field: fields.len(),
                     tri,
                     iso,
                     links,
                     region,
-                    left: cut(&left),
-                    right: cut(&right),
                 });
             }
+            fields.push(field);
         }
-        Ok(LevelPlan { level, areas })
+        Ok(LevelPlan {
+            level,
+            fields,
+            areas,
+            area_mm2,
+            planned_mm2,
+        })
+    }
+
+    /// The intervals `[y₀, y₁]` of grid section `i` of `axes.field` where the cutter fits
+    /// ([`Self::cutter_fits`]): samples across the section at most `scan` mm apart, then
+    /// every end between a fitting and a blocked sample refined by [`FIT_BISECTIONS`]
+    /// bisections (to `scan·2⁻⁶`). An end at a section boundary is that boundary. Cost:
+    /// O((width / scan + ends · FIT_BISECTIONS) · candidates) cutter queries.
+    fn fit_intervals(
+        &self,
+        fit: &FitQuery<'_>,
+        axes: &Axes<'_>,
+        i: usize,
+        scan: f64,
+        fit_min: f64,
+    ) -> Result<Vec<(f64, f64)>, PlanError> {
+        let reg = &axes.field.region;
+        let (s, l, r) = (reg.s[i], reg.left[i], reg.right[i]);
+        if r < l {
+            return Ok(Vec::new());
+        }
+        let k = (((r - l) / scan).ceil() as usize).max(1);
+        let ys: Vec<f64> = (0..=k).map(|m| l + (r - l) * m as f64 / k as f64).collect();
+        let mut ok = Vec::with_capacity(ys.len());
+        for &y in &ys {
+            ok.push(self.cutter_fits(fit, axes, [s, y], fit_min)?);
+        }
+        // Refine the end between a blocked `bad` and a fitting `good` ordinate.
+        let refine = |mut bad: f64, mut good: f64| -> Result<f64, PlanError> {
+            for _ in 0..FIT_BISECTIONS {
+                let m = 0.5 * (bad + good);
+                if self.cutter_fits(fit, axes, [s, m], fit_min)? {
+                    good = m;
+                } else {
+                    bad = m;
+                }
+            }
+            Ok(good)
+        };
+        let mut out = Vec::new();
+        let mut m = 0;
+        while m < ys.len() {
+            if !ok[m] {
+                m += 1;
+                continue;
+            }
+            let start = m;
+            while m < ys.len() && ok[m] {
+                m += 1;
+            }
+            let y0 = if start == 0 {
+                ys[0]
+            } else {
+                refine(ys[start - 1], ys[start])?
+            };
+            let y1 = if m == ys.len() {
+                ys[ys.len() - 1]
+            } else {
+                refine(ys[m], ys[m - 1])?
+            };
+            out.push((y0, y1));
+        }
+        Ok(out)
+    }
+
+    /// Whether the cutter (ball and flutes, not shank nor holder) at planar point `q`, touching
+    /// the level, keeps `fit_min` from the blades with one of the candidate axes of
+    /// [`Axes::candidates`] (each with the early-exit query). O(candidates · query).
+    fn cutter_fits(
+        &self,
+        fit: &FitQuery<'_>,
+        axes: &Axes<'_>,
+        q: [f64; 2],
+        fit_min: f64,
+    ) -> Result<bool, PlanError> {
+        let (p, n) = axes.point_of(q);
+        if !fit.ball_fits(&p, &n, fit_min) {
+            return Ok(false);
+        }
+        for a in axes.candidates(q, &p, &n) {
+            let cl = self.touch(&fit.shape, &p, &n, &a, axes.level, q)?;
+            if fit.cutter.is_clear(&cl, fit_min) {
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 }
 
@@ -593,19 +926,157 @@ struct LevelCl {
     min_blade_clearance: f64,
     max_scallop: f64,
     paths: usize,
-    skipped: usize,
-    /// Motions between two collision-free postures that were not clear even with a planned
-    /// midpoint (the path was split there).
+    /// Path points where the cutter fits with no candidate axis (between the fit samples).
+    skipped_cutter: usize,
+    /// Path points where the cutter fits but shank or holder hit with every candidate axis.
+    skipped_tool: usize,
+    /// Motions between two collision-free postures that were not clear even through planned
+    /// intermediate postures (the path was split there).
     split_motions: usize,
+    /// Intermediate postures inserted to certify motions.
+    bridge_postures: usize,
+}
+
+/// A certified posture: the location and its clearance (whole tool against the design).
+type Posture = (CutterLocation, cam_plan::Clearance);
+
+/// Why a point has no posture.
+enum Blocked {
+    /// The cutter itself keeps `fit_min` from the blades with no candidate axis.
+    Cutter,
+    /// The cutter does with some axis, but never with shank and holder clear as well.
+    ShankOrHolder,
 }
 
 impl ChannelRoughing {
+    /// A posture at planar `q` (module docs, step 5): the axes `first` (when given), then
+    /// the candidates of [`Axes::candidates`]; the cutter must keep `fit_min` from the
+    /// blades and the whole tool `0` from the design. A posture with at least the machining
+    /// tolerance to spare (so that the motions between postures certify) is preferred, else
+    /// the first clear one. O(candidates · query).
+    #[allow(clippy::too_many_arguments)]
+    fn posture(
+        &self,
+        ctx: &PlanContext<'_>,
+        fit: &FitQuery<'_>,
+        fit_min: f64,
+        axes: &Axes<'_>,
+        q: [f64; 2],
+        first: Option<Vector3<f64>>,
+    ) -> Result<Result<Posture, Blocked>, PlanError> {
+        let (p, n) = axes.point_of(q);
+        if !fit.ball_fits(&p, &n, fit_min) {
+            return Ok(Err(Blocked::Cutter));
+        }
+        let room = ctx.tolerances.machining_tol;
+        let mut cutter_fits = false;
+        let mut fallback: Option<Posture> = None;
+        let tries = first
+            .map(|a| limit_tilt(a, &n, axes.max_tilt))
+            .into_iter()
+            .chain(axes.candidates(q, &p, &n));
+        for a in tries {
+            let cl = self.touch(&fit.shape, &p, &n, &a, axes.level, q)?;
+            // The whole tool's clearance bounds the cutter's against the blades from below:
+            // the cutter query runs only when the whole tool's does not settle it.
+            let want = if fallback.is_none() { 0.0 } else { room };
+            let Some(c) = ctx.clearance.clearance_if_clear(&cl, want) else {
+                cutter_fits = cutter_fits || fit.cutter.is_clear(&cl, fit_min);
+                continue;
+            };
+            if c.distance_mm < fit_min && !fit.cutter.is_clear(&cl, fit_min) {
+                continue;
+            }
+            cutter_fits = true;
+            if c.distance_mm >= room {
+                return Ok(Ok((cl, c)));
+            }
+            if fallback.is_none() {
+                fallback = Some((cl, c));
+            }
+        }
+        Ok(match fallback {
+            Some(f) => Ok(f),
+            None if cutter_fits => Err(Blocked::ShankOrHolder),
+            None => Err(Blocked::Cutter),
+        })
+    }
+
+    /// Connects `a` (planar `qa`) to `b` (`qb`): `true` when the motion is certified clear
+    /// ([`cam_plan::DesignClearance::segment_clearance_between`], within `seg_tol`), or its
+    /// halves are through a planned posture at the planar midpoint (first axis: the mean of
+    /// the end axes), recursively up to `depth` levels; the inserted postures are pushed to
+    /// `out` in order. O(2^depth · (posture + motion check)).
+    #[allow(clippy::too_many_arguments)]
+    fn bridge(
+        &self,
+        ctx: &PlanContext<'_>,
+        fit: &FitQuery<'_>,
+        fit_min: f64,
+        axes: &Axes<'_>,
+        (a, qa): (&Posture, [f64; 2]),
+        (b, qb): (&Posture, [f64; 2]),
+        seg_tol: f64,
+        depth: usize,
+        out: &mut Vec<Posture>,
+    ) -> Result<bool, PlanError> {
+        let clear = ctx
+            .clearance
+            .segment_clearance_between(
+                (&a.0, a.1.distance_mm),
+                (&b.0, b.1.distance_mm),
+                0.0,
+                seg_tol,
+                SEGMENT_QUERIES,
+            )
+            .is_ok();
+        if clear {
+            return Ok(true);
+        }
+        if depth == 0 {
+            return Ok(false);
+        }
+        let qm = [0.5 * (qa[0] + qb[0]), 0.5 * (qa[1] + qb[1])];
+        let am = (a.0.axis.into_inner() + b.0.axis.into_inner()).try_normalize(1e-12);
+        let Ok(m) = self.posture(ctx, fit, fit_min, axes, qm, am)? else {
+            return Ok(false);
+        };
+        if !self.bridge(
+            ctx,
+            fit,
+            fit_min,
+            axes,
+            (a, qa),
+            (&m, qm),
+            seg_tol,
+            depth - 1,
+            out,
+        )? {
+            return Ok(false);
+        }
+        out.push(m);
+        self.bridge(
+            ctx,
+            fit,
+            fit_min,
+            axes,
+            (&m, qm),
+            (b, qb),
+            seg_tol,
+            depth - 1,
+            out,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
     fn locate_level(
         &self,
         ctx: &PlanContext<'_>,
         lp: &LevelPlan,
         bounds: &[Bound],
         blades_only: &cam_plan::DesignClearance<'_>,
+        fit: &FitQuery<'_>,
+        fit_min: f64,
         doc: f64,
     ) -> Result<LevelCl, PlanError> {
         let shape = ctx.tool.cutter.shape;
@@ -617,119 +1088,78 @@ impl ChannelRoughing {
             min_blade_clearance: f64::INFINITY,
             max_scallop: 0.0,
             paths: 0,
-            skipped: 0,
+            skipped_cutter: 0,
+            skipped_tool: 0,
             split_motions: 0,
+            bridge_postures: 0,
         };
         // Motions between postures may come this far below zero clearance (the other half
         // of the machining tolerance is the clearance query's own sampling error).
         let seg_tol = 0.5 * ctx.tolerances.machining_tol;
+        let lv = &lp.level;
+        // Every cutter location of the level (all lanes), for the scallop measurement.
+        let mut level_runs: Vec<Vec<CutterLocation>> = Vec::new();
         for area in &lp.areas {
-            let lv = &lp.level;
-            let point_of = |q: [f64; 2]| {
-                let theta = q[1] / lv.radius_at(q[0]);
-                lv.at_developed(q[0], theta)
+            let Some(field) = lp.fields.get(area.field) else {
+                continue;
             };
-            let ruling = |b: usize, u: f64| {
-                let r = &bounds[b].ruled;
-                (r.point(u, 1.0) - r.point(u, 0.0)).normalize()
-            };
-            // Axis wanted at a planar point: rulings interpolated across the area.
-            let axis_at = |q: [f64; 2], n: &Vector3<f64>| {
-                let (l, r) = area.region.bounds(q[0]);
-                let f = if r > l {
-                    ((q[1] - l) / (r - l)).clamp(0.0, 1.0)
-                } else {
-                    0.5
-                };
-                let ul = interp(&area.region.s, &area.left.u, q[0]);
-                let ur = interp(&area.region.s, &area.right.u, q[0]);
-                let a = ruling(area.left.ruled, ul) * (1.0 - f) + ruling(area.right.ruled, ur) * f;
-                limit_tilt(a.try_normalize(1e-12).unwrap_or(*n), n, max_tilt)
-            };
-            let place = |q: [f64; 2]| {
-                format!(
-                    "level {}, s = {:.3} mm, y = {:.3} mm",
-                    area.level, q[0], q[1]
-                )
+            let axes = Axes {
+                lv,
+                field,
+                bounds,
+                max_tilt,
+                level: area.level,
             };
             let mut chunks: Vec<Vec<Move>> = Vec::new();
             let mut cur: Vec<Move> = Vec::new();
-            let mut level_cls: Vec<CutterLocation> = Vec::new();
             for (pi, path) in area.tri.iter().enumerate() {
-                let pts: Vec<(Vector3<f64>, Vector3<f64>)> =
-                    path.iter().map(|&q| point_of(q)).collect();
                 let raw: Vec<Vector3<f64>> = path
                     .iter()
-                    .zip(&pts)
-                    .map(|(&q, (_, n))| axis_at(q, n))
+                    .map(|&q| axes.wanted(q, &axes.point_of(q).1))
                     .collect();
                 let smooth = smooth_axes(&raw, self.params.axis_smoothing);
-                // A collision-free posture at planar point `q` (wanted axis `a`, else the
-                // level normal) with its clearance, or `None`.
-                let posture = |q: [f64; 2],
-                               p: &Vector3<f64>,
-                               n: &Vector3<f64>,
-                               a: &Vector3<f64>|
-                 -> Result<
-                    Option<(CutterLocation, cam_plan::Clearance)>,
-                    PlanError,
-                > {
-                    let a = limit_tilt(*a, n, max_tilt);
-                    let cl = self.touch(&shape, p, n, &a, q, &place)?;
-                    let c = ctx.clearance.clearance(&cl);
-                    if c.distance_mm >= 0.0 {
-                        return Ok(Some((cl, c)));
+                let mut found: Vec<Option<Posture>> = Vec::with_capacity(path.len());
+                for (&q, a) in path.iter().zip(&smooth) {
+                    match self.posture(ctx, fit, fit_min, &axes, q, Some(*a))? {
+                        Ok(p) => found.push(Some(p)),
+                        Err(why) => {
+                            // No certified posture: the point is left uncut (the path is
+                            // split there; the measured scallop shows the residue).
+                            match why {
+                                Blocked::Cutter => out.skipped_cutter += 1,
+                                Blocked::ShankOrHolder => out.skipped_tool += 1,
+                            }
+                            found.push(None);
+                        }
                     }
-                    let alt = self.touch(&shape, p, n, n, q, &place)?;
-                    let ca = ctx.clearance.clearance(&alt);
-                    Ok((ca.distance_mm >= 0.0).then_some((alt, ca)))
-                };
-                let mut found: Vec<Option<(CutterLocation, cam_plan::Clearance)>> =
-                    Vec::with_capacity(path.len());
-                for ((&q, (p, n)), a) in path.iter().zip(&pts).zip(&smooth) {
-                    let f = posture(q, p, n, a)?;
-                    if f.is_none() {
-                        // Neither posture is collision-free: the point is left uncut (the
-                        // path is split there and the measured scallop shows the residue).
-                        out.skipped += 1;
-                    }
-                    found.push(f);
                 }
-                // The motions between consecutive postures are checked too (the axis may
-                // change between them): a motion that is not clear gets one planned
-                // midpoint; when a half is still not clear the path is split there (the
-                // linker retracts and approaches around the gap).
-                let seg_ok =
-                    |a: &(CutterLocation, cam_plan::Clearance),
-                     b: &(CutterLocation, cam_plan::Clearance)| {
-                        ctx.clearance
-                            .segment_clearance_between(
-                                (&a.0, a.1.distance_mm),
-                                (&b.0, b.1.distance_mm),
-                                0.0,
-                                seg_tol,
-                                SEGMENT_QUERIES,
-                            )
-                            .is_ok()
-                    };
-                let mut checked: Vec<Option<(CutterLocation, cam_plan::Clearance)>> =
-                    Vec::with_capacity(found.len());
+                // The motions between consecutive postures are certified too (the axis may
+                // change between them), through planned intermediate postures where needed;
+                // when that fails the path is split there (the linker retracts and
+                // approaches around the gap).
+                let mut checked: Vec<Option<Posture>> = Vec::with_capacity(found.len());
+                let mut mids: Vec<Posture> = Vec::new();
                 for k in 0..found.len() {
                     if k > 0 {
                         if let (Some(a), Some(b)) = (&found[k - 1], &found[k]) {
-                            if !seg_ok(a, b) {
-                                let qm = [
-                                    0.5 * (path[k - 1][0] + path[k][0]),
-                                    0.5 * (path[k - 1][1] + path[k][1]),
-                                ];
-                                let (pm, nm) = point_of(qm);
-                                let am = smooth[k - 1] + smooth[k];
-                                let mid = posture(qm, &pm, &nm, &am)?
-                                    .filter(|m| seg_ok(a, m) && seg_ok(m, b));
-                                if mid.is_none() {
-                                    out.split_motions += 1;
-                                }
-                                checked.push(mid);
+                            mids.clear();
+                            let ok = self.bridge(
+                                ctx,
+                                fit,
+                                fit_min,
+                                &axes,
+                                (a, path[k - 1]),
+                                (b, path[k]),
+                                seg_tol,
+                                BRIDGE_DEPTH,
+                                &mut mids,
+                            )?;
+                            if ok {
+                                out.bridge_postures += mids.len();
+                                checked.extend(mids.drain(..).map(Some));
+                            } else {
+                                out.split_motions += 1;
+                                checked.push(None);
                             }
                         }
                     }
@@ -753,7 +1183,7 @@ impl ChannelRoughing {
                 for run in cls.split(Option::is_none) {
                     out.tri_len += polyline_len(run.iter().flatten().map(|c| c.tip.coords));
                 }
-                // Link from the previous path inside the area (one-way links lifted by the
+                // Link from the previous path inside the lane (one-way links lifted by the
                 // depth of cut); a link that is not collision-free ends the chunk instead.
                 let first = cls.first().copied().flatten();
                 if pi > 0 && !cur.is_empty() {
@@ -773,9 +1203,9 @@ impl ChannelRoughing {
                         let mut clear = true;
                         let mut prev = cur.last().map(|m| m.cl);
                         for &q in link.iter().skip(1).take(link.len().saturating_sub(2)) {
-                            let (p, n) = point_of(q);
-                            let a = axis_at(q, &n);
-                            let cl = self.touch(&shape, &p, &n, &a, q, &place)?;
+                            let (p, n) = axes.point_of(q);
+                            let a = axes.wanted(q, &n);
+                            let cl = self.touch(&shape, &p, &n, &a, area.level, q)?;
                             let cl = CutterLocation {
                                 tip: cl.tip + n * lift,
                                 axis: cl.axis,
@@ -820,6 +1250,7 @@ impl ChannelRoughing {
                         chunks.push(std::mem::take(&mut cur));
                     }
                 }
+                let mut run: Vec<CutterLocation> = Vec::new();
                 for (k, c) in cls.iter().enumerate() {
                     match c {
                         Some(cl) => {
@@ -828,14 +1259,20 @@ impl ChannelRoughing {
                             if !dup {
                                 cur.push(Move::feed(*cl));
                             }
-                            level_cls.push(*cl);
+                            run.push(*cl);
                         }
                         None => {
                             if !cur.is_empty() {
                                 chunks.push(std::mem::take(&mut cur));
                             }
+                            if !run.is_empty() {
+                                level_runs.push(std::mem::take(&mut run));
+                            }
                         }
                     }
+                }
+                if !run.is_empty() {
+                    level_runs.push(run);
                 }
                 out.paths += 1;
             }
@@ -843,29 +1280,35 @@ impl ChannelRoughing {
                 chunks.push(cur);
             }
             for path in &area.iso {
-                out.iso_len += polyline_len(path.iter().map(|&q| point_of(q).0));
+                out.iso_len += polyline_len(path.iter().map(|&q| axes.point_of(q).0));
             }
+            out.moves.extend(chunks);
+        }
+        // The scallop of every lane (its machinable region), against every cutter position
+        // of the level.
+        for area in &lp.areas {
             out.max_scallop = out.max_scallop.max(measure_scallop(
                 &shape,
                 ctx.tool.cutter.flute_length,
-                &level_cls,
-                area,
+                &level_runs,
+                &area.region,
                 lv,
                 doc,
             ));
-            out.moves.extend(chunks);
         }
         Ok(out)
     }
 
+    /// The cutter location touching the level at `p` (normal `n`) with axis `a`; a contact
+    /// error names level `level` and planar point `q`.
     fn touch(
         &self,
         shape: &CutterShape,
         p: &Vector3<f64>,
         n: &Vector3<f64>,
         a: &Vector3<f64>,
+        level: usize,
         q: [f64; 2],
-        place: &impl Fn([f64; 2]) -> String,
     ) -> Result<CutterLocation, PlanError> {
         contact_location(
             shape,
@@ -874,7 +1317,12 @@ impl ChannelRoughing {
             Unit::new_normalize(*a),
         )
         .map(|c| c.cl)
-        .map_err(|e| self.geo(place(q), e.to_string()))
+        .map_err(|e| {
+            self.geo(
+                format!("level {level}, s = {:.3} mm, y = {:.3} mm", q[0], q[1]),
+                e.to_string(),
+            )
+        })
     }
 
     fn plot(&self, levels: &[LevelPlan]) -> Vec<Plot> {
@@ -910,6 +1358,38 @@ impl ChannelRoughing {
             },
         }]
     }
+}
+
+/// Trapezoidal integral over the grid `s` of the values `f(i)` at its points.
+fn trapezoid(s: &[f64], f: impl Fn(usize) -> f64) -> f64 {
+    (1..s.len())
+        .map(|i| 0.5 * (f(i - 1) + f(i)) * (s[i] - s[i - 1]))
+        .sum()
+}
+
+/// The lanes of a trimmed area (module docs, step 4): maximal runs `lo..hi` of consecutive
+/// grid sections with the same number of fitting intervals, each interval `k` of such a run
+/// overlapping its neighbour's in `y`, as `(lo, hi, k)`; runs of fewer than 2 sections are
+/// left out (their area counts as unmachinable). O(sections · intervals).
+fn lanes(sections: &[Vec<(f64, f64)>]) -> Vec<(usize, usize, usize)> {
+    let joins = |a: &[(f64, f64)], b: &[(f64, f64)]| {
+        !a.is_empty()
+            && a.len() == b.len()
+            && a.iter().zip(b).all(|(x, y)| x.0 <= y.1 && y.0 <= x.1)
+    };
+    let mut out = Vec::new();
+    let mut lo = 0;
+    while lo < sections.len() {
+        let mut hi = lo + 1;
+        while hi < sections.len() && joins(&sections[hi - 1], &sections[hi]) {
+            hi += 1;
+        }
+        if hi - lo >= 2 {
+            out.extend((0..sections[lo].len()).map(|k| (lo, hi, k)));
+        }
+        lo = hi;
+    }
+    out
 }
 
 fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
@@ -954,17 +1434,22 @@ fn inside(shape: &CutterShape, flute: f64, cl: &CutterLocation, x: &Vector3<f64>
     (d - a * h).norm() <= shape.radius_at(h)
 }
 
-/// Largest scallop over a grid of the area: from each grid point of the level, the distance
-/// along the level normal to the first cutter position (module docs); at most `cap`.
+/// Largest scallop over a grid of the lane `region` (its machinable region): from each grid
+/// point of the level, the distance along the level normal to the first cutter position of
+/// `runs` (module docs), at most `cap`: the ray is marched at a quarter of the ball radius
+/// and the first entry bisected (40 steps); a cutter crossed by the ray over less than a
+/// march step may be missed, which only reads more. Each run is a sequence of consecutive
+/// locations joined by cutting motions, densified to a quarter radius.
+/// O(grid · (cap / step) · dense locations near the point).
 fn measure_scallop(
     shape: &CutterShape,
     flute: f64,
-    cls: &[CutterLocation],
-    area: &AreaPlan,
+    runs: &[Vec<CutterLocation>],
+    region: &Region,
     lv: &DepthLevel,
     cap: f64,
 ) -> f64 {
-    if cls.is_empty() {
+    if runs.is_empty() {
         return 0.0;
     }
     let reach = match *shape {
@@ -977,32 +1462,30 @@ fn measure_scallop(
         _ => 0.0,
     };
     // Densify consecutive locations to a quarter radius.
-    let mut dense: Vec<CutterLocation> = Vec::with_capacity(cls.len() * 2);
-    for w in cls.windows(2) {
-        let d = (w[1].tip - w[0].tip).norm();
-        let k = ((d / (0.25 * reach)).ceil() as usize).clamp(1, 64);
-        if d > 4.0 * reach {
-            dense.push(w[0]);
-            continue;
+    let mut dense: Vec<CutterLocation> = Vec::new();
+    for cls in runs {
+        for w in cls.windows(2) {
+            let d = (w[1].tip - w[0].tip).norm();
+            let k = ((d / (0.25 * reach)).ceil() as usize).clamp(1, 64);
+            for i in 0..k {
+                let t = i as f64 / k as f64;
+                let axis = w[0].axis.into_inner() * (1.0 - t) + w[1].axis.into_inner() * t;
+                dense.push(CutterLocation {
+                    tip: w[0].tip + (w[1].tip - w[0].tip) * t,
+                    axis: Unit::new_normalize(axis),
+                });
+            }
         }
-        for i in 0..k {
-            let t = i as f64 / k as f64;
-            let axis = w[0].axis.into_inner() * (1.0 - t) + w[1].axis.into_inner() * t;
-            dense.push(CutterLocation {
-                tip: w[0].tip + (w[1].tip - w[0].tip) * t,
-                axis: Unit::new_normalize(axis),
-            });
+        if let Some(l) = cls.last() {
+            dense.push(*l);
         }
-    }
-    if let Some(l) = cls.last() {
-        dense.push(*l);
     }
     let (ns, ny) = SCALLOP_GRID;
-    let (s0, s1) = (area.region.s[0], area.region.s[area.region.s.len() - 1]);
+    let (s0, s1) = (region.s[0], region.s[region.s.len() - 1]);
     let mut worst: f64 = 0.0;
     for i in 0..=ns {
         let s = s0 + (s1 - s0) * i as f64 / ns as f64;
-        let (l, r) = area.region.bounds(s);
+        let (l, r) = region.bounds(s);
         for j in 0..=ny {
             let y = l + (r - l) * j as f64 / ny as f64;
             let (p, n) = lv.at_developed(s, y / lv.radius_at(s));
@@ -1017,11 +1500,24 @@ fn measure_scallop(
             if hit(0.0) {
                 continue;
             }
-            if !hit(cap) {
+            // March up the ray at a quarter radius to the first position inside a cutter
+            // (a ray may pass above or beside the cutters: the cap alone does not tell),
+            // then bisect between the last miss and the first hit.
+            let step = (0.25 * reach).max(1e-3).min(cap);
+            let mut lo = 0.0;
+            let mut first_hit = None;
+            while lo < cap {
+                let t = (lo + step).min(cap);
+                if hit(t) {
+                    first_hit = Some(t);
+                    break;
+                }
+                lo = t;
+            }
+            let Some(mut hi) = first_hit else {
                 worst = worst.max(cap);
                 continue;
-            }
-            let (mut lo, mut hi) = (0.0, cap);
+            };
             for _ in 0..40 {
                 let m = 0.5 * (lo + hi);
                 if hit(m) {
