@@ -145,7 +145,7 @@ fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
                 // Beyond the cutter's largest radius from the axis line: cannot be nearer.
                 let z = q.dot(a);
                 let w = (q - a * z).norm();
-                if w > 3.0 || z < -1.0 || z > FLUTE + 3.0 {
+                if w > 3.0 || !(-1.0..=FLUTE + 3.0).contains(&z) {
                     continue;
                 }
                 d = d.min(cutter_distance(w, z));
