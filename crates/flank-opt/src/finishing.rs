@@ -356,7 +356,8 @@ pub fn optimise_from(
         under = under.max(*d);
     }
     let env = prob.envelope(&res.x)?;
-    let chord = OUTPUT_CHORD_FRACTION * run.problem.overcut_tol.min(run.problem.undercut_tol);
+    let chord = (OUTPUT_CHORD_FRACTION * run.problem.overcut_tol.min(run.problem.undercut_tol))
+        .max(OUTPUT_CHORD_FLOOR_MM);
     let locations = output_locations(&env, run.output_locations, run.problem.flute_length, chord)?;
     Ok(PathResult {
         initial_max_deviation_mm: initial_max,
@@ -379,6 +380,10 @@ pub fn optimise_from(
 /// written motion (linear between locations) strays from the optimised envelope by at most
 /// this much at the tip and the flute top, so by at most this much anywhere on the cutter.
 const OUTPUT_CHORD_FRACTION: f64 = 0.25;
+/// Smallest chord tolerance of the written pass (mm): tighter accuracy requests would
+/// multiply the locations for no machining gain (the post linearises to a few µm anyway);
+/// the dense measurement still measures the pass as written.
+const OUTPUT_CHORD_FLOOR_MM: f64 = 1e-3;
 /// Bisections of one output interval (2¹⁰ = 1024 sub-intervals at most per initial one).
 const OUTPUT_MAX_DEPTH: usize = 10;
 

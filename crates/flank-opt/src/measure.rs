@@ -42,10 +42,15 @@ const CERTIFY_TOL_MM: f64 = 1e-4;
 /// linear segments; cam-core overflows its bookkeeping above 42 runs, reported).
 const CERTIFY_RUNS: usize = 32;
 
+/// Most points along the side (bounds the cost for passes with very many locations; on
+/// impeller-8+8, 4 × ~180 locations stay well below it).
+const MAX_ALONG: usize = 2000;
+
 /// Density of the measurement grid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DenseGrid {
-    /// Points along the side per written cutter location (at least 2 points in all).
+    /// Points along the side per written cutter location (at least 2 and at most
+    /// `MAX_ALONG` = 2000 points in all).
     pub per_location: usize,
     /// Rows evenly spaced from the hub edge to the shroud edge (at least 2).
     pub across: usize,
@@ -128,7 +133,7 @@ pub fn measure_written_path(
     let env = written_envelope(shape, flute_length, locations)?;
     let s = side.blade.side(side.side);
     let (va, vb) = side.v_range;
-    let nu = (grid.per_location * m).max(2);
+    let nu = (grid.per_location * m).clamp(2, MAX_ALONG);
     let us = along_parameters(&side.blade, side.side, side.v_range, nu);
     let ((u0, u1), _) = s.domain();
     let um = 0.5 * (u0 + u1);
