@@ -10,7 +10,14 @@
 //!    ([`crate::problem`]). The catalogue cutter just below the optimum is reported.
 //! 3. The path of the job's tool (ball end or tapered ball end): its initial path
 //!    ([`InitialPath`]), then minimax SLP (largest |deviation|) under hub tangency and
-//!    clearance, shape fixed. This is the path written.
+//!    clearance, shape fixed. The written locations follow the optimised envelope within a
+//!    quarter of the tolerance ([`output_locations`]). The written pass is then measured
+//!    densely against the design side ([`crate::measure`], issue 13); while it is outside
+//!    the tolerance, the points outside become samples and the SLP continues from the
+//!    current path (at most `REFINE_ROUNDS` rounds, cutting planes). The operation's
+//!    `max_overcut_mm`, `max_undercut_mm` and `max_deviation_mm` are that dense measurement
+//!    (`sample_max_*` keep the optimiser's own figures); a pass still outside after the
+//!    rounds is refused ([`FlankError::NotAccurate`]).
 //! 4. Comparison: the largest catalogue cylindrical ball end whose initial path keeps the
 //!    clearance, with its own minimax path; `stiffness_ratio_vs_cylindrical` is the job
 //!    tool's stiffness over that cylinder's.
@@ -21,6 +28,7 @@
 
 use crate::catalogue::Catalogue;
 use crate::geometry::{ball_radius, guides_through, FlankSide, InitialPath};
+use crate::measure::{measure_written_path, DenseGrid};
 use crate::problem::{deviations_max, Family, FlankProblem, HistoryRow, Mode, ProblemSettings};
 use crate::slp::{self, SlpOptions, Termination};
 use crate::{FlankError, FLANK_FINISHING};
@@ -48,7 +56,7 @@ fn default_locations() -> usize {
     30
 }
 fn default_along() -> usize {
-    24
+    60
 }
 fn default_across() -> usize {
     8
@@ -91,7 +99,8 @@ pub struct FinishingParams {
     /// `both` (default), `pressure` or `suction`.
     #[serde(default = "default_sides")]
     pub sides: Sides,
-    /// Accuracy samples along the blade (default 24).
+    /// Accuracy samples along the blade (default 60: two per guide control point of the
+    /// default 30, so the minimax path cannot swing between sample columns; issue 13).
     #[serde(default = "default_along")]
     pub samples_along: usize,
     /// Accuracy samples across (hub to shroud, default 8).
@@ -200,9 +209,10 @@ pub struct PathResult {
     pub initial_max_deviation_mm: f64,
     /// Signed deviations of the design samples (NaN: not an accuracy sample).
     pub deviations: Vec<f64>,
-    /// Largest overcut (mm, >= 0).
+    /// Largest overcut over the optimiser's accuracy samples (mm, >= 0); the written pass
+    /// itself is measured by [`crate::measure::measure_written_path`].
     pub max_overcut_mm: f64,
-    /// Largest undercut (mm, >= 0).
+    /// Largest undercut over the optimiser's accuracy samples (mm, >= 0).
     pub max_undercut_mm: f64,
     /// Smallest clearance to the adjacent blade (mm).
     pub min_clearance_mm: f64,
@@ -260,6 +270,20 @@ pub fn optimise(
     mode: Mode,
     run: &RunSettings,
 ) -> Result<PathResult, FlankError> {
+    optimise_from(side, shape, how, mode, run, None)
+}
+
+/// [`optimise`] started from the variables `start` (a previous result's `x` on the same side
+/// with the same `run.locations`) instead of the initial path; `None`: from the initial path.
+/// Errors as [`optimise`], and [`FlankError::Param`] when `start` has the wrong length.
+pub fn optimise_from(
+    side: &FlankSide,
+    shape: CutterShape,
+    how: InitialPath,
+    mode: Mode,
+    run: &RunSettings,
+    start: Option<&[f64]>,
+) -> Result<PathResult, FlankError> {
     let (family, r, theta) = match shape {
         CutterShape::BallEnd { radius } => (Family::Ball, radius, 0.0),
         CutterShape::TaperedBallEnd {
@@ -277,8 +301,17 @@ pub fn optimise(
     let mut settings = run.problem;
     settings.min_sample_height = settings.min_sample_height.max(r);
     let mut prob = FlankProblem::new(side, g0, g1, family, mode, settings);
-    let x0 = prob.pack(r, theta);
+    let mut x0 = prob.pack(r, theta);
     let n = x0.len();
+    if let Some(x) = start {
+        if x.len() != n {
+            return Err(FlankError::Param(format!(
+                "start vector has {} variables, the problem {n}",
+                x.len()
+            )));
+        }
+        x0 = x.to_vec();
+    }
     let mut scale = vec![1.0; n];
     let mut lower = vec![f64::NEG_INFINITY; n];
     let mut upper = vec![f64::INFINITY; n];
@@ -323,11 +356,9 @@ pub fn optimise(
         under = under.max(*d);
     }
     let env = prob.envelope(&res.x)?;
-    let (lo, hi) = env.domain();
-    let m = run.output_locations;
-    let locations = (0..m)
-        .map(|i| env.cutter_location(lo + (hi - lo) * i as f64 / (m - 1) as f64))
-        .collect::<Result<Vec<_>, _>>()?;
+    let chord = (OUTPUT_CHORD_FRACTION * run.problem.overcut_tol.min(run.problem.undercut_tol))
+        .max(OUTPUT_CHORD_FLOOR_MM);
+    let locations = output_locations(&env, run.output_locations, run.problem.flute_length, chord)?;
     Ok(PathResult {
         initial_max_deviation_mm: initial_max,
         max_overcut_mm: over,
@@ -343,6 +374,67 @@ pub fn optimise(
         locations,
         x: res.x,
     })
+}
+
+/// Fraction of the accuracy tolerance allowed to the chord error of the written pass: the
+/// written motion (linear between locations) strays from the optimised envelope by at most
+/// this much at the tip and the flute top, so by at most this much anywhere on the cutter.
+const OUTPUT_CHORD_FRACTION: f64 = 0.25;
+/// Smallest chord tolerance of the written pass (mm): tighter accuracy requests would
+/// multiply the locations for no machining gain (the post linearises to a few µm anyway);
+/// the dense measurement still measures the pass as written.
+const OUTPUT_CHORD_FLOOR_MM: f64 = 1e-3;
+/// Bisections of one output interval (2¹⁰ = 1024 sub-intervals at most per initial one).
+const OUTPUT_MAX_DEPTH: usize = 10;
+
+/// The written cutter locations of `env`: `m` evenly in the path parameter, then each
+/// interval bisected while the cutter location at its middle lies farther than `chord` (mm)
+/// from the chord of its ends, measured at the tip and at the flute top (`flute_length`
+/// above it), which bounds how far any point of the cutter's axis segment strays from the
+/// written linear motion there (the ends of a segment move linearly, so every point in
+/// between stays within the larger of the two). At the rounded leading edge, where the axis
+/// turns fastest, this inserts locations that 60 even ones lacked (issue 13: 0.019 mm of
+/// linearisation overcut at the nose). O(final count · depth) guide evaluations.
+pub fn output_locations(
+    env: &cam_core::SweptEnvelope,
+    m: usize,
+    flute_length: f64,
+    chord: f64,
+) -> Result<Vec<cam_core::CutterLocation>, FlankError> {
+    let (lo, hi) = env.domain();
+    let m = m.max(2);
+    let at = |s: f64| env.cutter_location(s);
+    let ends = |c: &cam_core::CutterLocation| {
+        (
+            c.tip.coords,
+            c.tip.coords + c.axis.into_inner() * flute_length,
+        )
+    };
+    let mut out = vec![at(lo)?];
+    for i in 1..m {
+        let (a, b) = (
+            lo + (hi - lo) * (i - 1) as f64 / (m - 1) as f64,
+            lo + (hi - lo) * i as f64 / (m - 1) as f64,
+        );
+        // Depth-first bisection, left to right.
+        let mut stack = vec![(a, b, 0usize)];
+        while let Some((a, b, depth)) = stack.pop() {
+            let (ca, cb) = (at(a)?, at(b)?);
+            let mid = 0.5 * (a + b);
+            let cm = at(mid)?;
+            let ((ta, pa), (tb, pb), (tm, pm)) = (ends(&ca), ends(&cb), ends(&cm));
+            let err = (tm - 0.5 * (ta + tb))
+                .norm()
+                .max((pm - 0.5 * (pa + pb)).norm());
+            if err > chord && depth < OUTPUT_MAX_DEPTH {
+                stack.push((mid, b, depth + 1));
+                stack.push((a, mid, depth + 1));
+            } else {
+                out.push(cb);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// The largest cylindrical ball end of the catalogue whose initial path keeps the
@@ -490,6 +582,12 @@ impl FlankFinishing {
         let mut metrics = Metrics::new();
         let mut over = 0.0f64;
         let mut under = 0.0f64;
+        let mut sample_over = 0.0f64;
+        let mut sample_under = 0.0f64;
+        let mut refine_rounds = 0usize;
+        let mut dense_points = 0usize;
+        let mut uncertified = 0usize;
+        let mut worst_at: Option<(Side, crate::measure::DensePoint)> = None;
         let mut clear = f64::INFINITY;
         let mut hub = 0.0f64;
         let mut iterations = 0;
@@ -501,7 +599,7 @@ impl FlankFinishing {
         let mut one_path = ToolPath::new(&self.name, &self.tool);
         let count = ctx.impeller.main().count();
         for (k, &side) in sides.iter().enumerate() {
-            let fs = FlankSide::new(ctx.impeller, side, p.samples_along, p.samples_across)?;
+            let mut fs = FlankSide::new(ctx.impeller, side, p.samples_along, p.samples_across)?;
             let mut runs: Vec<(String, Vec<HistoryRow>)> = Vec::new();
             if k == 0 && p.optimise_shape {
                 let start = match cutter.shape {
@@ -547,16 +645,81 @@ impl FlankFinishing {
                 }
                 runs.push(("shape and path".into(), study.history));
             }
-            let res = optimise(&fs, cutter.shape, p.initial_path, Mode::Minimax, &run)?;
+            let root = run
+                .problem
+                .min_sample_height
+                .max(ball_radius(&cutter.shape));
+            let mut res = optimise(&fs, cutter.shape, p.initial_path, Mode::Minimax, &run)?;
             iterations += res.iterations;
             termination = worse(termination, res.termination);
-            over = over.max(res.max_overcut_mm);
-            under = under.max(res.max_undercut_mm);
+            let report_mm = REFINE_FRACTION * run.problem.overcut_tol.min(run.problem.undercut_tol);
+            let measure = |fs: &FlankSide, res: &PathResult| {
+                measure_written_path(
+                    fs,
+                    &cutter.shape,
+                    cutter.flute_length,
+                    &res.locations,
+                    root,
+                    DenseGrid::default(),
+                    report_mm,
+                )
+            };
+            let mut dense = measure(&fs, &res)?;
+            // Cutting planes (issue 13): the dense measurement's points outside the tolerance
+            // become samples and the path is re-optimised from where it stands.
+            let mut rounds = 0;
+            // A warm start needs local steps only: a tenth of the initial trust radius.
+            // The hub rows are linearised: plan them to `REFINE_HUB_MARGIN` of ε so that the
+            // accepted point keeps ε after the last step's second-order error.
+            let refine_run = RunSettings {
+                trust_radius: REFINE_TRUST_FRACTION * run.trust_radius,
+                problem: ProblemSettings {
+                    hub_tol: REFINE_HUB_MARGIN * run.problem.hub_tol,
+                    ..run.problem
+                },
+                ..run
+            };
+            while (dense.max_overcut_mm > run.problem.overcut_tol
+                || dense.max_undercut_mm > run.problem.undercut_tol)
+                && rounds < REFINE_ROUNDS
+            {
+                rounds += 1;
+                fs.add_samples(
+                    dense
+                        .outside_points
+                        .iter()
+                        .take(REFINE_POINTS)
+                        .map(|q| q.uv),
+                );
+                res = optimise_from(
+                    &fs,
+                    cutter.shape,
+                    p.initial_path,
+                    Mode::Minimax,
+                    &refine_run,
+                    Some(&res.x),
+                )?;
+                iterations += res.iterations;
+                termination = worse(termination, res.termination);
+                dense = measure(&fs, &res)?;
+            }
+            refine_rounds += rounds;
+            dense_points += dense.points;
+            uncertified += dense.uncertified;
+            if let Some(w) = dense.worst_overcut {
+                if dense.max_overcut_mm > over {
+                    worst_at = Some((side, w));
+                }
+            }
+            over = over.max(dense.max_overcut_mm);
+            under = under.max(dense.max_undercut_mm);
+            sample_over = sample_over.max(res.max_overcut_mm);
+            sample_under = sample_under.max(res.max_undercut_mm);
             clear = clear.min(res.min_clearance_mm);
             hub = hub.max(res.hub_error_mm);
             stiffness = res.stiffness_n_per_mm;
             initial_dev = initial_dev.max(res.initial_max_deviation_mm);
-            final_dev = final_dev.max(deviations_max(&res.deviations));
+            final_dev = final_dev.max(dense.max_overcut_mm.max(dense.max_undercut_mm));
             out.plots.push(deviation_map(
                 &fs,
                 &res.deviations,
@@ -615,7 +778,14 @@ impl FlankFinishing {
         ]
         .iter()
         .filter(|(_, v, t, _)| v.is_nan() || *v > t * (1.0 + 1e-9) + 1e-12)
-        .map(|(what, v, t, u)| format!("{what} {v:.4} {u} > {t} {u}"))
+        .map(|(what, v, t, u)| match (*what, worst_at) {
+            ("overcut", Some((side, w))) => format!(
+                "{what} {v:.4} {u} > {t} {u} (dense measurement of the written pass, {side:?} \
+                 side at ({:.3}, {:.3}, {:.3}), {:.3} mm above the hub)",
+                w.point.x, w.point.y, w.point.z, w.hub_height_mm
+            ),
+            _ => format!("{what} {v:.4} {u} > {t} {u}"),
+        })
         .chain((clear < pr.min_clearance - 1e-9).then(|| {
             format!(
                 "clearance to the next blade {clear:.4} mm < {} mm",
@@ -636,6 +806,11 @@ impl FlankFinishing {
         out.paths = cam_plan::pattern::copy_to(&one_path, ctx.impeller.main().pitch_rad(), &order);
         metrics.number("max_overcut_mm", over);
         metrics.number("max_undercut_mm", under);
+        metrics.number("sample_max_overcut_mm", sample_over);
+        metrics.number("sample_max_undercut_mm", sample_under);
+        metrics.count("dense_points", dense_points);
+        metrics.count("dense_uncertified_points", uncertified);
+        metrics.count("refine_rounds", refine_rounds);
         metrics.number("min_blade_clearance_mm", clear);
         metrics.number("hub_tangency_error_mm", hub);
         metrics.number("stiffness_n_per_mm", stiffness);
@@ -648,6 +823,18 @@ impl FlankFinishing {
         Ok(out)
     }
 }
+
+/// Refinement rounds (dense measurement, overcut points added as samples, re-optimisation)
+/// before the operation gives up with [`FlankError::NotAccurate`].
+const REFINE_ROUNDS: usize = 4;
+/// Dense points outside by more than this fraction of the tolerance are added.
+const REFINE_FRACTION: f64 = 0.5;
+/// Hub tangency tolerance of a refinement run as a fraction of `hub_tangency_tol_mm`.
+const REFINE_HUB_MARGIN: f64 = 0.95;
+/// Trust radius of a refinement run as a fraction of `trust_radius_mm` (warm start).
+const REFINE_TRUST_FRACTION: f64 = 0.1;
+/// At most this many points (the worst) are added per round (LP rows stay below ~2000).
+const REFINE_POINTS: usize = 300;
 
 /// Approach distance above the first cutter location of a pass (mm).
 const APPROACH_MM: f64 = 5.0;

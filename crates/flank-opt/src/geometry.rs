@@ -13,9 +13,12 @@ const TANGENCY_ROUNDS: usize = 4;
 /// Bisection steps lowering the ball onto the hub: the bracket is at most a few ball radii
 /// wide, 50 halvings leave < 1e-12 mm.
 const HUB_BISECTIONS: usize = 50;
-/// Fraction of the u domain trimmed at the leading and trailing edges for the accuracy
-/// samples (the rounded edges are not flanked).
-const EDGE_TRIM: f64 = 0.02;
+/// Fine steps per along-sample of the arc-length/turning measure that places the samples
+/// along the side ([`along_parameters`]).
+const FINE_PER_SAMPLE: usize = 40;
+/// Hub heights of the extra across rows in the fillet band, as fractions of the fillet radius
+/// (overcut-only samples there: the ball end, not the flank, shapes that band).
+const FILLET_BAND_ROWS: [f64; 4] = [0.2, 0.4, 0.6, 0.8];
 
 /// How the initial cutter locations are found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
@@ -51,11 +54,20 @@ pub struct FlankSide {
 }
 
 impl FlankSide {
-    /// Prepares `side` of the impeller's main blade: `nu × nv` accuracy samples on the design
-    /// side between the hub and shroud edges (edges trimmed by [`EDGE_TRIM`] of u), and
-    /// `nu × nv` clearance samples on the nearest side of a neighbouring blade facing it (the
-    /// main blades next to it and the nearest splitters are candidates).
-    /// O(nu·nv) surface evaluations.
+    /// Prepares `side` of the impeller's main blade: accuracy samples on the design side over
+    /// its whole u domain, leading and trailing edge included, and `nu × nv` clearance samples
+    /// on the nearest side of a neighbouring blade facing it (the main blades next to it and
+    /// the nearest splitters are candidates).
+    ///
+    /// The accuracy grid is `nu × (nv + 4)`: `nu` parameters along the side placed by
+    /// [`along_parameters`] (half by arc length, half by turning of the normal, so the
+    /// rounded leading-edge nose, where the normal turns by ~90° within a few per cent of the
+    /// length, gets its share), and across `nv` rows evenly spaced in v from the hub edge to
+    /// the shroud edge plus rows at 0.2, 0.4, 0.6 and 0.8 fillet radii above the hub edge
+    /// (`FILLET_BAND_ROWS`), where the ball end can gouge the blade below the lowest flank
+    /// row (issue 13: 0.065 mm at 0.89 mm above the hub of impeller-8+8). Samples in that
+    /// band are overcut-only ([`crate::problem`]).
+    /// O(nu·(nv + FINE_PER_SAMPLE)) surface evaluations.
     pub fn new(impeller: &Impeller, side: Side, nu: usize, nv: usize) -> Result<Self, FlankError> {
         if nu < 2 || nv < 2 {
             return Err(FlankError::Param(
@@ -72,13 +84,12 @@ impl FlankSide {
         };
         let s = blade.side(side);
         let ((u0, u1), _) = s.domain();
-        let (ua, ub) = (u0 + EDGE_TRIM * (u1 - u0), u1 - EDGE_TRIM * (u1 - u0));
-        let mut samples = Vec::with_capacity(nu * nv);
-        let mut sample_uv = Vec::with_capacity(nu * nv);
-        for i in 0..nu {
-            let u = ua + (ub - ua) * i as f64 / (nu - 1) as f64;
-            for j in 0..nv {
-                let v = v_range.0 + (v_range.1 - v_range.0) * j as f64 / (nv - 1) as f64;
+        let us = along_parameters(&blade, side, v_range, nu);
+        let vs = across_parameters(&blade, side, v_range, nv, impeller.fillet_radius_mm());
+        let mut samples = Vec::with_capacity(nu * vs.len());
+        let mut sample_uv = Vec::with_capacity(nu * vs.len());
+        for &u in &us {
+            for &v in &vs {
                 samples.push(Point3::from(s.point(u, v)));
                 sample_uv.push((u, v));
             }
@@ -129,10 +140,21 @@ impl FlankSide {
             v_range,
             hub: impeller.hub().clone(),
             samples,
-            grid: (nu, nv),
+            grid: (nu, vs.len()),
             sample_uv,
             adjacent,
         })
+    }
+
+    /// Appends accuracy samples at the side parameters `uv` (after the `grid`, which stays
+    /// the first `nu·nv` samples). Used to add the points where a dense measurement found the
+    /// written pass outside its tolerance (cutting planes). O(count) evaluations.
+    pub fn add_samples(&mut self, uv: impl IntoIterator<Item = (f64, f64)>) {
+        let s = self.blade.side(self.side);
+        for (u, v) in uv {
+            self.samples.push(Point3::from(s.point(u, v)));
+            self.sample_uv.push((u, v));
+        }
     }
 
     /// Signed distance of `p` from the hub (positive on the channel side).
@@ -235,6 +257,98 @@ impl FlankSide {
         }
         Ok(p - a * (0.5 * (lo + hi)))
     }
+}
+
+/// `n` parameters u over the whole domain of `side` (both ends included), equidistributing
+/// `½·arc/arc_total + ½·turn/turn_total`, where `arc` is the larger of the hub- and
+/// shroud-edge isocurves' arc lengths and `turn` the larger turning angle of their outward
+/// normals (rad). Uniform u when the side neither lengthens nor turns (degenerate input).
+/// Where the normal turns fast (the rounded leading-edge nose of impeller-8+8 turns ~90° in
+/// the first 12 % of u) the samples crowd; on a flat stretch they follow arc length.
+/// O(n · `FINE_PER_SAMPLE`) point and normal evaluations.
+pub fn along_parameters(blade: &Blade, side: Side, v_range: (f64, f64), n: usize) -> Vec<f64> {
+    let s = blade.side(side);
+    let ((u0, u1), _) = s.domain();
+    let n = n.max(2);
+    let fine = n * FINE_PER_SAMPLE;
+    let at =
+        |u: f64| [v_range.0, v_range.1].map(|v| (s.point(u, v), blade.outward_normal(side, u, v)));
+    let mut arc = vec![0.0f64; fine + 1];
+    let mut turn = vec![0.0f64; fine + 1];
+    let mut prev = at(u0);
+    for k in 1..=fine {
+        let cur = at(u0 + (u1 - u0) * k as f64 / fine as f64);
+        let mut da: f64 = 0.0;
+        let mut dt: f64 = 0.0;
+        for e in 0..2 {
+            da = da.max((cur[e].0 - prev[e].0).norm());
+            if let (Some(a), Some(b)) = (prev[e].1, cur[e].1) {
+                dt = dt.max(a.dot(&b).clamp(-1.0, 1.0).acos());
+            }
+        }
+        arc[k] = arc[k - 1] + da;
+        turn[k] = turn[k - 1] + dt;
+        prev = cur;
+    }
+    let (a_tot, t_tot) = (arc[fine], turn[fine]);
+    let measure: Vec<f64> = (0..=fine)
+        .map(|k| {
+            let uniform = k as f64 / fine as f64;
+            match (a_tot > 1e-12, t_tot > 1e-9) {
+                (true, true) => 0.5 * arc[k] / a_tot + 0.5 * turn[k] / t_tot,
+                (true, false) => arc[k] / a_tot,
+                _ => uniform,
+            }
+        })
+        .collect();
+    let mut out = Vec::with_capacity(n);
+    let mut k = 0;
+    for i in 0..n {
+        let target = i as f64 / (n - 1) as f64;
+        while k + 1 < fine && measure[k + 1] < target {
+            k += 1;
+        }
+        let (m0, m1) = (measure[k], measure[k + 1]);
+        let f = if m1 > m0 {
+            ((target - m0) / (m1 - m0)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        out.push(u0 + (u1 - u0) * (k as f64 + f) / fine as f64);
+    }
+    out[0] = u0;
+    out[n - 1] = u1;
+    out
+}
+
+/// The across parameters v of the accuracy grid: `n` evenly from the hub edge to the shroud
+/// edge, plus the fillet-band rows at `FILLET_BAND_ROWS` × `fillet` above the hub edge
+/// (converted to v by the side's mean hub-to-shroud length), sorted. O(1) evaluations.
+fn across_parameters(
+    blade: &Blade,
+    side: Side,
+    v_range: (f64, f64),
+    n: usize,
+    fillet: f64,
+) -> Vec<f64> {
+    let s = blade.side(side);
+    let ((u0, u1), _) = s.domain();
+    let um = 0.5 * (u0 + u1);
+    let span = (s.point(um, v_range.1) - s.point(um, v_range.0)).norm();
+    let mut vs: Vec<f64> = (0..n)
+        .map(|j| v_range.0 + (v_range.1 - v_range.0) * j as f64 / (n - 1) as f64)
+        .collect();
+    if span > 1e-9 && fillet > 0.0 {
+        vs.extend(
+            FILLET_BAND_ROWS
+                .iter()
+                .map(|f| v_range.0 + (v_range.1 - v_range.0) * (f * fillet / span).min(1.0)),
+        );
+    }
+    // Hub edge first, whichever way v runs.
+    vs.sort_by(|a, b| (a - v_range.0).abs().total_cmp(&(b - v_range.0).abs()));
+    vs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    vs
 }
 
 /// Radius of the cutter's sphere-family member centred on the axis at height `c` above the

@@ -9,7 +9,9 @@
 //!   trajectory surface) optimised together for the Rayleigh–Ritz stiffness under accuracy,
 //!   hub-tangency and clearance constraints by SLP ([`slp`], LPs by clarabel); the catalogue
 //!   cutter just below the optimum ([`catalogue`]); the path of the job's tool optimised as a
-//!   minimax problem; the best cylindrical ball end for comparison.
+//!   minimax problem; the written pass measured densely against the design side and refined
+//!   until it holds the tolerance ([`measure`], issue 13); the best cylindrical ball end for
+//!   comparison.
 //! - [`FLANK_SEMI_FINISHING`] ([`semi`]): paper 001 §4. Each free-form blade side split into
 //!   sub-ruled strips within the semi-finish tolerance, one flank pass per strip from the
 //!   shroud down; compared with isoparametric point milling at the same scallop height.
@@ -24,6 +26,7 @@
 pub mod catalogue;
 pub mod finishing;
 pub mod geometry;
+pub mod measure;
 pub mod problem;
 pub mod semi;
 pub mod slp;

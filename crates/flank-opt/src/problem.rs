@@ -8,7 +8,11 @@
 //! distance of design sample `i` to the envelope:
 //!
 //! 1. accuracy: `d_i + overcut_tol >= 0`, `undercut_tol − d_i >= 0` (shape optimisation) or
-//!    the minimax rows `d_i` (path optimisation);
+//!    the minimax rows `d_i` (path optimisation) for the samples at least
+//!    `min_sample_height` above the hub; for the samples of the fillet band below it (still
+//!    above the hub) only the overcut row `d_i + overcut_tol >= 0` in both modes: the ball
+//!    end leaves the fillet there (undercut is expected), but it must not cut into the blade
+//!    (issue 13);
 //! 2. hub tangency at each cutter location `s_j`: `ε ± (h(P0(s_j)) − r) >= 0` with `h` the
 //!    signed hub distance;
 //! 3. clearance: `d(q_k) − c_min >= 0` for the adjacent-blade samples `q_k` within
@@ -104,6 +108,8 @@ pub struct FlankProblem<'a> {
     g1: GuideCurve,
     cl_params: Vec<f64>,
     samples: Vec<usize>,
+    /// Samples of the fillet band (above the hub, below `min_sample_height`): overcut rows.
+    band: Vec<usize>,
     family: Family,
     mode: Mode,
     settings: ProblemSettings,
@@ -133,8 +139,12 @@ impl<'a> FlankProblem<'a> {
         let cl_params = (0..n)
             .map(|i| lo + (hi - lo) * i as f64 / (n - 1).max(1) as f64)
             .collect();
+        let height = |i: usize| side.hub_distance(&side.samples[i].coords);
         let samples = (0..side.samples.len())
-            .filter(|&i| side.hub_distance(&side.samples[i].coords) >= settings.min_sample_height)
+            .filter(|&i| height(i) >= settings.min_sample_height)
+            .collect();
+        let band = (0..side.samples.len())
+            .filter(|&i| (0.0..settings.min_sample_height).contains(&height(i)))
             .collect();
         Self {
             side,
@@ -142,6 +152,7 @@ impl<'a> FlankProblem<'a> {
             g1,
             cl_params,
             samples,
+            band,
             family,
             mode,
             settings,
@@ -302,6 +313,11 @@ impl<'a> FlankProblem<'a> {
     pub fn accuracy_samples(&self) -> &[usize] {
         &self.samples
     }
+
+    /// Indices of the fillet-band samples (overcut rows only).
+    pub fn fillet_band_samples(&self) -> &[usize] {
+        &self.band
+    }
 }
 
 impl Model for FlankProblem<'_> {
@@ -333,6 +349,13 @@ impl Model for FlankProblem<'_> {
                     eval.constraints.push(high);
                 }
             }
+        }
+        let band = self.band.clone();
+        for &i in &band {
+            let p = self.side.samples[i];
+            let mut row = self.distance_row(&env, &p, i, gradients)?;
+            row.value += st.overcut_tol;
+            eval.constraints.push(row);
         }
         self.deviations = deviations;
         let (_, g0, _) = self.unpack(x);
