@@ -847,9 +847,10 @@ impl SweptEnvelope {
                         let start = if g_a <= g_b { sa } else { sb };
                         let (f, s, t, it) = self.polish(pv, start)?;
                         out.iterations += it;
+                        // Where Newton ended, and the interval itself (searched even
+                        // when Newton left it): two entries per run, so `found` holds
+                        // `1 + 2·MAX_RUNS`.
                         found[n_found] = s;
-                        n_found += 1;
-                        // The interval was searched even when Newton left it.
                         found[n_found + 1] = 0.5 * (sa + sb);
                         n_found += 2;
                         if f < out.distance {

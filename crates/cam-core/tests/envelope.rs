@@ -589,6 +589,39 @@ mod certified {
         );
     }
 
+    /// A query from the centre of a ring-shaped path sees every interval at nearly the same
+    /// distance, so certification runs Newton in interval after interval: with the largest run
+    /// budget (64) it must neither overrun its record of searched intervals (it panicked
+    /// above 42 runs) nor answer farther than a dense brute force.
+    #[test]
+    fn certification_with_the_largest_run_budget_on_a_ring() {
+        let ring = |z: f64| {
+            let pts: Vec<Vector3> = (0..=60)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / 60.0;
+                    Vector3::new(30.0 * a.cos(), 30.0 * a.sin(), z)
+                })
+                .collect();
+            cubic(&pts)
+        };
+        let shape = CutterShape::BallEnd { radius: 2.0 };
+        let fam = SphereFamily::from_shape(&shape, 20.0).unwrap();
+        let opts = EnvelopeOptions {
+            max_certify_runs: 64,
+            ..EnvelopeOptions::default()
+        };
+        let env = SweptEnvelope::new(fam, ring(0.0), ring(20.0), 0.0, opts).unwrap();
+        for p in [
+            Point3::new(0.0, 0.0, 2.0),
+            Point3::new(0.5, -0.3, 8.0),
+            Point3::new(-1.0, 0.2, -3.0),
+        ] {
+            let d = env.signed_distance(&p, None).unwrap();
+            let brute = brute_force(&env, &p);
+            assert!(d.distance <= brute + 1e-9, "{} vs {brute}", d.distance);
+        }
+    }
+
     /// Rational guides carry no hodograph bound: the answer says it is not certified.
     #[test]
     fn rational_guides_are_reported_uncertified() {
