@@ -18,13 +18,14 @@
 //! the linker's detour ([`cam_plan::Linker::connect`]): retract along the tool axis to the
 //! safety surface, travel over it (where the axis turns through +Z, the rotary axis' pole on
 //! the fixture machines, so the swing happens with the tool above the blank), approach along
-//! the next axis. The detour changes the postures after it, so the check is repeated
+//! the next axis. A swinging approach that already starts on the surface is fed instead (see
+//! [`reroute_swinging_rapids`]). The detour changes the postures after it, so the check is repeated
 //! (at most [`MAX_RELINK_PASSES`] passes) until no such rapid is left inside the surface.
 //!
 //! Cost per pass: one post without linearisation, O(n) inverse kinematics plus one sweep
 //! continuation per large rotary step.
 
-use cam_core::{CutterLocation, Move, ToolPath};
+use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
 use cam_plan::Linker;
 use postproc_kinematics::{post_path, swinging_rapids, Joints, LimitPolicy, Machine, PostOptions};
 
@@ -36,7 +37,8 @@ pub const MAX_RELINK_PASSES: usize = 4;
 /// What [`reroute_swinging_rapids`] did to one operation.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct MachineLinks {
-    /// Rapids replaced by a detour over the safety surface.
+    /// Rapids replaced by a detour over the safety surface, or approaches from it fed so that
+    /// the swing happens on the surface.
     pub rerouted: usize,
     /// Swinging rapids still inside the safety surface after the last pass (their ends allow
     /// no retract along the tool axis, or the passes ran out).
@@ -77,7 +79,11 @@ fn framed(path: &ToolPath, retract_mm: f64) -> Vec<Move> {
 
 /// Replaces every rapid of `path` on which `machine` would swing (see the module docs) and
 /// that starts or ends inside the safety surface of `linker` by the detour over the surface
-/// ([`Linker::connect`], approach `approach_mm` above the next posture); `post` are the
+/// ([`Linker::connect`], approach `approach_mm` above the next posture); a rapid that already
+/// starts on the surface (an approach) becomes a plunge-feed move instead, so the post's
+/// posture group — whose branch it chooses at the group's first rapid — begins at the rapid
+/// that reaches the surface and the swing happens there (table machines turn the part about
+/// Z, which keeps a tool outside the capped cylinder outside it); `post` are the
 /// options of the real post (tool length, initial posture, unwinding), `retract_mm` the
 /// approach/retract distance the assembly adds at the operation's ends. A rapid whose ends
 /// allow no retract along the tool axis is left and counted in
@@ -131,6 +137,19 @@ pub fn reroute_swinging_rapids(
             if next.peek() == Some(&i) {
                 next.next();
                 let from = path.moves[i - 1].cl;
+                if !linker.surface.contains(&from.tip) {
+                    // The rapid already starts on the safety surface: the swing belongs to the
+                    // posture group of the moves after it (the post chooses a group's branch
+                    // at its first rapid). Fed, this approach joins that group, which then
+                    // starts with the rapid reaching the surface: the swing happens there.
+                    rebuilt.push(Move {
+                        kind: MoveKind::Plunge,
+                        cl: m.cl,
+                        feed_mm_per_min: None,
+                    });
+                    out.rerouted += 1;
+                    continue;
+                }
                 if let Ok(detour) = linker.connect(&from, &m.cl, approach_mm) {
                     rebuilt.extend(detour);
                     out.rerouted += 1;
@@ -148,7 +167,7 @@ pub fn reroute_swinging_rapids(
 mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
     use super::*;
-    use cam_core::{MoveKind, Point3};
+    use cam_core::Point3;
     use cam_plan::SafetySurface;
 
     fn headhead() -> Machine {
