@@ -60,6 +60,18 @@ pub enum MachineLinkError {
     },
 }
 
+/// Distance (mm) from the safety surface within which a tip counts as on it: the linker puts
+/// its exit points on the surface up to rounding (1e-14 mm inside it on impeller-8+8).
+pub const ON_SURFACE_MM: f64 = 1e-6;
+
+/// Whether the tip of `cl` lies inside the safety surface of `linker` by more than
+/// [`ON_SURFACE_MM`].
+fn inside_surface(linker: &Linker, cl: &CutterLocation) -> bool {
+    let s = &linker.surface;
+    let p = cl.tip;
+    s.radius_mm - p.x.hypot(p.y) > ON_SURFACE_MM && s.top_z_mm - p.z > ON_SURFACE_MM
+}
+
 /// The moves the post sees for `path` (the approach and retract `retract_mm` along the tool
 /// axis that [`gcode_emit::assemble`] adds at the operation's ends, then the path).
 fn framed(path: &ToolPath, retract_mm: f64) -> Vec<Move> {
@@ -120,7 +132,7 @@ pub fn reroute_swinging_rapids(
         let inside = |i: usize| {
             path.moves
                 .get(i)
-                .is_some_and(|m| linker.surface.contains(&m.cl.tip))
+                .is_some_and(|m| inside_surface(linker, &m.cl))
         };
         let flagged: Vec<usize> = swinging_rapids(machine, &posted)
             .into_iter()
@@ -137,7 +149,7 @@ pub fn reroute_swinging_rapids(
             if next.peek() == Some(&i) {
                 next.next();
                 let from = path.moves[i - 1].cl;
-                if !linker.surface.contains(&from.tip) {
+                if !inside_surface(linker, &from) {
                     // The rapid already starts on the safety surface: the swing belongs to the
                     // posture group of the moves after it (the post chooses a group's branch
                     // at its first rapid). Fed, this approach joins that group, which then
@@ -167,7 +179,7 @@ pub fn reroute_swinging_rapids(
 mod tests {
     #![allow(clippy::unwrap_used, clippy::expect_used)]
     use super::*;
-    use cam_core::Point3;
+    use cam_core::{MoveKind, Point3};
     use cam_plan::SafetySurface;
 
     fn headhead() -> Machine {
@@ -260,5 +272,50 @@ mod tests {
         let links = reroute_swinging_rapids(&mut kept, &m, &options, 10.0, &linker, 2.0).unwrap();
         assert_eq!(links.rerouted, 0);
         assert_eq!(kept.moves.len(), original.moves.len());
+    }
+
+    /// An approach from the safety surface (rounding puts the linker's exit points up to
+    /// 1e-14 mm inside it) whose rapid swings C by 340°: a detour would repeat the same
+    /// approach, so it is fed instead; posted again, the swing is on no rapid inside the
+    /// surface.
+    #[test]
+    fn swinging_approach_from_the_safety_surface_is_fed() {
+        let m = headhead();
+        let axis = |c_deg: f64| {
+            m.tool_axis(5f64.to_radians(), c_deg.to_radians())
+                .into_inner()
+        };
+        let surface = SafetySurface {
+            radius_mm: 213.0,
+            top_z_mm: 140.0,
+        };
+        let linker = Linker::new(surface);
+        let on = CutterLocation::new(Point3::new(0.0, -100.0, 140.0 - 1e-14), axis(170.0)).unwrap();
+        let above = CutterLocation::new(Point3::new(0.0, -100.0, 134.0), axis(190.0)).unwrap();
+        let entry = CutterLocation::new(Point3::new(0.0, -100.0, 132.0), axis(190.0)).unwrap();
+        let mut path = ToolPath::new("approach", "d30");
+        path.moves = vec![
+            Move::rapid(on),
+            Move::rapid(above),
+            Move::feed(entry),
+            Move::feed(CutterLocation::new(Point3::new(2.0, -100.0, 100.0), axis(190.0)).unwrap()),
+        ];
+        let options = PostOptions {
+            tool_length: 210.0,
+            linearisation_tol: None,
+            unwind_on_rapid: true,
+            initial: Some(m.joints_for_angles(
+                &on.tip,
+                210.0,
+                5f64.to_radians(),
+                170f64.to_radians(),
+            )),
+            ..PostOptions::default()
+        };
+        let links = reroute_swinging_rapids(&mut path, &m, &options, 10.0, &linker, 2.0).unwrap();
+        assert_eq!((links.rerouted, links.remaining), (1, 0));
+        assert_eq!(path.moves.len(), 4);
+        assert_eq!(path.moves[1].kind, MoveKind::Plunge);
+        assert_eq!(path.moves[1].cl, above);
     }
 }
