@@ -121,7 +121,8 @@ pub fn run_job_with(job: &Job, out: &Path, registry: &Registry) -> Result<Report
     report.timings_ms.insert("model_ms".into(), ms(t));
 
     let t = stage(&progress, "planning operations");
-    let operations = plan(job, &impeller, registry, &mut report.notes)?;
+    let mut operations = plan(job, &impeller, registry, &mut report.notes)?;
+    link_for_machine(job, &impeller, &mut operations, &mut report.notes)?;
     if operations.is_empty() {
         report
             .notes
@@ -533,6 +534,96 @@ fn set_feeds(path: &mut ToolPath, rates: &Rates) {
     }
 }
 
+/// The post options of the job's program (shared by the post and by
+/// [`link_for_machine`], whose posture choice must be the post's).
+fn post_options(job: &Job) -> PostOptions {
+    PostOptions {
+        linearisation_tol: Some(job.tolerances.linearisation_tol),
+        // Rapids too: near the part (between plunges the tool travels a few mm above the
+        // blank) a joint-interpolated G0 with a rotary change leaves its straight line by
+        // more than the clearance; rapids that change branch are routed over the safety
+        // surface by `link_for_machine` (the post cannot linearise them).
+        linearise_rapids: true,
+        // Continuous rotary axes are never unwound: an unwinding is a full turn of the head
+        // or table under joint interpolation, which the post cannot linearise; between two
+        // plunges of impeller-plunge-400 on the head-head machine one took the cutter 30 mm
+        // deep through the blank. The angle then accumulates the operation's real rotation.
+        unwind_on_rapid: false,
+        reverse_motion: Some(ReverseMotionOptions::default()),
+        ..PostOptions::default()
+    }
+}
+
+/// Machine-aware linking of the planned operations (imported CL data is posted as given):
+/// every rapid on which the job's machine would change the solution branch or swing a
+/// rotary axis, inside the safety surface, becomes a retract to the safety surface, a travel
+/// over it and an approach ([`machine_links::reroute_swinging_rapids`]). Operations are
+/// chained as the program runs them (each starts from the posture the previous one ends
+/// in). Each planned operation reports `machine_links` (rapids rerouted) and
+/// `swinging_rapids_left`; a note names operations with swinging rapids left.
+pub fn link_for_machine(
+    job: &Job,
+    impeller: &Impeller,
+    operations: &mut [JobOperation],
+    notes: &mut Vec<String>,
+) -> Result<(), CliError> {
+    if operations.is_empty() {
+        return Ok(());
+    }
+    let machine = load_machine(job)?;
+    let surface =
+        SafetySurface::around_stock(impeller.stock(), job.safety.clearance_mm).map_err(msg)?;
+    let linker = Linker::with_blank(surface, impeller.stock());
+    let retract_mm = AssembleOptions::default().retract_mm;
+    let mut initial: Option<postproc_kinematics::Joints> = None;
+    for op in operations.iter_mut() {
+        let mut options = post_options(job);
+        options.initial = initial;
+        if let Some(tl) = op.cl.tool_length_mm {
+            options.tool_length = tl;
+        }
+        if op.kind == "cl_import" {
+            // Posted as given; only the chaining posture is needed.
+            let links = machine_links::reroute_swinging_rapids(
+                &mut op.cl.path.clone(),
+                &machine,
+                &options,
+                retract_mm,
+                &linker,
+                LINK_APPROACH_MM,
+            )
+            .map_err(msg)?;
+            initial = links.last.or(initial);
+            continue;
+        }
+        let links = machine_links::reroute_swinging_rapids(
+            &mut op.cl.path,
+            &machine,
+            &options,
+            retract_mm,
+            &linker,
+            LINK_APPROACH_MM,
+        )
+        .map_err(msg)?;
+        set_feeds(&mut op.cl.path, &op.rates);
+        initial = links.last.or(initial);
+        op.metrics
+            .count("machine_links", links.rerouted)
+            .count("swinging_rapids_left", links.remaining);
+        if links.remaining > 0 {
+            notes.push(format!(
+                "{}: {} rapid(s) inside the safety surface change the solution branch or swing \
+                 a rotary axis on {} and could not be routed over the safety surface (see the \
+                 verification)",
+                op.cl.path.name,
+                links.remaining,
+                machine.name()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Stage 3: writes `toolpath.cls` and, when there is something to machine, the program;
 /// fills `report.post` (and its notes and displacement plots). Returns the assembled program.
 pub fn post(
@@ -562,15 +653,7 @@ pub fn post(
     };
     let options = AssembleOptions {
         mode,
-        post: PostOptions {
-            linearisation_tol: Some(job.tolerances.linearisation_tol),
-            // Rapids too: near the part (between plunges the tool travels a few mm above the
-            // blank) a joint-interpolated G0 with a rotary change leaves its straight line by
-            // more than the clearance; rapids that change branch are left as they are.
-            linearise_rapids: true,
-            reverse_motion: Some(ReverseMotionOptions::default()),
-            ..PostOptions::default()
-        },
+        post: post_options(job),
         ..AssembleOptions::default()
     };
     let program_path = out.join(format!("program.{}", dialect.extension()));
@@ -913,6 +996,8 @@ impl AccessibilityChecker for GougeCheck<'_> {
         self.clearance.is_clear(cl, self.min_clearance_mm)
     }
 }
+
+pub mod machine_links;
 
 #[cfg(test)]
 mod tests;

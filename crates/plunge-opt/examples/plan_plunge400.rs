@@ -1,5 +1,6 @@
 //! Plans the three plunge-roughing sections of `fixtures/impeller-plunge-400` (Ø30, Ø16 and
-//! Ø8 plunge cutters of `fixtures/tools/plunge-cutters.toml`) and prints their metrics.
+//! Ø8 plunge cutters of `fixtures/tools/plunge-cutters.toml`) from the blank turned to the
+//! shroud contour and prints their metrics.
 //!
 //! `cargo run -p plunge-opt --example plan_plunge400`
 
@@ -96,7 +97,10 @@ fn tool(i: usize) -> Result<Tool, Box<dyn Error>> {
 fn main() -> Result<(), Box<dyn Error>> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/impeller-plunge-400");
     let impeller = impeller_model::load(root.join("impeller.toml"))?;
-    let stock = impeller.stock().clone();
+    // The blank turned to the shroud contour (as `job-plunge.toml` starts): from the uncut
+    // cylinder the Ø16 and Ø8 strokes near the inlet are longer than the stick-out and their
+    // holders would enter the blank (the planner refuses such plunges).
+    let stock = impeller.turned_stock(0.0)?;
     let tolerances = Tolerances::default();
     let linker = Linker::new(SafetySurface::around_stock(&stock, 10.0)?);
     let mut start = 1.0;

@@ -22,6 +22,8 @@
 //! - [`axis_optimisation`]: the W curve, its discretisation, the monotone-α walk;
 //! - [`axial_depth`]: the Newton solve of eqs. 2–9, the offset floor for corner radius and
 //!   allowance, the general disk-projection route;
+//! - [`stock_clearance`]: shank and holder kept out of the stock (blank or turned stock)
+//!   along every plunge, the whole tool along the rapids between plunges;
 //! - [`interference`]: exact centre-disk travel through uncut material;
 //! - [`allowance`]: the hub allowance left on the floor;
 //! - [`toolpath`]: rapid / plunge / retract moves and row links;
@@ -64,7 +66,10 @@
 //! `max_core_travel_*_mm`, `min_blade_clearance_mm`, `section_start_fraction`,
 //! `section_end_fraction`, `axes_moved_per_channel`, `axes_kept_for_clearance_per_channel`
 //! (plunges whose α-raising move would break the blade allowance keep their conventional
-//! axis). With one operation per section these
+//! axis), `positions_skipped_for_stock_per_channel` (plunges left out because shank or holder
+//! would enter the stock; every plunge of a section → an error asking for a turned stock or a
+//! longer stick-out), `row_rapids_over_safety_surface_per_channel` (in-row rapids that would
+//! not keep the tool out of the stock and go over the safety surface). With one operation per section these
 //! are the per-section figures. Plot: α along every row, conventional and optimised.
 //!
 //! Dependencies: `nurbs` (W-curve interpolation), `cam-core`, `impeller-model`, `cam-plan`,
@@ -78,6 +83,7 @@ pub mod conventional_axes;
 pub mod interference;
 pub mod operation;
 pub mod rows;
+pub mod stock_clearance;
 pub mod toolpath;
 
 pub use operation::{PlungeParams, PlungeRoughing, SectionPlan};

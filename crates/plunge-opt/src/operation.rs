@@ -6,6 +6,7 @@ use crate::axis_optimisation::{optimise_row_within, OptimisedRow, DEFAULT_W_STEP
 use crate::conventional_axes::{Posture, PostureBuilder};
 use crate::interference::{core_travel, interfering_count, ClearedRegion, Material, Stroke};
 use crate::rows::{plan_rows, stations, ChannelFrame, RowSettings};
+use crate::stock_clearance::StockClearance;
 use crate::toolpath::channel_path;
 use crate::KIND;
 use cam_core::CutterShape;
@@ -151,6 +152,9 @@ pub struct SectionPlan {
     pub min_blade_clearance_mm: f64,
     /// Positions moved across the channel toward its middle to keep the blade allowance.
     pub shifted_for_clearance: usize,
+    /// Plunges left out because shank or holder would enter the stock
+    /// ([`crate::stock_clearance`]).
+    pub skipped_for_stock: usize,
     /// Wall-clock time of each planning stage (ms).
     pub timings_ms: Vec<(&'static str, f64)>,
 }
@@ -408,6 +412,41 @@ impl PlungeRoughing {
             min_clear = min_clear.min(*c);
         }
         lap("blade_clearance_check");
+        // Shank and holder keep out of the stock (blank or turned stock) along every plunge;
+        // a plunge that cannot is left out (the next section or a shorter stroke from a
+        // turned stock reaches its material).
+        let stock_check = StockClearance::new(ctx.stock, &tool.cutter, radius);
+        let mut optimised = optimised;
+        let mut skipped_for_stock = 0;
+        for row in &mut optimised {
+            let keep: Vec<bool> = row
+                .postures
+                .par_iter()
+                .map(|p| stock_check.plunge_clear(p))
+                .collect();
+            skipped_for_stock += keep.iter().filter(|k| !**k).count();
+            let mut k = keep.iter();
+            row.postures.retain(|_| *k.next().unwrap_or(&true));
+            let mut k = keep.iter();
+            row.alpha_before.retain(|_| *k.next().unwrap_or(&true));
+            let mut k = keep.iter();
+            row.alpha_after.retain(|_| *k.next().unwrap_or(&true));
+            let mut k = keep.iter();
+            row.moves.retain(|_| *k.next().unwrap_or(&true));
+        }
+        optimised.retain(|r| !r.postures.is_empty());
+        if optimised.is_empty() {
+            return Err(PlanError::tool(
+                op,
+                tool.name(),
+                format!(
+                    "at every plunge of the section the shank or holder would enter the stock \
+                     (clearance {} mm): a longer stick-out or a turned stock is needed",
+                    crate::stock_clearance::STOCK_CLEARANCE_MM
+                ),
+            ));
+        }
+        lap("stock_clearance_check");
         let material = Material {
             stock: ctx.stock,
             cleared: (self.params.start_fraction < 1.0).then(|| ClearedRegion {
@@ -435,6 +474,7 @@ impl PlungeRoughing {
             allowance_after,
             min_blade_clearance_mm: min_clear,
             shifted_for_clearance,
+            skipped_for_stock,
             timings_ms,
         })
     }
@@ -456,12 +496,19 @@ impl Operation for PlungeRoughing {
     fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
         let plan = self.plan_section(ctx)?;
         let rows = plan.final_rows();
-        let path = channel_path(
+        let radius = ctx
+            .tool
+            .cutter
+            .shape
+            .radius_at(ctx.tool.cutter.flute_length);
+        let stock_check = StockClearance::new(ctx.stock, &ctx.tool.cutter, radius);
+        let (path, lifted) = channel_path(
             &self.name,
             ctx.tool.name(),
             &rows,
             ctx.linker,
             ctx.rates().plunge_mm_per_min,
+            &|a, b| stock_check.rapid_clear(a, b),
         )
         .map_err(|e| match e {
             PlanError::Geometry { place, reason, .. } => {
@@ -530,6 +577,11 @@ impl Operation for PlungeRoughing {
             plan.shifted_for_clearance,
         );
         m.count(
+            "positions_skipped_for_stock_per_channel",
+            plan.skipped_for_stock,
+        );
+        m.count("row_rapids_over_safety_surface_per_channel", lifted);
+        m.count(
             "axes_kept_for_clearance_per_channel",
             plan.optimised.iter().map(|r| r.kept_for_clearance).sum(),
         );
@@ -580,6 +632,14 @@ impl Operation for PlungeRoughing {
                 .collect::<Vec<_>>()
                 .join(", ")
         ));
+        if plan.skipped_for_stock > 0 {
+            notes.push(format!(
+                "{} plunge(s) per channel left out: the shank or holder would enter the stock \
+                 (clearance {} mm; a turned stock or a longer stick-out reaches them)",
+                plan.skipped_for_stock,
+                crate::stock_clearance::STOCK_CLEARANCE_MM
+            ));
+        }
         if !monotone {
             notes.push(
                 "alpha_monotone = false: on some row the W curve ended before α could increase"

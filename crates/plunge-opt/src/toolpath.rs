@@ -4,31 +4,45 @@
 //!
 //! Inside a row the tool moves from one plunge's start to the next one's at rapid: both lie
 //! the start clearance above the shroud and the blank along their axes, a plunge step apart.
-//! Between rows (and at both ends) the tool retracts along its axis to the safety surface,
-//! travels on it and comes down along the next axis. O(plunges).
+//! Where that rapid would not keep the tool out of the stock (`rapid_clear`, see
+//! [`crate::stock_clearance::StockClearance::rapid_clear`]), and between rows (and at both
+//! ends), the tool retracts along its axis to the safety surface, travels on it and comes
+//! down along the next axis. O(plunges) plus the rapid checks.
 
 use crate::conventional_axes::Posture;
-use cam_core::{Move, MoveKind, ToolPath};
+use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
 use cam_plan::{Linker, PlanError};
 
-/// The moves of one channel for `rows` (each outlet → inlet, rows in machining order).
+/// The moves of one channel for `rows` (each outlet → inlet, rows in machining order), and
+/// the number of in-row rapids that `rapid_clear` rejected and that go over the safety
+/// surface instead.
 pub fn channel_path(
     name: &str,
     tool: &str,
     rows: &[Vec<Posture>],
     linker: &Linker,
     plunge_feed_mm_per_min: f64,
-) -> Result<ToolPath, PlanError> {
+    rapid_clear: &(dyn Fn(&CutterLocation, &CutterLocation) -> bool + Sync),
+) -> Result<(ToolPath, usize), PlanError> {
     let mut path = ToolPath::new(name, tool);
     let mut prev: Option<Posture> = None;
+    let mut lifted = 0;
     for row in rows {
         for (i, p) in row.iter().enumerate() {
+            let over = match prev {
+                Some(q) if i > 0 && !rapid_clear(&q.start, &p.start) => {
+                    lifted += 1;
+                    true
+                }
+                Some(_) => i == 0,
+                None => false,
+            };
             match prev {
                 None => {
                     path.moves
                         .push(Move::rapid(linker.retract_point(&p.start)?));
                 }
-                Some(q) if i == 0 => {
+                Some(q) if over => {
                     let out = linker.retract_point(&q.start)?;
                     let inn = linker.retract_point(&p.start)?;
                     path.moves.push(Move {
@@ -72,5 +86,69 @@ pub fn channel_path(
         out.push(m);
     }
     path.moves = out;
-    Ok(path)
+    Ok((path, lifted))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::axial_depth::Contact;
+    use cam_core::{Point3, UnitVector3, Vector3};
+    use cam_plan::SafetySurface;
+
+    fn posture(x: f64) -> Posture {
+        let axis = UnitVector3::new_normalize(Vector3::z());
+        let cl = |z: f64| CutterLocation {
+            tip: Point3::new(x, 0.0, z),
+            axis,
+        };
+        Posture {
+            m: 0.5,
+            s: 0.5,
+            centre: Vector3::new(x, 0.0, 20.0),
+            w: Vector3::new(x, 0.0, 100.0),
+            cl: cl(20.0),
+            start: cl(132.0),
+            contact: Contact {
+                t: 0.0,
+                uv: (0.0, 0.0),
+                point: Vector3::new(x, 0.0, 20.0),
+                normal: Vector3::z(),
+                iterations: 0,
+            },
+            alpha: 0.0,
+        }
+    }
+
+    /// Two plunges of one row: the rapid between their starts stays where `rapid_clear`
+    /// accepts it; where it rejects it the tool retracts to the safety surface (z = 140),
+    /// travels and comes down, and the rejection is counted.
+    #[test]
+    fn rejected_row_rapid_goes_over_the_safety_surface() {
+        let linker = Linker::new(SafetySurface {
+            radius_mm: 213.0,
+            top_z_mm: 140.0,
+        });
+        let rows = vec![vec![posture(100.0), posture(106.0)]];
+        let highest = |p: &ToolPath, from: usize| {
+            p.moves[from..]
+                .iter()
+                .take_while(|m| m.kind != MoveKind::Plunge)
+                .map(|m| m.cl.tip.z)
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        let (direct, n) = channel_path("p", "t", &rows, &linker, 100.0, &|_, _| true).unwrap();
+        assert_eq!(n, 0);
+        // rapid down from the safety surface to start 0, plunge, retract to start 0, rapid to
+        // start 1, ...
+        assert_eq!(direct.moves[3].kind, MoveKind::Retract);
+        assert_eq!(direct.moves[4].kind, MoveKind::Rapid);
+        assert!((highest(&direct, 4) - 132.0).abs() < 1e-9);
+        let (lifted, n) = channel_path("p", "t", &rows, &linker, 100.0, &|_, _| false).unwrap();
+        assert_eq!(n, 1);
+        assert_eq!(lifted.moves[4].kind, MoveKind::Retract);
+        assert!(highest(&lifted, 4) >= 140.0 - 1e-9);
+        assert!(lifted.moves.len() > direct.moves.len());
+    }
 }

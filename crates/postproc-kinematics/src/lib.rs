@@ -76,8 +76,8 @@ pub use machine::{
     AxisSpec, HeadHead, HeadTable, Kinematics, Machine, RotaryMode, TableTable, TiltAxis,
 };
 pub use post::{
-    post_locations, post_path, post_path_checked, post_tool_path, LimitPolicy, PostMetrics,
-    PostOptions, PostedBlock, PostedPath,
+    is_reconfiguration, post_locations, post_path, post_path_checked, post_tool_path,
+    swinging_rapids, LimitPolicy, PostMetrics, PostOptions, PostedBlock, PostedPath,
 };
 pub use reverse_motion::{
     AccessibilityChecker, DisplacementCurves, ReverseMotionOptions, ReverseMotionReport,

@@ -504,6 +504,41 @@ fn set_feed(machine: &Machine, from: &PostedBlock, b: &mut PostedBlock) {
     }
 }
 
+/// Source indices of the rapid moves of `posted` on which the machine does not follow the
+/// programmed straight move but swings: the block was unwound (a continuous rotary axis
+/// turned by a multiple of 2π, which joint interpolation performs as a full turn of the head
+/// or table), it changes the solution branch ([`is_reconfiguration`]: a rotary step above
+/// [`RECONFIGURATION_STEP_RAD`] that the exact inverse kinematics along the move does not
+/// reach), or it starts or ends outside the axis limits. Such a rapid is not linearised
+/// ([`PostOptions::linearise_rapids`] leaves it as it is), so between its ends the tool sweeps
+/// an arc of radius up to the pivot plus tool length (head) or the tip radius (table); a caller
+/// that knows the part routes it over a safety surface instead (the job pipeline of
+/// `impeller-cam` does). Inserted linearisation blocks are skipped: the index is that of the
+/// source move (`PostedBlock::source_index`). Cost O(n) plus one sweep continuation per
+/// large rotary step.
+pub fn swinging_rapids(machine: &Machine, posted: &PostedPath) -> Vec<usize> {
+    let source: Vec<&PostedBlock> = posted.blocks.iter().filter(|b| !b.inserted).collect();
+    source
+        .windows(2)
+        .filter(|w| {
+            let (a, b) = (w[0], w[1]);
+            b.kind == MoveKind::Rapid
+                && (b.unwound
+                    || a.limit_violation.is_some()
+                    || b.limit_violation.is_some()
+                    || is_reconfiguration(
+                        machine,
+                        posted.tool_length,
+                        &a.cl,
+                        &a.joints,
+                        &b.cl,
+                        &b.joints,
+                    ))
+        })
+        .map(|w| w[1].source_index)
+        .collect()
+}
+
 /// A rotary step larger than this (rad) inside a group counts as a reconfiguration (the
 /// machine would swing the table or head around between two neighbouring cutter locations).
 pub const RECONFIGURATION_STEP_RAD: f64 = std::f64::consts::FRAC_PI_2;
@@ -635,8 +670,9 @@ fn linearised_deviation(
 /// and linearisation tracks that swing with exact intermediate postures. A change of the
 /// solution branch (e.g. the tilt sign) in the middle of a move cannot be tracked: the tool
 /// would swing away from the intended orientations.
-/// (A branch change through the pole is a small step: see [`keep_branch_near_pole`].)
-fn is_reconfiguration(
+/// (A branch change through the pole is a small step; the solution choice keeps the branch
+/// there where that serves the cut, see `keep_branch_near_pole`.)
+pub fn is_reconfiguration(
     machine: &Machine,
     tool_length: f64,
     cla: &CutterLocation,

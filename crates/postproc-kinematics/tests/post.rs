@@ -6,8 +6,8 @@ use cam_core::{CutterLocation, Move, MoveKind, Point3, Vector3};
 use postproc_kinematics::linearise::point_segment_distance;
 use postproc_kinematics::plot::displacement_svg;
 use postproc_kinematics::{
-    post_locations, post_path, post_path_checked, AccessibilityChecker, AxisId, Joints,
-    KinematicsError, LimitPolicy, Machine, PostError, PostOptions, ReverseMotionOptions,
+    post_locations, post_path, post_path_checked, swinging_rapids, AccessibilityChecker, AxisId,
+    Joints, KinematicsError, LimitPolicy, Machine, PostError, PostOptions, ReverseMotionOptions,
 };
 
 fn fixture(name: &str) -> Machine {
@@ -729,4 +729,92 @@ fn sweep_pole_angle_of_known_arcs() {
     let down = |v: UnitVector3<f64>| UnitVector3::new_normalize(-v.into_inner());
     let d = sweep_pole_angle(&down(tilt(10.0, -45.0)), &down(tilt(10.0, 45.0)));
     assert!((d - expect).abs() < 1e-12, "{d} {expect}");
+}
+
+/// Two plunges 5 mm apart whose axes lie 5° from the vertical at C = 170° and C = 190° on the
+/// head-head machine (continuous C): with unwinding the rapid between them turns C from 170°
+/// to −170°, a 340° swing of the head that joint interpolation performs and the post cannot
+/// linearise, and `swinging_rapids` names it; without unwinding C steps by 20° and the rapid
+/// is linearised (the tip stays within the tolerance of its line, dense sampling).
+#[test]
+fn swinging_rapids_name_an_unwinding_between_two_plunges() {
+    let m = fixture("headhead-ac");
+    let tl = 210.0;
+    let at = |c_deg: f64, x: f64| {
+        CutterLocation::new(
+            Point3::new(x, -100.0, 132.0),
+            axis_from_angles(&m, 5.0, c_deg),
+        )
+        .unwrap()
+    };
+    let (a, b) = (at(170.0, 0.0), at(190.0, 5.0));
+    let depth = |cl: CutterLocation| {
+        CutterLocation::new(cl.tip - cl.axis.into_inner() * 100.0, cl.axis.into_inner()).unwrap()
+    };
+    let moves = vec![
+        Move::rapid(a),
+        Move::feed(depth(a)),
+        Move::feed(a),
+        Move::rapid(b),
+        Move::feed(depth(b)),
+    ];
+    // The head stands on the branch of the first plunge (as after the plunges before it).
+    let unwinding = PostOptions {
+        tool_length: tl,
+        linearisation_tol: Some(0.005),
+        linearise_rapids: true,
+        initial: Some(m.joints_for_angles(&a.tip, tl, 5f64.to_radians(), 170f64.to_radians())),
+        ..Default::default()
+    };
+    let p = post_path(&m, &moves, &unwinding).unwrap();
+    let rapid = p.blocks.iter().find(|b| b.source_index == 3).unwrap();
+    assert!(rapid.unwound);
+    assert_eq!(swinging_rapids(&m, &p), vec![3]);
+    let kept = PostOptions {
+        unwind_on_rapid: false,
+        ..unwinding
+    };
+    let p = post_path(&m, &moves, &kept).unwrap();
+    assert!(swinging_rapids(&m, &p).is_empty());
+    let mut worst: f64 = 0.0;
+    for w in p.blocks.windows(2).filter(|w| w[1].source_index == 3) {
+        for k in 1..100 {
+            let tip = m
+                .forward(&w[0].joints.lerp(&w[1].joints, k as f64 / 100.0), tl)
+                .tip;
+            worst = worst.max(point_segment_distance(&tip, &a.tip, &b.tip));
+        }
+    }
+    assert!(worst <= 0.005 * 1.0001, "dense deviation {worst}");
+}
+
+/// On the table-table machine (A limited to [−100°, 50°]) a rapid from an axis tilted 40° to
+/// one tilted 60° the same way can only be reached on the other branch (A = −60°, C turned by
+/// 180°): `swinging_rapids` names it; a rapid to 45° (same branch) is not named.
+#[test]
+fn swinging_rapids_name_a_branch_change() {
+    let m = fixture("xyzac-trt");
+    let cl = |a_deg: f64, x: f64| {
+        CutterLocation::new(Point3::new(x, 0.0, 40.0), axis_from_angles(&m, a_deg, 30.0)).unwrap()
+    };
+    let opts = PostOptions {
+        linearisation_tol: None,
+        limit_policy: LimitPolicy::Report,
+        ..Default::default()
+    };
+    let flip = vec![
+        Move::rapid(cl(40.0, 0.0)),
+        Move::feed(cl(40.0, 1.0)),
+        Move::rapid(cl(60.0, 5.0)),
+    ];
+    let p = post_path(&m, &flip, &opts).unwrap();
+    assert!(p.blocks[2].joints.tilt < 0.0, "{:?}", p.blocks[2].joints);
+    assert_eq!(swinging_rapids(&m, &p), vec![2]);
+    let same = vec![
+        Move::rapid(cl(40.0, 0.0)),
+        Move::feed(cl(40.0, 1.0)),
+        Move::rapid(cl(45.0, 5.0)),
+    ];
+    let p = post_path(&m, &same, &opts).unwrap();
+    assert!(swinging_rapids(&m, &p).is_empty());
 }
