@@ -59,7 +59,7 @@ fn default_job_is_the_fixture_job_with_its_tools() {
     let machine = job.machine.clone().unwrap();
     assert!(job.is_embedded(&machine));
     assert!(job.read_text(&machine).unwrap().contains("xyzac-trt"));
-    // The process plan: four operations, their tools, from the turned blank; no CL files.
+    // The process plan: five operations, their tools, from the turned blank; no CL files.
     let ops: Vec<(&str, &str, &str)> = job
         .operations
         .iter()
@@ -70,6 +70,7 @@ fn default_job_is_the_fixture_job_with_its_tools() {
         [
             ("rough", "channel_roughing", "T5-taper-ball-r1.5"),
             ("hub-finish", "hub_finishing", "T6-taper-ball-r1"),
+            ("blade-semi", "flank_semi_finishing", "T5-taper-ball-r1.5"),
             ("blade-finish", "flank_finishing", "T6-taper-ball-r1"),
             ("blade-root", "blade_root_finishing", "T7-ball-d2"),
         ]
