@@ -20,15 +20,32 @@ use crate::tool_solid::{Piece, RevolvedSolid};
 use cam_core::Point3;
 use parry3d_f64::math::{Pose, Rotation, Vector};
 use parry3d_f64::query;
-use parry3d_f64::shape::{ConvexPolyhedron, TriMesh};
+use parry3d_f64::shape::{Capsule, ConvexPolyhedron, TriMesh};
 
 /// Number of sides of the polygons approximating the part circles.
 pub const RING_SEGMENTS: usize = 24;
 
+/// Slack (mm) subtracted from every clearance cached by [`DesignCollider::check_cached`]:
+/// covers the convergence tolerance of parry's distance query (GJK) and rounding.
+pub const CLEARANCE_SLACK_MM: f64 = 1e-3;
+
+/// One piece of a tool part: its polyhedron in the tool frame, the height of its axis middle,
+/// its part, and its bounding capsule (axis heights `h0..h1`, radius: the polyhedron's
+/// largest ring radius).
+#[derive(Debug, Clone)]
+struct PartPiece {
+    shape: ConvexPolyhedron,
+    mid: f64,
+    kind: PartKind,
+    h0: f64,
+    h1: f64,
+    capsule_radius: f64,
+}
+
 /// A tool part as convex polyhedra in the tool frame (tip at origin, axis +Z).
 #[derive(Debug, Clone)]
 pub struct PartShapes {
-    pieces: Vec<(ConvexPolyhedron, f64, PartKind)>,
+    pieces: Vec<PartPiece>,
 }
 
 fn piece_polyhedron(p: &Piece) -> Option<(ConvexPolyhedron, f64)> {
@@ -59,10 +76,19 @@ impl PartShapes {
     /// Shapes of the shank and holder (`rapid = false`) or of the whole tool (`rapid = true`).
     pub fn new(body: &ToolBody, rapid: bool) -> Self {
         let mut pieces = Vec::new();
+        let scale = 1.0 / (std::f64::consts::PI / RING_SEGMENTS as f64).cos();
         let mut add = |s: &RevolvedSolid, kind: PartKind| {
             for p in s.pieces() {
-                if let Some((c, hm)) = piece_polyhedron(p) {
-                    pieces.push((c, hm, kind));
+                if let Some((shape, mid)) = piece_polyhedron(p) {
+                    let (h0, h1) = p.heights();
+                    pieces.push(PartPiece {
+                        shape,
+                        mid,
+                        kind,
+                        h0,
+                        h1,
+                        capsule_radius: p.max_radius() * scale,
+                    });
                 }
             }
         };
@@ -122,7 +148,13 @@ impl DesignCollider {
         let pose = Pose::from_parts(Vector::new(tip[0], tip[1], tip[2]), rot);
         let mesh_pose = Pose::IDENTITY;
         let mut out: Vec<DesignHit> = Vec::new();
-        for (shape, hm, kind) in &parts.pieces {
+        for PartPiece {
+            shape,
+            mid: hm,
+            kind,
+            ..
+        } in &parts.pieces
+        {
             let hits = matches!(
                 query::intersection_test(&pose, shape, &mesh_pose, &self.mesh),
                 Ok(r) if r.intersecting
@@ -155,5 +187,106 @@ impl DesignCollider {
             }
         }
         out
+    }
+
+    /// [`check`](Self::check) for a sequence of positions of the same parts, skipping the
+    /// pieces proven clear. `cache` holds one entry per piece of `parts` (start with
+    /// [`ClearanceCache::new`]; use one cache per part set and sequence of positions).
+    ///
+    /// Whenever a piece is tested in full and found clear (no mesh intersection, axis middle
+    /// outside the design), the cache keeps its axis end points and a clearance `c`: the
+    /// smaller of the distance from the piece's bounding capsule to the mesh and the design's
+    /// signed distance at the axis middle, less [`CLEARANCE_SLACK_MM`]. A later position whose
+    /// axis end points moved less than `c` (every point of the capsule moves at most the
+    /// larger end-point displacement, the axis middle at most that much) keeps the capsule —
+    /// hence the polyhedron — off the mesh, and the middle outside the design (the
+    /// [`DesignModel`] contract: the signed distance never exceeds the true distance, with
+    /// the right sign), so the full test would report nothing: the result is exactly that of
+    /// [`check`](Self::check). Cost: one capsule–mesh distance and one signed distance per
+    /// refreshed piece, O(1) per skipped piece.
+    pub fn check_cached(
+        &self,
+        design: &dyn DesignModel,
+        parts: &PartShapes,
+        tip: &[f64; 3],
+        axis: &[f64; 3],
+        cache: &mut ClearanceCache,
+    ) -> Vec<DesignHit> {
+        cache.entries.resize(parts.pieces.len(), None);
+        let at = |h: f64| {
+            [
+                tip[0] + h * axis[0],
+                tip[1] + h * axis[1],
+                tip[2] + h * axis[2],
+            ]
+        };
+        let dist = |a: &[f64; 3], b: &[f64; 3]| {
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        };
+        let mut out: Vec<DesignHit> = Vec::new();
+        let mut single = PartShapes { pieces: Vec::new() };
+        for (piece, entry) in parts.pieces.iter().zip(cache.entries.iter_mut()) {
+            let (e0, e1) = (at(piece.h0), at(piece.h1));
+            if let Some(c) = entry {
+                if dist(&e0, &c.ends[0]).max(dist(&e1, &c.ends[1])) < c.clearance {
+                    continue;
+                }
+            }
+            single.pieces.clear();
+            single.pieces.push(piece.clone());
+            let hits = self.check(design, &single, tip, axis);
+            *entry = None;
+            if hits.is_empty() {
+                let capsule = Capsule::new(
+                    Vector::new(e0[0], e0[1], e0[2]),
+                    Vector::new(e1[0], e1[1], e1[2]),
+                    piece.capsule_radius,
+                );
+                let mesh_clear =
+                    query::distance(&Pose::IDENTITY, &capsule, &Pose::IDENTITY, &self.mesh)
+                        .map_or(0.0, |d| d.distance);
+                let m = at(piece.mid);
+                let sd = design.signed_distance(&Point3::new(m[0], m[1], m[2]));
+                let clearance = mesh_clear.min(sd) - CLEARANCE_SLACK_MM;
+                if clearance > 0.0 {
+                    *entry = Some(Clearance {
+                        ends: [e0, e1],
+                        clearance,
+                    });
+                }
+            }
+            for h in hits {
+                match out.iter_mut().find(|o| o.part == h.part) {
+                    Some(o) if o.depth < h.depth => {
+                        o.depth = h.depth;
+                        o.point = h.point;
+                    }
+                    Some(_) => {}
+                    None => out.push(h),
+                }
+            }
+        }
+        out
+    }
+}
+
+/// A clear piece position remembered by [`DesignCollider::check_cached`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Clearance {
+    ends: [[f64; 3]; 2],
+    clearance: f64,
+}
+
+/// Per-piece clearances of one part set along a sequence of positions (see
+/// [`DesignCollider::check_cached`]).
+#[derive(Debug, Clone, Default)]
+pub struct ClearanceCache {
+    entries: Vec<Option<Clearance>>,
+}
+
+impl ClearanceCache {
+    /// An empty cache (every piece is tested in full at first).
+    pub fn new() -> Self {
+        Self::default()
     }
 }
