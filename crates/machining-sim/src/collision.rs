@@ -290,3 +290,51 @@ impl ClearanceCache {
         Self::default()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::design::BoxDesign;
+    use crate::synthetic::workload_cutter;
+
+    /// The cached check reports exactly what the full check reports, position by position,
+    /// along a sweep that approaches, enters (shank and holder) and leaves a block design.
+    #[test]
+    fn cached_check_equals_full_check() {
+        let design = BoxDesign {
+            min: [-10.0, -10.0, 0.0],
+            max: [10.0, 10.0, 20.0],
+            sample_spacing: 2.0,
+        };
+        let collider = DesignCollider::new(&design.triangle_mesh()).unwrap();
+        let body = ToolBody::new(&workload_cutter());
+        for rapid in [false, true] {
+            let parts = PartShapes::new(&body, rapid);
+            let mut cache = ClearanceCache::new();
+            let (mut hits, mut skipped_somewhere) = (0usize, false);
+            for k in 0..600 {
+                let t = k as f64 / 600.0;
+                let tip = [
+                    -40.0 + 80.0 * t,
+                    3.0 * (9.0 * t).sin(),
+                    30.0 - 40.0 * (3.0 * t).sin(),
+                ];
+                let (s, c) = (0.4 * (5.0 * t).sin(), 0.4 * (5.0 * t).cos());
+                let n = (s * s + c * c + 1.0f64).sqrt();
+                let axis = [s / n, c / n, 1.0 / n];
+                let full = collider.check(&design, &parts, &tip, &axis);
+                let before = cache.entries.clone();
+                let cached = collider.check_cached(&design, &parts, &tip, &axis, &mut cache);
+                assert_eq!(full, cached, "position {k}");
+                hits += full.len();
+                skipped_somewhere |= before
+                    .iter()
+                    .zip(&cache.entries)
+                    .any(|(a, b)| a.is_some() && a == b);
+            }
+            assert!(hits > 0, "the sweep must collide");
+            assert!(skipped_somewhere, "the cache must skip some pieces");
+        }
+    }
+}

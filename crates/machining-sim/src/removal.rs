@@ -196,9 +196,13 @@ struct Prep {
     cut_box: Option<([f64; 3], [f64; 3])>,
     /// Largest radius of the clipped cutting pieces (mm).
     cut_radius: f64,
+    /// Height span of the clipped cutting pieces along the axis (mm).
+    cut_span: (f64, f64),
     coll_box: Option<([f64; 3], [f64; 3])>,
     /// Largest radius of the clipped collision pieces (mm).
     coll_radius: f64,
+    /// Height span of the clipped collision pieces along the axis (mm).
+    coll_span: (f64, f64),
     coll: std::ops::Range<usize>,
 }
 
@@ -232,17 +236,20 @@ fn prepare(
         let body = &bodies[pl.tool];
         let mut cut_box = None;
         let mut cut_radius: f64 = 0.0;
+        let mut cut_span = (f64::INFINITY, f64::NEG_INFINITY);
         if !pl.rapid {
             for p in body.cutting.pieces() {
                 if let Some(c) = clip_piece(p, &pl.tip, &pl.axis, &lo, &hi) {
                     merge_box(&mut cut_box, piece_box(&c, &pl.tip, &pl.axis));
                     cut_radius = cut_radius.max(c.max_radius());
+                    cut_span = (cut_span.0.min(c.heights().0), cut_span.1.max(c.heights().1));
                 }
             }
         }
         let start = coll_pieces.len();
         let mut coll_box = None;
         let mut coll_radius: f64 = 0.0;
+        let mut coll_span = (f64::INFINITY, f64::NEG_INFINITY);
         if check_collisions || pl.rapid {
             let parts: [(&RevolvedSolid, PartKind); 3] = if pl.rapid {
                 [
@@ -263,6 +270,10 @@ fn prepare(
                     if let Some(c) = clip_piece(p, &pl.tip, &pl.axis, &lo, &hi) {
                         merge_box(&mut coll_box, piece_box(&c, &pl.tip, &pl.axis));
                         coll_radius = coll_radius.max(c.max_radius());
+                        coll_span = (
+                            coll_span.0.min(c.heights().0),
+                            coll_span.1.max(c.heights().1),
+                        );
                         coll_pieces.push((c, *kind));
                     }
                 }
@@ -271,8 +282,10 @@ fn prepare(
         preps.push(Prep {
             cut_box,
             cut_radius,
+            cut_span,
             coll_box,
             coll_radius,
+            coll_span,
             coll: start..coll_pieces.len(),
         });
     }
@@ -302,9 +315,31 @@ struct Band {
 #[derive(Debug, Clone, Copy)]
 struct Footprint {
     range: Range2,
-    d_lo: f64,
-    d_hi: f64,
     band: Option<Band>,
+    /// Tip coordinates along u, v and the ray direction d.
+    tip: [f64; 3],
+    /// Axis components along u, v and d.
+    axis: [f64; 3],
+    /// Height span of the part's clipped pieces.
+    span: (f64, f64),
+    /// Radius bound of the part's clipped pieces (with slack).
+    r: f64,
+    /// Largest offset of a part point from its axis point along d: `r·sqrt(1 − a_d²)`.
+    ext_d: f64,
+}
+
+/// Heights `h` of `lo..=hi` where the axis coordinate `t + h·a` lies within `r` of `c`
+/// (empty: `lo > hi`).
+#[inline]
+fn axis_window(c: f64, t: f64, a: f64, r: f64, (lo, hi): (f64, f64)) -> (f64, f64) {
+    if a.abs() > 1e-12 {
+        let (x, y) = ((c - t - r) / a, (c - t + r) / a);
+        (lo.max(x.min(y)), hi.min(x.max(y)))
+    } else if (c - t).abs() <= r {
+        (lo, hi)
+    } else {
+        (1.0, 0.0)
+    }
 }
 
 impl Footprint {
@@ -312,6 +347,7 @@ impl Footprint {
         grid: &GridGeometry,
         bx: &Option<([f64; 3], [f64; 3])>,
         radius: f64,
+        span: (f64, f64),
         pl: &Placement,
     ) -> Option<Self> {
         let (blo, bhi) = bx.as_ref()?;
@@ -329,11 +365,15 @@ impl Footprint {
             nv: au / n,
             r: radius + CULL_SLACK_MM,
         });
+        let r = radius + CULL_SLACK_MM;
         Some(Self {
             range: Range2 { i0, i1, j0, j1 },
-            d_lo: blo[d] - CULL_SLACK_MM,
-            d_hi: bhi[d] + CULL_SLACK_MM,
             band,
+            tip: [pl.tip[ua], pl.tip[va], pl.tip[d]],
+            axis: [au, av, pl.axis[d]],
+            span,
+            r,
+            ext_d: r * (1.0 - pl.axis[d] * pl.axis[d]).max(0.0).sqrt() + CULL_SLACK_MM,
         })
     }
 
@@ -357,10 +397,28 @@ impl Footprint {
         (a <= e).then_some((a, e))
     }
 
-    /// Whether material spanning `[m0, m1]` along the ray can meet the part.
+    /// Heights of the part's axis within `r` of row coordinate `v` (see [`axis_window`]).
     #[inline]
-    fn overlaps(&self, m0: f64, m1: f64) -> bool {
-        m1 >= self.d_lo && m0 <= self.d_hi
+    fn row_window(&self, v: f64) -> (f64, f64) {
+        axis_window(v, self.tip[1], self.axis[1], self.r, self.span)
+    }
+
+    /// Whether any material interval of `segs` (the ray at column coordinate `u`) meets the
+    /// part's extent along the ray: the part's points on that ray have axis heights in the
+    /// row window narrowed by `u`, and lie within `ext_d` of their axis point along d.
+    #[inline]
+    fn meets(&self, segs: &[[f32; 2]], u: f64, row: (f64, f64)) -> bool {
+        let (lo, hi) = axis_window(u, self.tip[0], self.axis[0], self.r, row);
+        if lo > hi {
+            return false;
+        }
+        let (a, b) = (
+            self.tip[2] + self.axis[2] * lo,
+            self.tip[2] + self.axis[2] * hi,
+        );
+        let (d_lo, d_hi) = (a.min(b) - self.ext_d, a.max(b) + self.ext_d);
+        segs.iter()
+            .any(|s| f64::from(s[1]) >= d_lo && f64::from(s[0]) <= d_hi)
     }
 }
 
@@ -428,9 +486,13 @@ fn ray_work(
 ///   farther than `R` from the axis line in projection is farther than `R` in space and
 ///   meets no clipped piece, and the unclipped rest of the tool lies outside the stock box,
 ///   where no ray holds material;
-/// * a ray whose material `[first start, last end]` lies outside the part's box extent
-///   along the ray is skipped before any geometry: the part's interval on that ray (inside
-///   the stock box) lies in the box, so subtraction and overlap would be no-ops.
+/// * a ray none of whose material intervals meets the part's extent along the ray is
+///   skipped before any geometry. A point of the part on the ray at `(u, v)` is
+///   `tip + h·a + w` with `w ⊥ a`, `|w| ≤ R`, so its axis height `h` lies in the window where
+///   `|tip_u + h·a_u − u| ≤ R` and `|tip_v + h·a_v − v| ≤ R` (within the clipped pieces'
+///   span) and its coordinate along the ray within `R·sqrt(1 − a_d²)` of `tip_d + h·a_d`;
+///   material outside that extent is untouched by subtraction and overlap. The unclipped
+///   rest of the tool lies outside the stock box, where no ray holds material.
 ///
 /// Every bound is widened by [`CULL_SLACK_MM`]. Cost per placement: O(rays of the band
 /// inside the box) bound checks plus one ray–solid intersection per ray whose material
@@ -455,8 +517,8 @@ pub fn apply_batch(
             .zip(&preps)
             .map(|(pl, p)| {
                 (
-                    Footprint::new(&geo, &p.cut_box, p.cut_radius, pl),
-                    Footprint::new(&geo, &p.coll_box, p.coll_radius, pl),
+                    Footprint::new(&geo, &p.cut_box, p.cut_radius, p.cut_span, pl),
+                    Footprint::new(&geo, &p.coll_box, p.coll_radius, p.coll_span, pl),
                 )
             })
             .collect();
@@ -504,6 +566,10 @@ pub fn apply_batch(
                     let (cut, coll) = &feet[k];
                     let cut_cols = cut.as_ref().and_then(|f| f.columns(&geo, j, v));
                     let coll_cols = coll.as_ref().and_then(|f| f.columns(&geo, j, v));
+                    let cut_row = cut.map_or((1.0, 0.0), |f| f.row_window(v));
+                    let coll_row = coll.map_or((1.0, 0.0), |f| f.row_window(v));
+                    let cut_cols = cut_cols.filter(|_| cut_row.0 <= cut_row.1);
+                    let coll_cols = coll_cols.filter(|_| coll_row.0 <= coll_row.1);
                     let (ia, ib) = match (cut_cols, coll_cols) {
                         (None, None) => continue,
                         (Some(a), None) | (None, Some(a)) => a,
@@ -514,19 +580,18 @@ pub fn apply_batch(
                     let dv = v - pl.tip[va];
                     let mut best: [Option<StockHit>; 3] = [None; 3];
                     for (i, ray) in row.iter_mut().enumerate().take(ib + 1).skip(ia) {
-                        let s = ray.as_slice();
-                        let (Some(first), Some(last)) = (s.first(), s.last()) else {
-                            continue;
-                        };
-                        let (m0, m1) = (f64::from(first[0]), f64::from(last[1]));
-                        let in_coll = coll_cols.is_some_and(|c| i >= c.0 && i <= c.1)
-                            && coll.is_some_and(|f| f.overlaps(m0, m1));
-                        let in_cut = cut_cols.is_some_and(|c| i >= c.0 && i <= c.1)
-                            && cut.is_some_and(|f| f.overlaps(m0, m1));
-                        if !(in_coll || in_cut) {
+                        let segs = ray.as_slice();
+                        if segs.is_empty() {
                             continue;
                         }
                         let u = u0 + i as f64 * cell;
+                        let in_coll = coll_cols.is_some_and(|c| i >= c.0 && i <= c.1)
+                            && coll.is_some_and(|f| f.meets(segs, u, coll_row));
+                        let in_cut = cut_cols.is_some_and(|c| i >= c.0 && i <= c.1)
+                            && cut.is_some_and(|f| f.meets(segs, u, cut_row));
+                        if !(in_coll || in_cut) {
+                            continue;
+                        }
                         let rl = RayLocal::new(d, u - pl.tip[ua], dv, &pl.axis);
                         removed += ray_work(
                             ray,
