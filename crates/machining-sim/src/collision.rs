@@ -19,7 +19,7 @@ use crate::removal::{PartKind, ToolBody};
 use crate::tool_solid::{Piece, RevolvedSolid};
 use cam_core::Point3;
 use parry3d_f64::math::{Pose, Rotation, Vector};
-use parry3d_f64::query;
+use parry3d_f64::query::{self, ClosestPoints};
 use parry3d_f64::shape::{Capsule, ConvexPolyhedron, TriMesh};
 
 /// Number of sides of the polygons approximating the part circles.
@@ -28,6 +28,11 @@ pub const RING_SEGMENTS: usize = 24;
 /// Slack (mm) subtracted from every clearance cached by [`DesignCollider::check_cached`]:
 /// covers the convergence tolerance of parry's distance query (GJK) and rounding.
 pub const CLEARANCE_SLACK_MM: f64 = 1e-3;
+
+/// Largest mesh clearance measured by [`DesignCollider::check_cached`] (mm): the capsule–mesh
+/// query stops at this distance, which keeps it cheap (BVH pruning) while letting a clear
+/// piece skip the positions of a few millimetres of motion.
+pub const CLEARANCE_PROBE_MM: f64 = 4.0;
 
 /// One piece of a tool part: its polyhedron in the tool frame, the height of its axis middle,
 /// its part, and its bounding capsule (axis heights `h0..h1`, radius: the polyhedron's
@@ -195,7 +200,8 @@ impl DesignCollider {
     ///
     /// Whenever a piece is tested in full and found clear (no mesh intersection, axis middle
     /// outside the design), the cache keeps its axis end points and a clearance `c`: the
-    /// smaller of the distance from the piece's bounding capsule to the mesh and the design's
+    /// smaller of the distance from the piece's bounding capsule to the mesh (capped at
+    /// [`CLEARANCE_PROBE_MM`]) and the design's
     /// signed distance at the axis middle, less [`CLEARANCE_SLACK_MM`]. A later position whose
     /// axis end points moved less than `c` (every point of the capsule moves at most the
     /// larger end-point displacement, the axis middle at most that much) keeps the capsule —
@@ -242,9 +248,22 @@ impl DesignCollider {
                     Vector::new(e1[0], e1[1], e1[2]),
                     piece.capsule_radius,
                 );
-                let mesh_clear =
-                    query::distance(&Pose::IDENTITY, &capsule, &Pose::IDENTITY, &self.mesh)
-                        .map_or(0.0, |d| d.distance);
+                // Capped query: the BVH prunes everything farther than the cap.
+                let mesh_clear = match query::closest_points(
+                    &Pose::IDENTITY,
+                    &capsule,
+                    &Pose::IDENTITY,
+                    &self.mesh,
+                    CLEARANCE_PROBE_MM,
+                ) {
+                    Ok(ClosestPoints::Disjoint) => CLEARANCE_PROBE_MM,
+                    Ok(ClosestPoints::WithinMargin(a, b)) => (a - b).length(),
+                    _ => 0.0,
+                };
+                if mesh_clear <= CLEARANCE_SLACK_MM {
+                    // Touching the mesh: no clearance to keep (and no hit, `hits` is empty).
+                    continue;
+                }
                 let m = at(piece.mid);
                 let sd = design.signed_distance(&Point3::new(m[0], m[1], m[2]));
                 let clearance = mesh_clear.min(sd) - CLEARANCE_SLACK_MM;
