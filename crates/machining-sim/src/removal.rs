@@ -403,6 +403,27 @@ impl Footprint {
         axis_window(v, self.tip[1], self.axis[1], self.r, self.span)
     }
 
+    /// `cols` narrowed to the columns `u` whose window (see [`Self::meets`]) can be non-empty:
+    /// `u` within `r` of the axis coordinate `tip_u + h·a_u` for some `h` of the row window.
+    #[inline]
+    fn narrow(
+        &self,
+        grid: &GridGeometry,
+        (i0, i1): (usize, usize),
+        (lo, hi): (f64, f64),
+    ) -> Option<(usize, usize)> {
+        if lo > hi {
+            return None;
+        }
+        let (a, b) = (
+            self.tip[0] + self.axis[0] * lo,
+            self.tip[0] + self.axis[0] * hi,
+        );
+        let (a, e) = grid.index_range(a.min(b) - self.r, a.max(b) + self.r, false)?;
+        let (a, e) = (a.max(i0), e.min(i1));
+        (a <= e).then_some((a, e))
+    }
+
     /// Whether any material interval of `segs` (the ray at column coordinate `u`) meets the
     /// part's extent along the ray: the part's points on that ray have axis heights in the
     /// row window narrowed by `u`, and lie within `ext_d` of their axis point along d.
@@ -568,8 +589,9 @@ pub fn apply_batch(
                     let coll_cols = coll.as_ref().and_then(|f| f.columns(&geo, j, v));
                     let cut_row = cut.map_or((1.0, 0.0), |f| f.row_window(v));
                     let coll_row = coll.map_or((1.0, 0.0), |f| f.row_window(v));
-                    let cut_cols = cut_cols.filter(|_| cut_row.0 <= cut_row.1);
-                    let coll_cols = coll_cols.filter(|_| coll_row.0 <= coll_row.1);
+                    let cut_cols = cut_cols.and_then(|c| cut.as_ref()?.narrow(&geo, c, cut_row));
+                    let coll_cols =
+                        coll_cols.and_then(|c| coll.as_ref()?.narrow(&geo, c, coll_row));
                     let (ia, ib) = match (cut_cols, coll_cols) {
                         (None, None) => continue,
                         (Some(a), None) | (None, Some(a)) => a,
