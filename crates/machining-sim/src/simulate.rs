@@ -3,9 +3,11 @@
 //!
 //! Each move is sampled at the positions of [`crate::motion::positions_for_move`] (sweep
 //! tolerance default `h/4` for cell `h`); positions are applied in batches with
-//! [`crate::removal::apply_batch`] (parallel over ray rows, exact sequential semantics), and
-//! each batch's shank/holder placements are checked against the design mesh in parallel
-//! ([`crate::collision`]). A rapid move never cuts; any contact of the tool with material
+//! [`crate::removal::apply_batch`] (parallel over ray rows, exact sequential semantics, rays
+//! culled where provably untouched), and each batch's shank/holder placements are checked
+//! against the design mesh in parallel over contiguous chunks, skipping the pieces whose
+//! cached clearance proves them clear ([`crate::collision::DesignCollider::check_cached`],
+//! same result as the full check). A rapid move never cuts; any contact of the tool with material
 //! during a rapid is a collision. The first move of a tool path is a single position.
 
 use crate::collision::{ClearanceCache, DesignCollider, PartShapes};
