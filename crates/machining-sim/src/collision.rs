@@ -19,16 +19,38 @@ use crate::removal::{PartKind, ToolBody};
 use crate::tool_solid::{Piece, RevolvedSolid};
 use cam_core::Point3;
 use parry3d_f64::math::{Pose, Rotation, Vector};
-use parry3d_f64::query;
-use parry3d_f64::shape::{ConvexPolyhedron, TriMesh};
+use parry3d_f64::query::{self, ClosestPoints};
+use parry3d_f64::shape::{Capsule, ConvexPolyhedron, TriMesh};
 
 /// Number of sides of the polygons approximating the part circles.
 pub const RING_SEGMENTS: usize = 24;
 
+/// Slack (mm) subtracted from every clearance cached by [`DesignCollider::check_cached`]:
+/// covers the convergence tolerance of parry's distance query (GJK) and rounding.
+pub const CLEARANCE_SLACK_MM: f64 = 1e-3;
+
+/// Largest mesh clearance measured by [`DesignCollider::check_cached`] (mm): the capsule–mesh
+/// query stops at this distance, which keeps it cheap (BVH pruning) while letting a clear
+/// piece skip the positions of a few millimetres of motion.
+pub const CLEARANCE_PROBE_MM: f64 = 4.0;
+
+/// One piece of a tool part: its polyhedron in the tool frame, the height of its axis middle,
+/// its part, and its bounding capsule (axis heights `h0..h1`, radius: the polyhedron's
+/// largest ring radius).
+#[derive(Debug, Clone)]
+struct PartPiece {
+    shape: ConvexPolyhedron,
+    mid: f64,
+    kind: PartKind,
+    h0: f64,
+    h1: f64,
+    capsule_radius: f64,
+}
+
 /// A tool part as convex polyhedra in the tool frame (tip at origin, axis +Z).
 #[derive(Debug, Clone)]
 pub struct PartShapes {
-    pieces: Vec<(ConvexPolyhedron, f64, PartKind)>,
+    pieces: Vec<PartPiece>,
 }
 
 fn piece_polyhedron(p: &Piece) -> Option<(ConvexPolyhedron, f64)> {
@@ -59,10 +81,19 @@ impl PartShapes {
     /// Shapes of the shank and holder (`rapid = false`) or of the whole tool (`rapid = true`).
     pub fn new(body: &ToolBody, rapid: bool) -> Self {
         let mut pieces = Vec::new();
+        let scale = 1.0 / (std::f64::consts::PI / RING_SEGMENTS as f64).cos();
         let mut add = |s: &RevolvedSolid, kind: PartKind| {
             for p in s.pieces() {
-                if let Some((c, hm)) = piece_polyhedron(p) {
-                    pieces.push((c, hm, kind));
+                if let Some((shape, mid)) = piece_polyhedron(p) {
+                    let (h0, h1) = p.heights();
+                    pieces.push(PartPiece {
+                        shape,
+                        mid,
+                        kind,
+                        h0,
+                        h1,
+                        capsule_radius: p.max_radius() * scale,
+                    });
                 }
             }
         };
@@ -122,7 +153,13 @@ impl DesignCollider {
         let pose = Pose::from_parts(Vector::new(tip[0], tip[1], tip[2]), rot);
         let mesh_pose = Pose::IDENTITY;
         let mut out: Vec<DesignHit> = Vec::new();
-        for (shape, hm, kind) in &parts.pieces {
+        for PartPiece {
+            shape,
+            mid: hm,
+            kind,
+            ..
+        } in &parts.pieces
+        {
             let hits = matches!(
                 query::intersection_test(&pose, shape, &mesh_pose, &self.mesh),
                 Ok(r) if r.intersecting
@@ -155,5 +192,168 @@ impl DesignCollider {
             }
         }
         out
+    }
+
+    /// [`check`](Self::check) for a sequence of positions of the same parts, skipping the
+    /// pieces proven clear. `cache` holds one entry per piece of `parts` (start with
+    /// [`ClearanceCache::new`]; use one cache per part set and sequence of positions).
+    ///
+    /// Whenever a piece is tested in full and found clear (no mesh intersection, axis middle
+    /// outside the design), the cache keeps its axis end points and a clearance `c`: the
+    /// smaller of the distance from the piece's bounding capsule to the mesh (capped at
+    /// [`CLEARANCE_PROBE_MM`]) and the design's
+    /// signed distance at the axis middle, less [`CLEARANCE_SLACK_MM`]. A later position whose
+    /// axis end points moved less than `c` (every point of the capsule moves at most the
+    /// larger end-point displacement, the axis middle at most that much) keeps the capsule —
+    /// hence the polyhedron — off the mesh, and the middle outside the design (the
+    /// [`DesignModel`] contract: the signed distance never exceeds the true distance, with
+    /// the right sign), so the full test would report nothing: the result is exactly that of
+    /// [`check`](Self::check). Cost: one capsule–mesh distance and one signed distance per
+    /// refreshed piece, O(1) per skipped piece.
+    pub fn check_cached(
+        &self,
+        design: &dyn DesignModel,
+        parts: &PartShapes,
+        tip: &[f64; 3],
+        axis: &[f64; 3],
+        cache: &mut ClearanceCache,
+    ) -> Vec<DesignHit> {
+        cache.entries.resize(parts.pieces.len(), None);
+        let at = |h: f64| {
+            [
+                tip[0] + h * axis[0],
+                tip[1] + h * axis[1],
+                tip[2] + h * axis[2],
+            ]
+        };
+        let dist = |a: &[f64; 3], b: &[f64; 3]| {
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        };
+        let mut out: Vec<DesignHit> = Vec::new();
+        let mut single = PartShapes { pieces: Vec::new() };
+        for (piece, entry) in parts.pieces.iter().zip(cache.entries.iter_mut()) {
+            let (e0, e1) = (at(piece.h0), at(piece.h1));
+            if let Some(c) = entry {
+                if dist(&e0, &c.ends[0]).max(dist(&e1, &c.ends[1])) < c.clearance {
+                    continue;
+                }
+            }
+            single.pieces.clear();
+            single.pieces.push(piece.clone());
+            let hits = self.check(design, &single, tip, axis);
+            *entry = None;
+            if hits.is_empty() {
+                let capsule = Capsule::new(
+                    Vector::new(e0[0], e0[1], e0[2]),
+                    Vector::new(e1[0], e1[1], e1[2]),
+                    piece.capsule_radius,
+                );
+                // Capped query: the BVH prunes everything farther than the cap.
+                let mesh_clear = match query::closest_points(
+                    &Pose::IDENTITY,
+                    &capsule,
+                    &Pose::IDENTITY,
+                    &self.mesh,
+                    CLEARANCE_PROBE_MM,
+                ) {
+                    Ok(ClosestPoints::Disjoint) => CLEARANCE_PROBE_MM,
+                    Ok(ClosestPoints::WithinMargin(a, b)) => (a - b).length(),
+                    _ => 0.0,
+                };
+                if mesh_clear <= CLEARANCE_SLACK_MM {
+                    // Touching the mesh: no clearance to keep (and no hit, `hits` is empty).
+                    continue;
+                }
+                let m = at(piece.mid);
+                let sd = design.signed_distance(&Point3::new(m[0], m[1], m[2]));
+                let clearance = mesh_clear.min(sd) - CLEARANCE_SLACK_MM;
+                if clearance > 0.0 {
+                    *entry = Some(Clearance {
+                        ends: [e0, e1],
+                        clearance,
+                    });
+                }
+            }
+            for h in hits {
+                match out.iter_mut().find(|o| o.part == h.part) {
+                    Some(o) if o.depth < h.depth => {
+                        o.depth = h.depth;
+                        o.point = h.point;
+                    }
+                    Some(_) => {}
+                    None => out.push(h),
+                }
+            }
+        }
+        out
+    }
+}
+
+/// A clear piece position remembered by [`DesignCollider::check_cached`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Clearance {
+    ends: [[f64; 3]; 2],
+    clearance: f64,
+}
+
+/// Per-piece clearances of one part set along a sequence of positions (see
+/// [`DesignCollider::check_cached`]).
+#[derive(Debug, Clone, Default)]
+pub struct ClearanceCache {
+    entries: Vec<Option<Clearance>>,
+}
+
+impl ClearanceCache {
+    /// An empty cache (every piece is tested in full at first).
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::design::BoxDesign;
+    use crate::synthetic::workload_cutter;
+
+    /// The cached check reports exactly what the full check reports, position by position,
+    /// along a sweep that approaches, enters (shank and holder) and leaves a block design.
+    #[test]
+    fn cached_check_equals_full_check() {
+        let design = BoxDesign {
+            min: [-10.0, -10.0, 0.0],
+            max: [10.0, 10.0, 20.0],
+            sample_spacing: 2.0,
+        };
+        let collider = DesignCollider::new(&design.triangle_mesh()).unwrap();
+        let body = ToolBody::new(&workload_cutter());
+        for rapid in [false, true] {
+            let parts = PartShapes::new(&body, rapid);
+            let mut cache = ClearanceCache::new();
+            let (mut hits, mut skipped_somewhere) = (0usize, false);
+            for k in 0..600 {
+                let t = k as f64 / 600.0;
+                let tip = [
+                    -40.0 + 80.0 * t,
+                    3.0 * (9.0 * t).sin(),
+                    30.0 - 40.0 * (3.0 * t).sin(),
+                ];
+                let (s, c) = (0.4 * (5.0 * t).sin(), 0.4 * (5.0 * t).cos());
+                let n = (s * s + c * c + 1.0f64).sqrt();
+                let axis = [s / n, c / n, 1.0 / n];
+                let full = collider.check(&design, &parts, &tip, &axis);
+                let before = cache.entries.clone();
+                let cached = collider.check_cached(&design, &parts, &tip, &axis, &mut cache);
+                assert_eq!(full, cached, "position {k}");
+                hits += full.len();
+                skipped_somewhere |= before
+                    .iter()
+                    .zip(&cache.entries)
+                    .any(|(a, b)| a.is_some() && a == b);
+            }
+            assert!(hits > 0, "the sweep must collide");
+            assert!(skipped_somewhere, "the cache must skip some pieces");
+        }
     }
 }

@@ -207,21 +207,27 @@ impl DexelGrid {
     pub(crate) fn rows_mut(&mut self) -> rayon::slice::ChunksMut<'_, Segments> {
         self.rays.par_chunks_mut(self.nu.max(1))
     }
+    /// Rows of rays (each `nu` long), mutable, in order.
+    pub(crate) fn rows_seq_mut(&mut self) -> std::slice::ChunksMut<'_, Segments> {
+        self.rays.chunks_mut(self.nu.max(1))
+    }
+    /// The grid's lattice without its rays.
+    #[inline]
+    pub fn geometry(&self) -> GridGeometry {
+        GridGeometry {
+            dir: self.dir,
+            nu: self.nu,
+            nv: self.nv,
+            u0: self.u0,
+            v0: self.v0,
+            cell: self.cell,
+        }
+    }
     /// Inclusive index range of rays whose coordinate lies within `[lo, hi]` along u (or v
     /// with `v = true`); `None` when empty.
     #[inline]
     pub fn index_range(&self, lo: f64, hi: f64, v: bool) -> Option<(usize, usize)> {
-        let (o, n) = if v {
-            (self.v0, self.nv)
-        } else {
-            (self.u0, self.nu)
-        };
-        let a = ((lo - o) / self.cell - 0.5).ceil().max(0.0);
-        let b = ((hi - o) / self.cell - 0.5).floor();
-        if n == 0 || !(a.is_finite() && b.is_finite()) || b < a || a >= n as f64 || b < 0.0 {
-            return None;
-        }
-        Some((a as usize, (b as usize).min(n - 1)))
+        self.geometry().index_range(lo, hi, v)
     }
     /// Index of the ray nearest to `(u, v)`, clamped to the grid.
     #[inline]
@@ -240,6 +246,47 @@ impl DexelGrid {
     /// Total material length over all rays times the cell area: this grid's volume estimate.
     pub fn volume(&self) -> f64 {
         self.rays.par_iter().map(Segments::length).sum::<f64>() * self.cell * self.cell
+    }
+}
+
+/// The lattice of a [`DexelGrid`] without its rays: a copy used for index computations while
+/// the rays are borrowed mutably.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridGeometry {
+    dir: usize,
+    nu: usize,
+    nv: usize,
+    u0: f64,
+    v0: f64,
+    cell: f64,
+}
+
+impl GridGeometry {
+    /// Ray direction (0 = X, 1 = Y, 2 = Z).
+    #[inline]
+    pub fn dir(&self) -> usize {
+        self.dir
+    }
+    /// Number of rays along u and v.
+    #[inline]
+    pub fn size(&self) -> (usize, usize) {
+        (self.nu, self.nv)
+    }
+    /// Inclusive index range of rays whose coordinate lies within `[lo, hi]` along u (or v
+    /// with `v = true`); `None` when empty. O(1).
+    #[inline]
+    pub fn index_range(&self, lo: f64, hi: f64, v: bool) -> Option<(usize, usize)> {
+        let (o, n) = if v {
+            (self.v0, self.nv)
+        } else {
+            (self.u0, self.nu)
+        };
+        let a = ((lo - o) / self.cell - 0.5).ceil().max(0.0);
+        let b = ((hi - o) / self.cell - 0.5).floor();
+        if n == 0 || !(a.is_finite() && b.is_finite()) || b < a || a >= n as f64 || b < 0.0 {
+            return None;
+        }
+        Some((a as usize, (b as usize).min(n - 1)))
     }
 }
 

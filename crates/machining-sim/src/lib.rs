@@ -67,7 +67,7 @@ pub mod tool_solid;
 
 pub use crosscheck::{crosscheck_overcut, CrossCheckPoint, Envelopes};
 pub use design::{BoxDesign, CylinderDesign, DesignModel, SurfaceGrid, TriangleMesh, UnionDesign};
-pub use dexel::{DexelGrid, Segments, TriDexel};
+pub use dexel::{DexelGrid, GridGeometry, Segments, TriDexel};
 pub use endpoints::{overcut_error_bound, EndpointDepth};
 pub use error::SimError;
 pub use impeller_design::{blank_of, ImpellerDesign, ImpellerSampling};

@@ -3,12 +3,14 @@
 //!
 //! Each move is sampled at the positions of [`crate::motion::positions_for_move`] (sweep
 //! tolerance default `h/4` for cell `h`); positions are applied in batches with
-//! [`crate::removal::apply_batch`] (parallel over ray rows, exact sequential semantics), and
-//! each batch's shank/holder placements are checked against the design mesh in parallel
-//! ([`crate::collision`]). A rapid move never cuts; any contact of the tool with material
+//! [`crate::removal::apply_batch`] (parallel over ray rows, exact sequential semantics, rays
+//! culled where provably untouched), and each batch's shank/holder placements are checked
+//! against the design mesh in parallel over contiguous chunks, skipping the pieces whose
+//! cached clearance proves them clear ([`crate::collision::DesignCollider::check_cached`],
+//! same result as the full check). A rapid move never cuts; any contact of the tool with material
 //! during a rapid is a collision. The first move of a tool path is a single position.
 
-use crate::collision::{DesignCollider, PartShapes};
+use crate::collision::{ClearanceCache, DesignCollider, PartShapes};
 use crate::design::DesignModel;
 use crate::dexel::TriDexel;
 use crate::endpoints::overcut_error_bound;
@@ -21,6 +23,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::time::Instant;
+
+/// Positions per sequential chunk of the design collision checks (chunks run in parallel;
+/// inside a chunk the clearance caches carry over from position to position).
+const DESIGN_CHUNK: usize = 256;
 
 /// Options of [`simulate`] / [`cut`].
 #[derive(Debug, Clone)]
@@ -275,19 +281,28 @@ pub fn cut(
         }
         if let (Some(collider), Some(design)) = (&collider, design) {
             let t = Instant::now();
+            // Contiguous chunks in parallel, positions in order inside a chunk so that the
+            // clearance caches can skip pieces proven clear (exact, see `check_cached`).
             let hits: Vec<(usize, crate::collision::DesignHit)> = batch
-                .par_iter()
+                .par_chunks(DESIGN_CHUNK)
                 .enumerate()
-                .flat_map_iter(|(k, pl)| {
-                    let parts = if pl.rapid {
-                        &shapes[pl.tool].1
-                    } else {
-                        &shapes[pl.tool].0
-                    };
-                    collider
-                        .check(design, parts, &pl.tip, &pl.axis)
-                        .into_iter()
-                        .map(move |h| (k, h))
+                .flat_map_iter(|(c, chunk)| {
+                    let mut caches = vec![ClearanceCache::new(); 2 * shapes.len()];
+                    let mut found = Vec::new();
+                    for (k, pl) in chunk.iter().enumerate() {
+                        let (parts, slot) = if pl.rapid {
+                            (&shapes[pl.tool].1, 2 * pl.tool + 1)
+                        } else {
+                            (&shapes[pl.tool].0, 2 * pl.tool)
+                        };
+                        let Some(cache) = caches.get_mut(slot) else {
+                            continue;
+                        };
+                        for h in collider.check_cached(design, parts, &pl.tip, &pl.axis, cache) {
+                            found.push((c * DESIGN_CHUNK + k, h));
+                        }
+                    }
+                    found
                 })
                 .collect();
             for (k, h) in hits {
