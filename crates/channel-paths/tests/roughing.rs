@@ -50,12 +50,39 @@ fn spec(params: &str) -> OperationSpec {
     }
 }
 
+/// Plans channel roughing with `params` in a context around the impeller's own stock (safety
+/// surface 10 mm over it).
+fn plan_rough(
+    imp: &impeller_model::Impeller,
+    tool: &Tool,
+    tol: &Tolerances,
+    process: &Process,
+    clearance: &DesignClearance<'_>,
+    params: &str,
+) -> cam_plan::PlannedOperation {
+    let stock = imp.stock();
+    let linker = Linker::new(SafetySurface::around_stock(stock, 10.0).unwrap());
+    let ctx = PlanContext {
+        impeller: imp,
+        stock,
+        tool,
+        tolerances: tol,
+        process,
+        clearance,
+        linker: &linker,
+        links: &cam_plan::LinkStats::default(),
+    };
+    build_channel_roughing(&spec(params))
+        .unwrap()
+        .plan(&ctx)
+        .unwrap()
+}
+
 /// A ball end, one level on the hub offset (about 2 s in the dev profile): the scallop
 /// measured over the machinable region within the target, clear of the blades.
 #[test]
 fn rough_default_impeller_within_scallop_and_clear_of_blades() {
     let imp = impeller_model::fixtures::default_impeller().unwrap();
-    let stock = imp.stock().clone();
     let tool = tool(CutterShape::BallEnd { radius: 1.0 });
     let tol = Tolerances::default();
     let proc_ = process();
@@ -68,19 +95,7 @@ fn rough_default_impeller_within_scallop_and_clear_of_blades() {
         },
     )
     .unwrap();
-    let linker = Linker::new(SafetySurface::around_stock(&stock, 10.0).unwrap());
-    let ctx = PlanContext {
-        impeller: &imp,
-        stock: &stock,
-        tool: &tool,
-        tolerances: &tol,
-        process: &proc_,
-        clearance: &clearance,
-        linker: &linker,
-        links: &cam_plan::LinkStats::default(),
-    };
-    let op = build_channel_roughing(&spec("scallop_mm = 0.3")).unwrap();
-    let plan = op.plan(&ctx).unwrap();
+    let plan = plan_rough(&imp, &tool, &tol, &proc_, &clearance, "scallop_mm = 0.3");
     let m = &plan.metrics;
     let get = |k: &str| m.get(k).and_then(|v| v.as_f64()).unwrap();
     eprintln!("{m:?}");
@@ -120,7 +135,6 @@ fn rough_default_impeller_within_scallop_and_clear_of_blades() {
 #[test]
 fn rough_tapered_ball_trimmed_to_where_the_cutter_fits() {
     let imp = impeller_model::fixtures::default_impeller().unwrap();
-    let stock = imp.stock().clone();
     let tool = tool(CutterShape::TaperedBallEnd {
         ball_radius: 1.5,
         half_angle: 2f64.to_radians(),
@@ -148,19 +162,7 @@ fn rough_tapered_ball_trimmed_to_where_the_cutter_fits() {
         },
     )
     .unwrap();
-    let linker = Linker::new(SafetySurface::around_stock(&stock, 10.0).unwrap());
-    let ctx = PlanContext {
-        impeller: &imp,
-        stock: &stock,
-        tool: &tool,
-        tolerances: &tol,
-        process: &proc_,
-        clearance: &clearance,
-        linker: &linker,
-        links: &cam_plan::LinkStats::default(),
-    };
-    let op = build_channel_roughing(&spec("scallop_mm = 0.5")).unwrap();
-    let plan = op.plan(&ctx).unwrap();
+    let plan = plan_rough(&imp, &tool, &tol, &proc_, &clearance, "scallop_mm = 0.5");
     let m = &plan.metrics;
     let get = |k: &str| m.get(k).and_then(|v| v.as_f64()).unwrap();
     eprintln!("{m:?}");

@@ -10,7 +10,7 @@
 
 use crate::blade::{Blade, Side};
 use crate::impeller::Impeller;
-use nalgebra::Vector3;
+use nalgebra::{Rotation3, Vector3};
 use nurbs::NurbsSurface;
 
 /// A point found on a surface.
@@ -189,21 +189,31 @@ impl Impeller {
                 let (t, phi, d) = s.closest(p);
                 Some((s.point(t, phi), d))
             }
-            Part::Main(k, side) | Part::Splitter(k, side) => {
-                let set = if matches!(part, Part::Main(..)) {
-                    self.main()
-                } else {
-                    self.splitter()?
-                };
-                if k >= set.count() {
-                    return None;
-                }
-                let rot = set.rotation(k);
-                let local = rot.inverse() * p;
-                let (sp, d) = blade_side_distance(set.blade(), side, &local, None);
+            Part::Main(..) | Part::Splitter(..) => {
+                let (q, rot) = self.blade_side_query(part)?;
+                let (sp, d) = blade_side_distance(q.blade, q.side, &(rot.inverse() * p), None);
                 Some((rot * sp.point, d))
             }
         }
+    }
+
+    /// The reference blade's side that a blade part copies, with the copy's rotation about
+    /// the impeller axis; `None` for hub and shroud and for a blade the impeller does not have.
+    fn blade_side_query(&self, part: Part) -> Option<(BladeSideQuery<'_>, Rotation3<f64>)> {
+        let (set, k, side) = match part {
+            Part::Main(k, side) => (self.main(), k, side),
+            Part::Splitter(k, side) => (self.splitter()?, k, side),
+            Part::Hub | Part::Shroud => return None,
+        };
+        (k < set.count()).then(|| {
+            (
+                BladeSideQuery {
+                    blade: set.blade(),
+                    side,
+                },
+                set.rotation(k),
+            )
+        })
     }
 }
 
@@ -263,23 +273,14 @@ impl nurbs::closest::PointQuery for PartQuery<'_> {
                     certified: a.certified,
                 }
             }
-            Part::Main(k, side) | Part::Splitter(k, side) => {
-                let set = if matches!(self.part, Part::Main(..)) {
-                    Some(self.impeller.main())
-                } else {
-                    self.impeller.splitter()
-                };
-                let Some(set) = set.filter(|set| k < set.count()) else {
+            Part::Main(..) | Part::Splitter(..) => {
+                let Some((side, rot)) = self.impeller.blade_side_query(self.part) else {
                     return missing;
                 };
-                let rot = set.rotation(k);
-                let local = rot.inverse() * q;
-                let (sp, d) = blade_side_distance(set.blade(), side, &local, hint);
+                let a = nurbs::closest::PointQuery::query(&side, &(rot.inverse() * q), hint);
                 nurbs::closest::PointProjection {
-                    point: rot * sp.point,
-                    signed_distance: d,
-                    hint: (sp.u, sp.v),
-                    certified: d.is_finite(),
+                    point: rot * a.point,
+                    ..a
                 }
             }
         }
