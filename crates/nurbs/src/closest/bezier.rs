@@ -221,6 +221,8 @@ impl BezierPatch {
         let (bv0, bv1, bv2) = bernstein2_fixed::<QV>((v - self.v0) * dv);
         let mut a = [[0.0f64; 4]; 6];
         let pw = &self.pw[..PU * QV];
+        // All four homogeneous lanes are summed even for a polynomial patch (its weight lane
+        // is then unused): whole-lane sums vectorise, a masked lane does not.
         for i in 0..PU {
             let mut t0 = [0.0f64; 4];
             let mut t1 = [0.0f64; 4];
@@ -228,20 +230,20 @@ impl BezierPatch {
             for j in 0..QV {
                 let c = &pw[i * QV + j];
                 for k in 0..4 {
-                    if k < 3 || R {
-                        t0[k] += bv0[j] * c[k];
-                        t1[k] += bv1[j] * c[k];
+                    t0[k] += bv0[j] * c[k];
+                    t1[k] += bv1[j] * c[k];
+                    if QV > 2 {
                         t2[k] += bv2[j] * c[k];
                     }
                 }
             }
             for k in 0..4 {
-                if k < 3 || R {
-                    a[0][k] += bu0[i] * t0[k];
-                    a[1][k] += bu1[i] * t0[k];
-                    a[2][k] += bu0[i] * t1[k];
-                    a[3][k] += bu2[i] * t0[k];
-                    a[4][k] += bu1[i] * t1[k];
+                a[0][k] += bu0[i] * t0[k];
+                a[1][k] += bu1[i] * t0[k];
+                a[2][k] += bu0[i] * t1[k];
+                a[3][k] += bu2[i] * t0[k];
+                a[4][k] += bu1[i] * t1[k];
+                if QV > 2 {
                     a[5][k] += bu0[i] * t2[k];
                 }
             }

@@ -350,8 +350,8 @@ impl SurfaceProjector {
         for _ in 0..64 {
             let mut pick = None;
             let mut pick_d = f64::INFINITY;
-            for c in 0..node.n as usize {
-                let d = node.aabb[c].dist2(q).max(node.obb[c].dist2(q));
+            let (lb, _) = node.bounds(q);
+            for (c, &d) in lb.iter().enumerate().take(node.n as usize) {
                 if d < pick_d || pick.is_none() {
                     pick_d = d;
                     pick = Some(node.child[c]);
@@ -417,16 +417,13 @@ impl SurfaceProjector {
             // (lower bound, centre distance, child) of the children closer than the bound.
             let mut kids = [(0.0f64, 0.0f64, 0u32); 4];
             let mut nk = 0;
+            let (lbs, centres) = node.bounds(q);
             for c in 0..node.n as usize {
-                let a = node.aabb[c].dist2(q);
-                if a >= bound {
-                    continue;
-                }
-                let lb = a.max(node.obb[c].dist2(q));
+                let lb = lbs[c];
                 if lb >= bound {
                     continue;
                 }
-                let key2 = (node.obb[c].c - q).norm_squared();
+                let key2 = centres[c];
                 // Insertion sort, nearest first (ties: nearer box centre).
                 let mut at = nk;
                 while at > 0 && (kids[at - 1].0, kids[at - 1].1) > (lb, key2) {

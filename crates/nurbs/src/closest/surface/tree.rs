@@ -99,14 +99,90 @@ pub(crate) struct Node {
 /// Marks a leaf index in [`Node4::child`] and on the walk's stack.
 pub(super) const LEAF_BIT: u32 = 1 << 31;
 
-/// Node of the 4-wide hierarchy: boxes of up to four children stored together.
+/// Node of the 4-wide hierarchy: the boxes of up to four children stored lane by lane
+/// (structure of arrays), so that the walk bounds all four children with the same few
+/// vector instructions. Unused lanes hold empty boxes.
 #[derive(Debug, Clone)]
 pub(super) struct Node4 {
-    pub(super) aabb: [Aabb; 4],
-    pub(super) obb: [Obb; 4],
+    /// Axis-aligned boxes: `lo[k][c]`, `hi[k][c]` = coordinate `k` of child `c`.
+    lo: [[f64; 4]; 3],
+    hi: [[f64; 4]; 3],
+    /// Oriented boxes: centre `oc[k][c]`, axis `a` as `ax[a][k][c]`, half extent `h[a][c]`.
+    oc: [[f64; 4]; 3],
+    ax: [[[f64; 4]; 3]; 3],
+    h: [[f64; 4]; 3],
     /// Child node index, or leaf index with [`LEAF_BIT`] set.
     pub(super) child: [u32; 4],
     pub(super) n: u8,
+}
+
+impl Node4 {
+    fn empty(n: u8) -> Self {
+        Node4 {
+            lo: [[f64::INFINITY; 4]; 3],
+            hi: [[f64::NEG_INFINITY; 4]; 3],
+            oc: [[0.0; 4]; 3],
+            ax: [[[0.0; 4]; 3]; 3],
+            h: [[0.0; 4]; 3],
+            child: [0; 4],
+            n,
+        }
+    }
+
+    fn set(&mut self, c: usize, aabb: &Aabb, obb: &Obb, child: u32) {
+        for k in 0..3 {
+            self.lo[k][c] = aabb.min[k];
+            self.hi[k][c] = aabb.max[k];
+            self.oc[k][c] = obb.c[k];
+            self.h[k][c] = obb.h[k];
+            for a in 0..3 {
+                self.ax[a][k][c] = obb.axes[a][k];
+            }
+        }
+        self.child[c] = child;
+    }
+
+    /// Per child: a lower bound of the squared distance from `q` to everything inside it
+    /// (the larger of its axis-aligned and oriented box distances), and the squared
+    /// distance to its oriented box's centre (the walk's tie-break). Lanes `≥ n` are
+    /// meaningless.
+    #[inline(always)]
+    pub(super) fn bounds(&self, q: &Vector3<f64>) -> ([f64; 4], [f64; 4]) {
+        let mut a = [0.0f64; 4];
+        for k in 0..3 {
+            for c in 0..4 {
+                let lo = self.lo[k][c] - q[k];
+                let hi = q[k] - self.hi[k][c];
+                let d = if lo > hi { lo } else { hi };
+                let d = if d > 0.0 { d } else { 0.0 };
+                a[c] += d * d;
+            }
+        }
+        let mut dx = [[0.0f64; 4]; 3];
+        let mut centre = [0.0f64; 4];
+        for k in 0..3 {
+            for c in 0..4 {
+                dx[k][c] = q[k] - self.oc[k][c];
+                centre[c] += dx[k][c] * dx[k][c];
+            }
+        }
+        let mut o = [0.0f64; 4];
+        for axis in 0..3 {
+            for c in 0..4 {
+                let p = dx[0][c] * self.ax[axis][0][c]
+                    + dx[1][c] * self.ax[axis][1][c]
+                    + dx[2][c] * self.ax[axis][2][c];
+                let x = p.abs() - self.h[axis][c];
+                let x = if x > 0.0 { x } else { 0.0 };
+                o[c] += x * x;
+            }
+        }
+        let mut lb = [0.0f64; 4];
+        for c in 0..4 {
+            lb[c] = if a[c] > o[c] { a[c] } else { o[c] };
+        }
+        (lb, centre)
+    }
 }
 
 /// Collapses binary node `at` (and its subtree) into 4-wide nodes; returns the index of the
@@ -129,17 +205,7 @@ pub(super) fn collapse(nodes: &[Node], at: usize, wide: &mut Vec<Node4>) -> u32 
         }
     }
     let me = wide.len();
-    let empty_obb = Obb {
-        c: Vector3::zeros(),
-        axes: [Vector3::x(), Vector3::y(), Vector3::z()],
-        h: [0.0; 3],
-    };
-    wide.push(Node4 {
-        aabb: [Aabb::empty(); 4],
-        obb: [empty_obb; 4],
-        child: [0; 4],
-        n: frontier.len() as u8,
-    });
+    wide.push(Node4::empty(frontier.len() as u8));
     for (c, &f) in frontier.iter().enumerate() {
         let n = &nodes[f];
         let child = if n.right == u32::MAX {
@@ -147,10 +213,7 @@ pub(super) fn collapse(nodes: &[Node], at: usize, wide: &mut Vec<Node4>) -> u32 
         } else {
             collapse(nodes, f, wide)
         };
-        let w = &mut wide[me];
-        w.aabb[c] = n.aabb;
-        w.obb[c] = n.obb;
-        w.child[c] = child;
+        wide[me].set(c, &n.aabb, &n.obb, child);
     }
     me as u32
 }
