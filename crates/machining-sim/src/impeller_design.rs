@@ -203,32 +203,62 @@ impl ImpellerDesign {
     /// hub's inlet end (`z ≤ z_inlet`) and the cylinder of its outlet radius (`r ≤ r_outlet`),
     /// where the meridional distance alone would extend the body past the contour's ends.
     pub fn hub_signed_distance(&self, p: &Point3) -> f64 {
-        let d = self.hub_sd.signed_distance(p);
+        self.hub_foot(p).0
+    }
+
+    /// [`Self::hub_signed_distance`] with the point of the face that decides it: the hub
+    /// surface in `p`'s meridional half-plane, or the inlet plane or outlet cylinder that
+    /// caps the body.
+    fn hub_foot(&self, p: &Point3) -> (f64, Foot) {
+        let (d, zr) = self.hub_sd.foot(p);
         let r = (p.x * p.x + p.y * p.y).sqrt();
-        d.max(p.z - self.hub_z_max).max(r - self.hub_r_max)
+        let (dz, dr) = (p.z - self.hub_z_max, r - self.hub_r_max);
+        if d >= dz && d >= dr {
+            (d, Foot::Meridian(zr))
+        } else if dz >= dr {
+            (dz, Foot::At(Point3::new(p.x, p.y, self.hub_z_max)))
+        } else {
+            (
+                dr,
+                Foot::Meridian(nalgebra::Vector2::new(p.z, self.hub_r_max)),
+            )
+        }
     }
 
     /// Signed distance to the blade nearest to `p` (negative inside the blade, below the
     /// shroud).
     pub fn blade_signed_distance(&self, p: &Point3) -> f64 {
+        self.blade_foot(p).0
+    }
+
+    /// [`Self::blade_signed_distance`] with the point of the face that decides it (a blade
+    /// side, or the shroud contour over the blade tips; far from every blade, where the
+    /// distance is the lower bound `dm − far_mm`, the foot on the side mesh).
+    fn blade_foot(&self, p: &Point3) -> (f64, Foot) {
         let q = PVec::new(p.x, p.y, p.z);
         let (proj, (tri, _)) = self
             .sides_mesh
             .project_local_point_and_get_location(q, false);
         let Some(&(bi, side, u, v)) = self.tri_info.get(tri as usize) else {
-            return f64::INFINITY;
+            return (f64::INFINITY, Foot::At(*p));
         };
         let dm = (proj.point - q).length();
         if dm > self.far_mm + EXACT_BAND_MM {
             // Farther than half the thickest blade from every side: outside all blades, and
             // the distance to the blade solids is at least dm − chord − t_max/2.
-            let ds = self.shroud_sd.signed_distance(p);
-            return (dm - self.far_mm).max(ds).max(1e-9);
+            let (ds, zr) = self.shroud_sd.foot(p);
+            let bound = dm - self.far_mm;
+            let foot = if ds > bound {
+                Foot::Meridian(zr)
+            } else {
+                Foot::At(Point3::new(proj.point.x, proj.point.y, proj.point.z))
+            };
+            return (bound.max(ds).max(1e-9), foot);
         }
         let blade = &self.blades[bi as usize].1;
-        let (d1, u1) = side_distance(blade, side, p, (u, v));
-        let (d2, u2) = side_distance(blade, side.other(), p, (u, v));
-        let ds = self.shroud_sd.signed_distance(p);
+        let (d1, u1, f1) = side_foot(blade, side, p, (u, v));
+        let (d2, u2, f2) = side_foot(blade, side.other(), p, (u, v));
+        let (ds, zr) = self.shroud_sd.foot(p);
         let u_pressure = if side == Side::Pressure { u1 } else { u2 };
         let ((ua, ub), _) = blade.side(Side::Pressure).domain();
         let end = usize::from(u_pressure > 0.5 * (ua + ub));
@@ -236,7 +266,26 @@ impl ImpellerDesign {
             .edge_half_gaps
             .get(bi as usize)
             .map_or(self.far_mm, |g| g[end]);
-        impeller_model::query::blade_solid_distance(d1, d2, ds, half_gap)
+        let d = impeller_model::query::blade_solid_distance(d1, d2, ds, half_gap);
+        // The face whose term decides `blade_solid_distance`.
+        let foot = if d == ds {
+            Foot::Meridian(zr)
+        } else if (d1 > 0.0 && d2 > 0.0) == (d1 <= d2) {
+            Foot::At(f1)
+        } else {
+            Foot::At(f2)
+        };
+        (d, foot)
+    }
+
+    /// The verifier's design distance with the point that decides it: the minimum of
+    /// [`Self::hub_signed_distance`] and [`Self::blade_signed_distance`] (see the module
+    /// docs).
+    fn design_foot(&self, p: &Point3) -> (f64, Point3) {
+        let h = self.hub_foot(p);
+        let b = self.blade_foot(p);
+        let (d, foot) = if h.0 <= b.0 { h } else { b };
+        (d, foot.resolve(p))
     }
 
     fn blade_grid(&self, name: &str, blade: &Blade, side: Side) -> SurfaceGrid {
@@ -376,6 +425,11 @@ impl ContourDistance {
     }
 
     fn signed_distance(&self, p: &Point3) -> f64 {
+        self.foot(p).0
+    }
+
+    /// The signed distance and the foot point `(z, r)` on the contour.
+    fn foot(&self, p: &Point3) -> (f64, nalgebra::Vector2<f64>) {
         let zr = nalgebra::Vector2::new(p.z, (p.x * p.x + p.y * p.y).sqrt());
         let mut k = 0;
         let mut best = f64::INFINITY;
@@ -417,9 +471,31 @@ impl ContourDistance {
         let nrm = nalgebra::Vector2::new(d[1], -d[0]);
         let dist = (zr - c).norm();
         if (zr - c).dot(&nrm) >= 0.0 {
-            dist
+            (dist, c)
         } else {
-            -dist
+            (-dist, c)
+        }
+    }
+}
+
+/// A point of the design boundary that decides a distance, resolved only when asked for.
+#[derive(Debug, Clone, Copy)]
+enum Foot {
+    /// A point in space.
+    At(Point3),
+    /// The meridional position `(z, r)` in the query point's half-plane (the nearest point
+    /// of a surface of revolution when it is the contour foot of the query point).
+    Meridian(nalgebra::Vector2<f64>),
+}
+
+impl Foot {
+    fn resolve(self, p: &Point3) -> Point3 {
+        match self {
+            Foot::At(x) => x,
+            Foot::Meridian(zr) => {
+                let phi = p.y.atan2(p.x);
+                Point3::new(zr[1] * phi.cos(), zr[1] * phi.sin(), zr[0])
+            }
         }
     }
 }
@@ -428,12 +504,18 @@ impl ContourDistance {
 /// `closest_point`, NURBS Book §6.1; allocation-free), positive on the outward side.
 /// Signed distance of `p` to one side of `blade` and the u parameter of the closest point.
 fn side_distance(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> (f64, f64) {
+    let (d, u, _) = side_foot(blade, side, p, hint);
+    (d, u)
+}
+
+/// [`side_distance`] with the closest point found on the side.
+fn side_foot(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> (f64, f64, Point3) {
     let sp = closest_point(blade.side(side), &p.coords, Some(hint));
     let d = match blade.outward_normal(side, sp.u, sp.v) {
         Some(n) if (p.coords - sp.point).dot(&n) < 0.0 => -sp.distance,
         _ => sp.distance,
     };
-    (d, sp.u)
+    (d, sp.u, Point3::from(sp.point))
 }
 
 fn side_name(side: Side) -> &'static str {
@@ -455,6 +537,50 @@ pub fn blank_of(impeller: &Impeller) -> Result<RevolvedStock, SimError> {
     outline.extend(prof.iter().map(|p| (p[0], p[1])));
     outline.push((last[0], 0.0));
     RevolvedStock::new(outline)
+}
+
+/// The verifier's design distance as a [`nurbs::closest::PointQuery`], so that code written
+/// against that vocabulary (clearance checks, tests that compare distance functions) can take
+/// it like any other shape. Sign: negative inside the part's material (hub body and blades
+/// below the shroud contour), as [`DesignModel::signed_distance`]. The point is on the face
+/// whose distance decides the answer (hub, a blade side, the shroud contour over the blade
+/// tips; far from every blade, the foot on the blade-side mesh). The answer is never
+/// `certified`: the blade is chosen on a triangle mesh and its sides are projected by a local
+/// Newton iteration, the contours are searched from samples, and beside blade edges and far
+/// from the blades the distance is a lower bound of its magnitude (module docs), which is
+/// what the verifier's probes need but not a proven global minimum. No hint is used.
+///
+/// ```
+/// use machining_sim::{ImpellerDesign, ImpellerSampling};
+/// use nurbs::closest::PointQuery;
+/// let imp = impeller_model::fixtures::default_impeller().unwrap();
+/// let design = ImpellerDesign::new(&imp, ImpellerSampling::default()).unwrap();
+/// let hub = imp.hub();
+/// let p = hub.point(0.5, 0.02) + hub.normal(0.5, 0.02) * 0.4;
+/// let a = design.query(&p, None);
+/// assert!((a.signed_distance - 0.4).abs() < 1e-6);
+/// assert!(((p - a.point).norm() - 0.4).abs() < 1e-6 && !a.certified);
+/// ```
+impl nurbs::closest::PointQuery for ImpellerDesign {
+    type Hint = ();
+
+    fn query(
+        &self,
+        q: &nalgebra::Vector3<f64>,
+        _hint: Option<()>,
+    ) -> nurbs::closest::PointProjection<()> {
+        let (d, foot) = self.design_foot(&Point3::from(*q));
+        nurbs::closest::PointProjection {
+            point: foot.coords,
+            signed_distance: d,
+            hint: (),
+            certified: false,
+        }
+    }
+
+    fn signed_distance(&self, q: &nalgebra::Vector3<f64>) -> f64 {
+        DesignModel::signed_distance(self, &Point3::from(*q))
+    }
 }
 
 impl DesignModel for ImpellerDesign {
@@ -571,6 +697,57 @@ impl DesignModel for ImpellerDesign {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The design's `PointQuery` answers the verifier's own distance (bit for bit, on a cloud
+    /// around the impeller) and, beside the hub and the blade sides, a point on that face at
+    /// that distance (1e-6 mm).
+    #[test]
+    fn point_query_gives_the_design_distance_and_its_foot() {
+        use nurbs::closest::PointQuery;
+        let imp = impeller_model::fixtures::default_impeller().unwrap();
+        let design = ImpellerDesign::new(&imp, ImpellerSampling::default()).unwrap();
+        let mut k = 0u32;
+        for iz in 0..10 {
+            for ir in 0..10 {
+                let (z, r) = (
+                    -3.0 + 52.0 * f64::from(iz) / 9.0,
+                    2.0 + 44.0 * f64::from(ir) / 9.0,
+                );
+                let phi = 0.41 * f64::from(k);
+                k += 1;
+                let p = Point3::new(r * phi.cos(), r * phi.sin(), z);
+                let a = design.query(&p.coords, None);
+                assert_eq!(
+                    a.signed_distance.to_bits(),
+                    DesignModel::signed_distance(&design, &p).to_bits(),
+                    "{p:?}"
+                );
+                assert!(!a.certified);
+                // The foot is a point of the boundary, so no nearer than the distance bound.
+                assert!((p.coords - a.point).norm() >= a.signed_distance.abs() - 1e-9);
+            }
+        }
+        let hub = imp.hub();
+        let blade = imp.main().blade();
+        let mut near = Vec::new();
+        for (t, h) in [(0.3, 0.5), (0.5, 1.0), (0.7, -0.4)] {
+            // Mid-channel between main blade 0 and the splitter (half a blade pitch / 2).
+            let phi = std::f64::consts::PI / 16.0 + 0.02;
+            let (tp, pp) = (t, phi);
+            near.push(hub.point(tp, pp) + hub.normal(tp, pp) * h);
+        }
+        for (u, v, h) in [(0.4, 0.4, 0.3), (0.6, 0.5, 0.8), (0.5, 0.3, -0.1)] {
+            let n = blade.outward_normal(Side::Suction, u, v).unwrap();
+            near.push(blade.suction().point(u, v) + n * h);
+        }
+        for p in near {
+            let a = design.query(&p, None);
+            let d = (p - a.point).norm();
+            assert!((d - a.signed_distance.abs()).abs() < 1e-6, "{p:?}: {a:?}");
+            let on = DesignModel::signed_distance(&design, &Point3::from(a.point));
+            assert!(on.abs() < 1e-6, "foot of {p:?} off the boundary by {on}");
+        }
+    }
 
     #[test]
     fn contour_distance_matches_the_model_projection() {
