@@ -168,7 +168,7 @@ mod tests {
         Args {
             cl_file: cl,
             machine: PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-                .join("../../fixtures/machines/xyzac-trt.toml"),
+                .join("embedded/machines/xyzac-trt.toml"),
             dialect: dialect.into(),
             out: dir.join(format!("out.{dialect}")),
             mode,
@@ -239,7 +239,7 @@ mod tests {
         let dir = scratch("nosafe");
         let text = std::fs::read_to_string(
             PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-                .join("../../fixtures/machines/xyzac-trt.toml"),
+                .join("embedded/machines/xyzac-trt.toml"),
         )
         .unwrap();
         let stripped: String = text

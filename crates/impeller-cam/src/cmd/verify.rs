@@ -426,7 +426,7 @@ mod tests {
         .unwrap();
         let machine = concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../../fixtures/machines/xyzac-trt.toml"
+            "/embedded/machines/xyzac-trt.toml"
         );
         let a = args(&[
             "--gcode",

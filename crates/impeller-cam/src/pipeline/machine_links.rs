@@ -184,7 +184,7 @@ mod tests {
 
     fn headhead() -> Machine {
         Machine::from_file(format!(
-            "{}/../../fixtures/machines/headhead-ac.toml",
+            "{}/testdata/headhead-ac.toml",
             env!("CARGO_MANIFEST_DIR")
         ))
         .unwrap()
