@@ -64,6 +64,15 @@
 //! - the cone bound `(g_a + g_b − L·h)/2` (Piyavskii) bounds `g` below on an interval from
 //!   its end values; blocks of seed intervals are first excluded with one evaluation at their
 //!   middle seed (`g_mid − L·half width`).
+//! - second order, for sphere families (ball and tapered ball ends, every member a sphere of
+//!   radius `ρ(t) >= ρ_min`): at fixed `t`, `F = |p − o| − ρ` has `F_ss <= |o_s|²/|p − o| +
+//!   |o_ss|`, and on an interval where `g >= lb` (the cone bound) `|p − o| >= ρ_min + lb`, so
+//!   `F_ss <= M = L²/(ρ_min + lb) + A` (`A` bounds `|o_ss|` from the second hodographs);
+//!   then `F(s, t) >= chord − M·h²/8 >= min(g_a, g_b) − M·h²/8` for every `t`, which bounds
+//!   `g` below. The cone bound's deficit `L·h/2` is first order in the interval width, this
+//!   one's second order: on densely sampled paths (a written pass of thousands of short
+//!   linear moves) the intervals beside the minimiser, where `g` rises by less than `L·h/2`,
+//!   are excluded without a Newton run each (issue 13: they exhausted the run budget);
 //! - an interval whose bound is below `answer − certify_tol` and that no Newton run has
 //!   searched (started in or ended in) is searched by Newton from its lower end; the answer
 //!   only decreases, so earlier exclusions stay valid.
@@ -218,6 +227,11 @@ pub struct EnvelopeDistance {
     /// bound, module docs) to hold no member nearer than `distance − certify_tol`. False for
     /// rational guides (no derivative bound is kept for them) or when the run budget ran out.
     pub certified: bool,
+    /// A lower bound of the distance from the certification pass: `distance − certify_tol`
+    /// when certified; when the run budget ran out, the smaller of that and the cone or
+    /// second-order bounds of the seed intervals left unsearched (so an uncertified answer
+    /// still bounds how much nearer the envelope could be); `−∞` for rational guides.
+    pub lower_bound: f64,
 }
 
 /// Sensitivity of the distance to one guide's control points: `∂d/∂Q_{first+i} =
@@ -318,6 +332,12 @@ pub struct SweptEnvelope {
     /// Per seed interval `[seeds[k].s, seeds[k+1].s]`: an upper bound of `|g'(s)|` (mm per
     /// unit parameter); `INFINITY` where none is known (rational guides, axis may vanish).
     lipschitz: Vec<f64>,
+    /// Per seed interval: an upper bound of `|∂²o/∂s²|` over every member centre (mm per unit
+    /// parameter²) for the second-order bound (module docs); `INFINITY` where none is known.
+    curvature: Vec<f64>,
+    /// Smallest member sphere radius when every member is a sphere (ball and tapered ball
+    /// ends); `None` for families with discs (no second-order bound is used for them).
+    sphere_radius_min: Option<f64>,
     /// Every seed interval has a finite bound (non-rational guides, axis bounded away from 0).
     certifiable: bool,
 }
@@ -378,6 +398,8 @@ impl SweptEnvelope {
             seeds: Vec::new(),
             opts,
             lipschitz: Vec::new(),
+            curvature: Vec::new(),
+            sphere_radius_min: None,
             certifiable: false,
         };
         let mut seeds = Vec::with_capacity(breaks.len() * opts.samples_per_span + 1);
@@ -388,8 +410,23 @@ impl SweptEnvelope {
             }
         }
         seeds.push(env.seed_at(d0.1)?);
-        env.lipschitz = env.interval_lipschitz(&seeds);
+        (env.lipschitz, env.curvature) = env.interval_bounds(&seeds);
         env.certifiable = env.lipschitz.iter().all(|l| l.is_finite());
+        env.sphere_radius_min = env
+            .family
+            .pieces()
+            .iter()
+            .all(|piece| piece.is_sphere())
+            .then(|| {
+                env.family
+                    .pieces()
+                    .iter()
+                    .fold(f64::INFINITY, |acc, piece| {
+                        acc.min(piece.radius[0])
+                            .min(piece.radius[0] + piece.radius[1])
+                    })
+            })
+            .filter(|r| r.is_finite() && *r > 0.0);
         env.seeds = seeds;
         Ok(env)
     }
@@ -414,9 +451,12 @@ impl SweptEnvelope {
     /// Per seed interval, an upper bound `L` of `|g'(s)|`, `g(s) = min_t F(s, t)` (module docs,
     /// "Certificate"): every member moves rigidly with the frame, so `g` changes no faster
     /// than the fastest point of any member's centre disc, `|P0'| + (|m|max + e_max)·|a'|`, with
-    /// `|a'| <= |D'|/ℓ` and `ℓ >= min(ℓ at the ends) − |D'|max·h/2`. The hodograph bounds come
-    /// from [`GuideCurve::derivative_bound`]. O(seeds · p).
-    fn interval_lipschitz(&self, seeds: &[Seed]) -> Vec<f64> {
+    /// `|a'| <= |D'|/ℓ` and `ℓ >= min(ℓ at the ends) − |D'|max·h/2`; and an upper bound `A` of
+    /// `|o_ss| <= |P0''| + |m|max·|a''|` with `|a''| <= (2|D''| + 3|a'|·|D'|)/ℓ` (from
+    /// `D'' = ℓ''a + 2ℓ'a' + ℓa''`, `|ℓ'| <= |D'|`, `|ℓ''| <= |a'|·|D'| + |D''|`). The
+    /// hodograph bounds come from [`GuideCurve::derivative_bound`] and
+    /// [`GuideCurve::second_derivative_bound`]. O(seeds · p).
+    fn interval_bounds(&self, seeds: &[Seed]) -> (Vec<f64>, Vec<f64>) {
         let mut m_max: f64 = 0.0;
         let mut e_max: f64 = 0.0;
         for piece in self.family.pieces() {
@@ -443,16 +483,53 @@ impl SweptEnvelope {
                         .map(|(x, y)| x + y)
                 };
                 let (Some(dp0), Some(dd)) = (dp0, dd) else {
-                    return f64::INFINITY;
+                    return (f64::INFINITY, f64::INFINITY);
                 };
                 let ell_min = ell(a).min(ell(b)) - dd * 0.5 * (b - a);
                 if ell_min.is_nan() || ell_min < self.opts.min_axis_length {
-                    return f64::INFINITY;
+                    return (f64::INFINITY, f64::INFINITY);
                 }
+                let d2p0 = self.guide0.second_derivative_bound(sp0, None);
+                let d2d = if self.shared_basis {
+                    self.guide1.second_derivative_bound(sp1, Some(&self.guide0))
+                } else {
+                    self.guide1
+                        .second_derivative_bound(sp1, None)
+                        .zip(d2p0)
+                        .map(|(x, y)| x + y)
+                };
+                let curvature = match (d2p0, d2d) {
+                    (Some(d2p0), Some(d2d)) => {
+                        let a_s = dd / ell_min;
+                        let a_ss = (2.0 * d2d + 3.0 * a_s * dd) / ell_min;
+                        (d2p0 + m_max * a_ss) * (1.0 + 1e-12)
+                    }
+                    _ => f64::INFINITY,
+                };
                 // Relative slack for the rounding of the bound itself.
-                (dp0 + (m_max + e_max) * dd / ell_min) * (1.0 + 1e-12)
+                (
+                    (dp0 + (m_max + e_max) * dd / ell_min) * (1.0 + 1e-12),
+                    curvature,
+                )
             })
-            .collect()
+            .unzip()
+    }
+
+    /// Second-order lower bound of `g` on seed interval `k` of parameter width `h` (module
+    /// docs, "Certificate"): `min(g_a, g_b) − M·h²/8` with `M = L²/(ρ_min + lb) + A`, valid
+    /// when every member is a sphere and `ρ_min + lb > 0` (`lb`: a lower bound of `g` on the
+    /// interval, here the cone bound); `−∞` where it does not apply. O(1).
+    fn second_order_bound(&self, k: usize, g_a: f64, g_b: f64, lb: f64, h: f64) -> f64 {
+        let Some(rho_min) = self.sphere_radius_min else {
+            return f64::NEG_INFINITY;
+        };
+        let (l, a) = (self.lipschitz[k], self.curvature[k]);
+        let near = rho_min + lb;
+        if !(near > 0.0 && l.is_finite() && a.is_finite()) {
+            return f64::NEG_INFINITY;
+        }
+        let m = (l * l / near + a) * (1.0 + 1e-12);
+        g_a.min(g_b) - m * h * h / 8.0
     }
 
     fn seed_at(&self, s: f64) -> Result<Seed, CamError> {
@@ -723,6 +800,7 @@ impl SweptEnvelope {
                     param: EnvelopeParam { s, t },
                     iterations,
                     certified: false,
+                    lower_bound: f64::NEG_INFINITY,
                 }
             }
             None => self.cold_start(&pv)?,
@@ -772,6 +850,7 @@ impl SweptEnvelope {
                     param: EnvelopeParam { s, t },
                     iterations: 0,
                     certified: false,
+                    lower_bound: f64::NEG_INFINITY,
                 });
             }
         }
@@ -787,6 +866,7 @@ impl SweptEnvelope {
                     param: EnvelopeParam { s, t },
                     iterations: 0,
                     certified: false,
+                    lower_bound: f64::NEG_INFINITY,
                 }
             }
         };
@@ -807,8 +887,11 @@ impl SweptEnvelope {
         let tol = self.opts.certify_tol;
         if !self.certifiable {
             out.certified = false;
+            out.lower_bound = f64::NEG_INFINITY;
             return Ok(());
         }
+        // Smallest bound of an interval left unsearched for want of runs.
+        let mut unsearched = f64::INFINITY;
         // Parameters where a Newton run ended: their seed intervals count as searched.
         let mut found = [out.param.s; 2 * MAX_RUNS + 1];
         let mut n_found = 1;
@@ -837,11 +920,15 @@ impl SweptEnvelope {
                 } else {
                     self.seed_value(pv, &self.seeds[k + 1])
                 };
-                let lb = (0.5 * (g_a + g_b - self.lipschitz[k] * (sb - sa))).min(g_a.min(g_b));
+                let mut lb = (0.5 * (g_a + g_b - self.lipschitz[k] * (sb - sa))).min(g_a.min(g_b));
                 let searched = found[..n_found].iter().any(|&s| s >= sa && s <= sb);
+                if lb < out.distance - tol && !searched {
+                    lb = lb.max(self.second_order_bound(k, g_a, g_b, lb, sb - sa));
+                }
                 if lb < out.distance - tol && !searched {
                     if runs >= max_runs {
                         certified = false;
+                        unsearched = unsearched.min(lb);
                     } else {
                         runs += 1;
                         let start = if g_a <= g_b { sa } else { sb };
@@ -864,6 +951,7 @@ impl SweptEnvelope {
             k0 = k1;
         }
         out.certified = certified;
+        out.lower_bound = (out.distance - tol).min(unsearched);
         Ok(())
     }
 

@@ -283,6 +283,43 @@ impl GuideCurve {
         Some(best)
     }
 
+    /// An upper bound of `|C''(u)|` over knot span `span`, or of `|C''(u) − B''(u)|` when
+    /// `minus` is a curve sharing this one's basis: the largest norm of the second hodograph's
+    /// control points `(p − 1)·(Q'_{i+1} − Q'_i)/(u_{i+p+1} − u_{i+2})`, `i = span − p …
+    /// span − 2`, with `Q'_i` the first hodograph's (see [`Self::derivative_bound`]); their
+    /// convex combination is `C''` on that span. `Some(0)` for degree 1 (linear on each
+    /// span); `None` for rational curves or a zero-length knot difference among those used.
+    /// O(p), no allocation.
+    pub fn second_derivative_bound(&self, span: usize, minus: Option<&GuideCurve>) -> Option<f64> {
+        if self.weights.is_some() || minus.is_some_and(|m| m.weights.is_some()) {
+            return None;
+        }
+        let p = self.degree;
+        if p < 2 {
+            return Some(0.0);
+        }
+        let u = self.kv.knots();
+        let q = |i: usize| match minus {
+            Some(m) => self.ctrl[i] - m.ctrl[i],
+            None => self.ctrl[i],
+        };
+        let first = |i: usize| -> Option<Vector3> {
+            let du = u[i + p + 1] - u[i + 1];
+            (du > 0.0).then(|| (q(i + 1) - q(i)) * (p as f64 / du))
+        };
+        let lo = span.checked_sub(p)?;
+        let mut best: f64 = 0.0;
+        for i in lo..span.saturating_sub(1) {
+            let du = u[i + p + 1] - u[i + 2];
+            if du <= 0.0 {
+                return None;
+            }
+            let d2 = (first(i + 1)? - first(i)?) * ((p - 1) as f64 / du);
+            best = best.max(d2.norm());
+        }
+        Some(best)
+    }
+
     /// Distinct knot values inside the domain (span boundaries), in increasing order.
     pub fn breakpoints(&self) -> Vec<f64> {
         let (lo, hi) = self.domain();

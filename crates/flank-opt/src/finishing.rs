@@ -19,8 +19,14 @@
 //!    (`sample_max_*` keep the optimiser's own figures); a pass still outside after the
 //!    rounds is refused ([`FlankError::NotAccurate`]).
 //! 4. Comparison: the largest catalogue cylindrical ball end whose initial path keeps the
-//!    clearance, with its own minimax path; `stiffness_ratio_vs_cylindrical` is the job
-//!    tool's stiffness over that cylinder's.
+//!    clearance, with its own minimax path, refined and measured densely by the same route
+//!    ([`minimax_measured`]); `stiffness_ratio_vs_cylindrical` is the job tool's stiffness
+//!    over that cylinder's, `cylinder_max_overcut_mm` / `cylinder_max_undercut_mm` its dense
+//!    figures.
+//! 5. Optionally (`second_initial_path`), the job tool's minimax path from a second initial
+//!    path, by the same route: `second_start_max_deviation_mm` and
+//!    `two_start_deviation_ratio` (larger over smaller largest |deviation|; issue 13 expects
+//!    at most 1.1).
 //!
 //! Complexity per SLP iteration: (samples + adjacent samples) certified envelope distance
 //! queries with gradients (a few µs each) and one sparse LP of `2 + 6n` variables plus one
@@ -28,7 +34,7 @@
 
 use crate::catalogue::Catalogue;
 use crate::geometry::{ball_radius, guides_through, FlankSide, InitialPath};
-use crate::measure::{measure_written_path, DenseGrid};
+use crate::measure::{measure_written_path, DenseGrid, WrittenDeviation};
 use crate::problem::{deviations_max, Family, FlankProblem, HistoryRow, Mode, ProblemSettings};
 use crate::slp::{self, SlpOptions, Termination};
 use crate::{FlankError, FLANK_FINISHING};
@@ -128,6 +134,12 @@ pub struct FinishingParams {
     /// `two_point` (default) or `mid_normal`.
     #[serde(default = "default_initial")]
     pub initial_path: InitialPath,
+    /// A second initial path (`two_point` or `mid_normal`) from which the job tool's minimax
+    /// path is also optimised, refined and measured on the first side (issue 13's two-start
+    /// convergence check); reported as `second_start_max_deviation_mm` and
+    /// `two_start_deviation_ratio`, not written. Default: none.
+    #[serde(default)]
+    pub second_initial_path: Option<InitialPath>,
     /// Run the shape study (default true).
     #[serde(default = "default_true")]
     pub optimise_shape: bool,
@@ -438,13 +450,15 @@ pub fn output_locations(
 }
 
 /// The largest cylindrical ball end of the catalogue whose initial path keeps the
-/// clearance, and its minimax path. `None` when no catalogue radius fits.
+/// clearance, with its minimax path refined and measured densely exactly as the job tool's
+/// ([`minimax_measured`], on a copy of `side`). `None` when no catalogue radius fits.
+/// Cost: one zero-iteration probe per radius tried, then one [`minimax_measured`].
 pub fn best_cylinder(
     side: &FlankSide,
     catalogue: &Catalogue,
     how: InitialPath,
     run: &RunSettings,
-) -> Result<Option<PathResult>, FlankError> {
+) -> Result<Option<MeasuredPath>, FlankError> {
     for r in catalogue.ball_radius_mm.descending() {
         let shape = CutterShape::BallEnd { radius: r };
         let probe = RunSettings {
@@ -455,10 +469,109 @@ pub fn best_cylinder(
             continue;
         };
         if res.min_clearance_mm >= run.problem.min_clearance {
-            return optimise(side, shape, how, Mode::Minimax, run).map(Some);
+            let mut own = side.clone();
+            return minimax_measured(&mut own, shape, how, run).map(Some);
         }
     }
     Ok(None)
+}
+
+/// A minimax path whose written pass was measured densely and refined (issue 13).
+#[derive(Debug, Clone)]
+pub struct MeasuredPath {
+    /// The last optimised path (its written locations are `path.locations`;
+    /// `initial_max_deviation_mm` is the initial path's, before the first run).
+    pub path: PathResult,
+    /// Dense measurement of that written pass ([`measure_written_path`]).
+    pub dense: WrittenDeviation,
+    /// Refinement rounds run (0 when the first pass already held the tolerance).
+    pub refine_rounds: usize,
+    /// SLP iterations of every run (first and refinements).
+    pub iterations: usize,
+    /// The worst termination of those runs.
+    pub termination: Termination,
+}
+
+impl MeasuredPath {
+    /// The dense overcut and undercut are within `settings`' tolerances, and no uncertified
+    /// query could hide an overcut beyond it.
+    pub fn holds(&self, settings: &ProblemSettings) -> bool {
+        self.dense.max_overcut_mm <= settings.overcut_tol
+            && self.dense.max_undercut_mm <= settings.undercut_tol
+            && self.dense.uncertified_max_overcut_mm <= settings.overcut_tol
+    }
+}
+
+/// The minimax path of `shape` on `side` from the initial path `how` (shape fixed,
+/// [`optimise`]), its written pass measured densely against the design side
+/// ([`measure_written_path`], default grid), and while that pass is outside the overcut or
+/// undercut tolerance, up to `REFINE_ROUNDS` = 4 cutting-plane rounds: the (at most
+/// `REFINE_POINTS` = 300 worst) dense points outside `REFINE_FRACTION` = ½ of the tolerance
+/// become samples of `side` and the SLP continues from the current path with a tenth of the
+/// trust radius and the hub rows planned to 95 % of ε (the linearised hub rows then keep ε
+/// after the last step). Used for the job tool, the second initial path and the best
+/// cylindrical ball end alike, so their reported accuracies are measured the same way.
+/// `side` keeps the added samples. Cost: (1 + rounds) SLP runs and dense measurements.
+pub fn minimax_measured(
+    side: &mut FlankSide,
+    shape: CutterShape,
+    how: InitialPath,
+    run: &RunSettings,
+) -> Result<MeasuredPath, FlankError> {
+    let pr = &run.problem;
+    let root = pr.min_sample_height.max(ball_radius(&shape));
+    let report_mm = REFINE_FRACTION * pr.overcut_tol.min(pr.undercut_tol);
+    let measure = |fs: &FlankSide, res: &PathResult| {
+        measure_written_path(
+            fs,
+            &shape,
+            pr.flute_length,
+            &res.locations,
+            root,
+            DenseGrid::default(),
+            report_mm,
+        )
+    };
+    let mut res = optimise(side, shape, how, Mode::Minimax, run)?;
+    // The initial path's largest deviation (a refinement run's own "initial" is its warm
+    // start).
+    let initial_max = res.initial_max_deviation_mm;
+    let mut iterations = res.iterations;
+    let mut termination = res.termination;
+    let mut dense = measure(side, &res)?;
+    let refine_run = RunSettings {
+        trust_radius: REFINE_TRUST_FRACTION * run.trust_radius,
+        problem: ProblemSettings {
+            hub_tol: REFINE_HUB_MARGIN * pr.hub_tol,
+            ..*pr
+        },
+        ..*run
+    };
+    let mut rounds = 0;
+    while (dense.max_overcut_mm > pr.overcut_tol || dense.max_undercut_mm > pr.undercut_tol)
+        && rounds < REFINE_ROUNDS
+    {
+        rounds += 1;
+        side.add_samples(
+            dense
+                .outside_points
+                .iter()
+                .take(REFINE_POINTS)
+                .map(|q| q.uv),
+        );
+        res = optimise_from(side, shape, how, Mode::Minimax, &refine_run, Some(&res.x))?;
+        iterations += res.iterations;
+        termination = worse(termination, res.termination);
+        dense = measure(side, &res)?;
+    }
+    res.initial_max_deviation_mm = initial_max;
+    Ok(MeasuredPath {
+        path: res,
+        dense,
+        refine_rounds: rounds,
+        iterations,
+        termination,
+    })
 }
 
 fn series(label: &str, rows: &[HistoryRow], f: impl Fn(&HistoryRow) -> f64) -> PlotSeries {
@@ -587,6 +700,7 @@ impl FlankFinishing {
         let mut refine_rounds = 0usize;
         let mut dense_points = 0usize;
         let mut uncertified = 0usize;
+        let mut uncertified_over = 0.0f64;
         let mut worst_at: Option<(Side, crate::measure::DensePoint)> = None;
         let mut clear = f64::INFINITY;
         let mut hub = 0.0f64;
@@ -645,67 +759,15 @@ impl FlankFinishing {
                 }
                 runs.push(("shape and path".into(), study.history));
             }
-            let root = run
-                .problem
-                .min_sample_height
-                .max(ball_radius(&cutter.shape));
-            let mut res = optimise(&fs, cutter.shape, p.initial_path, Mode::Minimax, &run)?;
-            iterations += res.iterations;
-            termination = worse(termination, res.termination);
-            let report_mm = REFINE_FRACTION * run.problem.overcut_tol.min(run.problem.undercut_tol);
-            let measure = |fs: &FlankSide, res: &PathResult| {
-                measure_written_path(
-                    fs,
-                    &cutter.shape,
-                    cutter.flute_length,
-                    &res.locations,
-                    root,
-                    DenseGrid::default(),
-                    report_mm,
-                )
-            };
-            let mut dense = measure(&fs, &res)?;
-            // Cutting planes (issue 13): the dense measurement's points outside the tolerance
-            // become samples and the path is re-optimised from where it stands.
-            let mut rounds = 0;
-            // A warm start needs local steps only: a tenth of the initial trust radius.
-            // The hub rows are linearised: plan them to `REFINE_HUB_MARGIN` of ε so that the
-            // accepted point keeps ε after the last step's second-order error.
-            let refine_run = RunSettings {
-                trust_radius: REFINE_TRUST_FRACTION * run.trust_radius,
-                problem: ProblemSettings {
-                    hub_tol: REFINE_HUB_MARGIN * run.problem.hub_tol,
-                    ..run.problem
-                },
-                ..run
-            };
-            while (dense.max_overcut_mm > run.problem.overcut_tol
-                || dense.max_undercut_mm > run.problem.undercut_tol)
-                && rounds < REFINE_ROUNDS
-            {
-                rounds += 1;
-                fs.add_samples(
-                    dense
-                        .outside_points
-                        .iter()
-                        .take(REFINE_POINTS)
-                        .map(|q| q.uv),
-                );
-                res = optimise_from(
-                    &fs,
-                    cutter.shape,
-                    p.initial_path,
-                    Mode::Minimax,
-                    &refine_run,
-                    Some(&res.x),
-                )?;
-                iterations += res.iterations;
-                termination = worse(termination, res.termination);
-                dense = measure(&fs, &res)?;
-            }
-            refine_rounds += rounds;
+            let job_side = fs.clone();
+            let measured = minimax_measured(&mut fs, cutter.shape, p.initial_path, &run)?;
+            iterations += measured.iterations;
+            termination = worse(termination, measured.termination);
+            let (res, dense) = (&measured.path, &measured.dense);
+            refine_rounds += measured.refine_rounds;
             dense_points += dense.points;
             uncertified += dense.uncertified;
+            uncertified_over = uncertified_over.max(dense.uncertified_max_overcut_mm);
             if let Some(w) = dense.worst_overcut {
                 if dense.max_overcut_mm > over {
                     worst_at = Some((side, w));
@@ -719,7 +781,8 @@ impl FlankFinishing {
             hub = hub.max(res.hub_error_mm);
             stiffness = res.stiffness_n_per_mm;
             initial_dev = initial_dev.max(res.initial_max_deviation_mm);
-            final_dev = final_dev.max(dense.max_overcut_mm.max(dense.max_undercut_mm));
+            let side_dev = dense.max_overcut_mm.max(dense.max_undercut_mm);
+            final_dev = final_dev.max(side_dev);
             out.plots.push(deviation_map(
                 &fs,
                 &res.deviations,
@@ -727,30 +790,94 @@ impl FlankFinishing {
             ));
             runs.push(("job tool path (minimax)".into(), res.history.clone()));
             if k == 0 && p.compare_cylindrical {
-                match best_cylinder(&fs, &catalogue, p.initial_path, &run)? {
+                match best_cylinder(&job_side, &catalogue, p.initial_path, &run)? {
                     Some(cyl) => {
-                        cylinder_k = cyl.stiffness_n_per_mm;
-                        metrics.number("cylinder_radius_mm", ball_radius_of(&cyl));
-                        metrics.number("cylinder_stiffness_n_per_mm", cyl.stiffness_n_per_mm);
-                        metrics
-                            .number("cylinder_max_deviation_mm", deviations_max(&cyl.deviations));
-                        metrics.number("cylinder_max_overcut_mm", cyl.max_overcut_mm);
-                        metrics.number("cylinder_max_undercut_mm", cyl.max_undercut_mm);
+                        let (cp, cd) = (&cyl.path, &cyl.dense);
+                        cylinder_k = cp.stiffness_n_per_mm;
+                        metrics.number("cylinder_radius_mm", ball_radius_of(cp));
+                        metrics.number("cylinder_stiffness_n_per_mm", cp.stiffness_n_per_mm);
+                        // Dense measurement of the cylinder's written pass (the same route
+                        // and refinement as the job tool's); the optimiser's own figure as
+                        // `cylinder_sample_max_deviation_mm`.
+                        metrics.number(
+                            "cylinder_max_deviation_mm",
+                            cd.max_overcut_mm.max(cd.max_undercut_mm),
+                        );
+                        metrics.number("cylinder_max_overcut_mm", cd.max_overcut_mm);
+                        metrics.number("cylinder_max_undercut_mm", cd.max_undercut_mm);
+                        metrics.number(
+                            "cylinder_sample_max_deviation_mm",
+                            deviations_max(&cp.deviations),
+                        );
+                        metrics.count("cylinder_dense_points", cd.points);
+                        metrics.count("cylinder_dense_uncertified_points", cd.uncertified);
+                        metrics.number(
+                            "cylinder_dense_uncertified_max_overcut_mm",
+                            cd.uncertified_max_overcut_mm,
+                        );
+                        metrics.count("cylinder_refine_rounds", cyl.refine_rounds);
+                        metrics.count("cylinder_slp_iterations", cyl.iterations);
                         metrics.text("cylinder_slp_termination", cyl.termination.as_str());
+                        if !cyl.holds(&run.problem) {
+                            out.notes.push(format!(
+                                "the best cylindrical ball end (r = {:.2} mm) misses the \
+                                 tolerance on its written pass after {} refinement round(s): \
+                                 overcut {:.4} mm, undercut {:.4} mm",
+                                ball_radius_of(cp),
+                                cyl.refine_rounds,
+                                cd.max_overcut_mm,
+                                cd.max_undercut_mm
+                            ));
+                        }
                         out.plots.push(deviation_map(
-                            &fs,
-                            &cyl.deviations,
+                            &job_side,
+                            &cp.deviations,
                             &format!(
                                 "flank finishing, best cylindrical ball end: signed deviation \
                                  over the {side:?} side (mm)"
                             ),
                         ));
-                        runs.push(("cylindrical ball end path (minimax)".into(), cyl.history));
+                        runs.push((
+                            "cylindrical ball end path (minimax)".into(),
+                            cp.history.clone(),
+                        ));
                     }
                     None => out
                         .notes
                         .push("no catalogue cylindrical ball end keeps the clearance".into()),
                 }
+            }
+            if let (0, Some(how)) = (k, p.second_initial_path) {
+                // Issue 13: the minimax from a second initial path, measured the same way;
+                // both largest deviations and their ratio (larger over smaller) are reported.
+                let mut second_side = job_side.clone();
+                let second = minimax_measured(&mut second_side, cutter.shape, how, &run)?;
+                let d2 = second
+                    .dense
+                    .max_overcut_mm
+                    .max(second.dense.max_undercut_mm);
+                metrics.text("second_start_initial_path", how.as_str());
+                metrics.number("first_start_max_deviation_mm", side_dev);
+                metrics.number("second_start_max_deviation_mm", d2);
+                metrics.number(
+                    "second_start_initial_max_deviation_mm",
+                    second.path.initial_max_deviation_mm,
+                );
+                metrics.number(
+                    "two_start_deviation_ratio",
+                    side_dev.max(d2) / side_dev.min(d2),
+                );
+                metrics.count("second_start_slp_iterations", second.iterations);
+                metrics.count("second_start_refine_rounds", second.refine_rounds);
+                metrics.count(
+                    "second_start_dense_uncertified_points",
+                    second.dense.uncertified,
+                );
+                metrics.text("second_start_slp_termination", second.termination.as_str());
+                runs.push((
+                    format!("job tool path from {} (minimax)", how.as_str()),
+                    second.path.history.clone(),
+                ));
             }
             let refs: Vec<(&str, &[HistoryRow])> = runs
                 .iter()
@@ -786,6 +913,15 @@ impl FlankFinishing {
             ),
             _ => format!("{what} {v:.4} {u} > {t} {u}"),
         })
+        .chain(
+            (uncertified_over > pr.overcut_tol * (1.0 + 1e-9) + 1e-12).then(|| {
+                format!(
+                    "{uncertified} dense distance queries are uncertified and could hide an \
+                     overcut of up to {uncertified_over:.4} mm > {} mm",
+                    pr.overcut_tol
+                )
+            }),
+        )
         .chain((clear < pr.min_clearance - 1e-9).then(|| {
             format!(
                 "clearance to the next blade {clear:.4} mm < {} mm",
@@ -810,6 +946,7 @@ impl FlankFinishing {
         metrics.number("sample_max_undercut_mm", sample_under);
         metrics.count("dense_points", dense_points);
         metrics.count("dense_uncertified_points", uncertified);
+        metrics.number("dense_uncertified_max_overcut_mm", uncertified_over);
         metrics.count("refine_rounds", refine_rounds);
         metrics.number("min_blade_clearance_mm", clear);
         metrics.number("hub_tangency_error_mm", hub);

@@ -32,6 +32,16 @@ pub enum InitialPath {
     MidNormal,
 }
 
+impl InitialPath {
+    /// The job-file spelling (`two_point`, `mid_normal`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            InitialPath::TwoPoint => "two_point",
+            InitialPath::MidNormal => "mid_normal",
+        }
+    }
+}
+
 /// One blade side prepared for flank milling.
 #[derive(Debug, Clone)]
 pub struct FlankSide {
