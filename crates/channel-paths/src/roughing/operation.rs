@@ -395,6 +395,7 @@ impl ChannelRoughing {
         PlanError::geometry(&self.name, place, reason)
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn bound(
         &self,
         ctx: &PlanContext<'_>,
