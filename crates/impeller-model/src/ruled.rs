@@ -123,6 +123,65 @@ pub fn ruled_between_isocurves(
     )?)
 }
 
+/// The ruled surface `r` (degree 1 in v, two rows of control points: w = 0 and w = 1) with
+/// every ruling prolonged beyond both edges along its own line: the result at w′ ∈ [0, 1] is
+/// `r` at w = −`below` + w′·(1 + `below` + `above`) (fractions of each ruling's length), built
+/// exactly by extrapolating the two rows of homogeneous control points. The rulings are the
+/// same lines, so an offset of the prolonged surface meets surfaces (depth levels) that lie
+/// beyond the hub or shroud edge of `r` by up to those fractions of a ruling.
+///
+/// Errors: `r` is not a two-row ruled surface, a fraction is negative or not finite, or a
+/// weight of a rational `r` would not stay positive.
+pub fn prolong_rulings(
+    r: &NurbsSurface,
+    below: f64,
+    above: f64,
+) -> Result<NurbsSurface, ModelError> {
+    if r.n_v() != 2 || r.knots_v().degree() != 1 {
+        return Err(ModelError::Geometry(
+            "prolonging rulings needs a ruled surface of degree 1 in v with two rows".into(),
+        ));
+    }
+    if !(below.is_finite() && above.is_finite() && below >= 0.0 && above >= 0.0) {
+        return Err(ModelError::invalid(
+            "ruling prolongation",
+            "must be finite and ≥ 0",
+        ));
+    }
+    let (_, (v0, v1)) = r.domain();
+    let rational = r.is_rational();
+    let mut ctrl = Vec::with_capacity(r.n_u());
+    let mut weights = Vec::with_capacity(r.n_u());
+    for i in 0..r.n_u() {
+        let h = |j: usize| {
+            let p = r.control_point(i, j);
+            let w = r.weight(i, j);
+            Vector4::new(p.x * w, p.y * w, p.z * w, w)
+        };
+        let (h0, h1) = (h(0), h(1));
+        let lo = h0 * (1.0 + below) - h1 * below;
+        let hi = h1 * (1.0 + above) - h0 * above;
+        if !(lo.w > 0.0 && hi.w > 0.0) {
+            return Err(ModelError::Geometry(format!(
+                "prolonged ruling {i} has a non-positive weight"
+            )));
+        }
+        ctrl.push(vec![
+            Vector3::new(lo.x / lo.w, lo.y / lo.w, lo.z / lo.w),
+            Vector3::new(hi.x / hi.w, hi.y / hi.w, hi.z / hi.w),
+        ]);
+        weights.push(vec![lo.w, hi.w]);
+    }
+    Ok(NurbsSurface::new(
+        r.degree_u(),
+        1,
+        r.knots_u().knots().to_vec(),
+        vec![v0, v0, v1, v1],
+        ctrl,
+        rational.then_some(weights),
+    )?)
+}
+
 /// Signed deviation (see module docs) of the true side at (u, v) from ruled `r` over [a, b].
 fn deviation(
     blade: &Blade,

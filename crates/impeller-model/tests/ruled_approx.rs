@@ -3,7 +3,9 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use impeller_model::query::closest_point;
-use impeller_model::ruled::{ruled_approximation, sub_ruled_strips, DeviationSide};
+use impeller_model::ruled::{
+    prolong_rulings, ruled_approximation, sub_ruled_strips, DeviationSide,
+};
 use impeller_model::{fixtures, load, Blade, Impeller, Side};
 
 fn fixture(name: &str) -> Impeller {
@@ -144,4 +146,35 @@ fn sub_ruled_strips_meet_the_tolerance_and_are_fewest() {
         }
     }
     assert!(sub_ruled_strips(blade, side, (a, b), 0.0).is_err());
+}
+
+/// Prolonged rulings lie on the same lines: the prolonged surface at w′ is the original at
+/// w = −below + w′·(1 + below + above), within 1e-9 mm, on a free-form blade's ruled
+/// approximation; bad fractions are errors.
+#[test]
+fn prolonged_rulings_extend_the_same_lines() {
+    let imp = fixture("impeller-5-freeform");
+    let blade = imp.main().blade();
+    let ra =
+        ruled_approximation(blade, Side::Pressure, blade.hub_shroud_v(Side::Pressure)).unwrap();
+    let (below, above) = (0.7, 1.3);
+    let long = prolong_rulings(&ra.surface, below, above).unwrap();
+    let ((u0, u1), _) = ra.surface.domain();
+    for i in 0..=20 {
+        let u = u0 + (u1 - u0) * i as f64 / 20.0;
+        let (a, b) = (ra.surface.point(u, 0.0), ra.surface.point(u, 1.0));
+        for k in 0..=10 {
+            let wp = k as f64 / 10.0;
+            let w = -below + wp * (1.0 + below + above);
+            let want = a + (b - a) * w;
+            let got = long.point(u, wp);
+            assert!(
+                (got - want).norm() < 1e-9,
+                "u {u} w' {wp}: {}",
+                (got - want).norm()
+            );
+        }
+    }
+    assert!(prolong_rulings(&ra.surface, -0.1, 0.0).is_err());
+    assert!(prolong_rulings(&ra.surface, f64::NAN, 0.0).is_err());
 }

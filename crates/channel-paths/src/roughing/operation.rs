@@ -4,10 +4,20 @@
 //! the two sub-channels beside the splitter).
 //!
 //! Per channel (channel 0, copied to every channel by rotation):
-//! 1. Every bounding blade side is replaced by its ruled approximation
-//!    ([`impeller_model::ruled::ruled_approximation`]) pushed out by its allowance so that it
-//!    contains the true side ("blade with thickness"), and offset by the cutter radius plus
-//!    the process' blade allowance: `δ = R + blade_allowance + ruled allowance`.
+//! 1. On each level every bounding blade side is replaced by its ruled approximation
+//!    ([`impeller_model::ruled::ruled_approximation`]) over the span band that the level's
+//!    slab reaches (side parameters v from the side's lowest crossing with the level to its
+//!    highest crossing with the level above, the shroud edge for the first level), pushed out
+//!    by that band's allowance so that it contains the true side there ("blade with
+//!    thickness"), and offset by the cutter radius plus the process' blade allowance:
+//!    `δ = R + blade_allowance + ruled allowance`. One ruled surface over the whole span
+//!    deviates from a strongly twisted free-form side by more than the channel is wide
+//!    (7.6–7.9 mm on impeller-11+11-freeform, whose hub channel is 3.9 mm wide: no level was
+//!    left); paper 001 splits the approximated ruled blade along the span for the same
+//!    reason. Each ruling is prolonged beyond both edges by `δ` plus one depth of cut
+//!    ([`impeller_model::ruled::prolong_rulings`]): the offset moves a side leaning from the
+//!    hub or shroud normal up to `δ` along it, and the offset edge then missed the hub level
+//!    (impeller-5-freeform).
 //! 2. Levels: `n = ⌈max depth / depth_of_cut⌉` interpolated levels between the shroud
 //!    (excluded) and the hub offset by the hub allowance (the last level), so that no step
 //!    between levels exceeds `depth_of_cut_mm` anywhere along the channel.
@@ -61,8 +71,8 @@
 //! levels; the baseline over the same lanes), `saving_ratio = 1 − triangle / isoparametric`,
 //! `max_scallop_mm` (measured over the machinable region: rays along the level normal from a
 //! grid of points of every lane to the first cutter position of the level, the cutters taken
-//! at the emitted locations of every lane of the level densified to a quarter radius along
-//! each cut), `levels`, `paths`, `min_blade_clearance_mm` (clearance query against the true
+//! at the emitted locations of every lane of the level densified to a sixteenth of the ball
+//! radius along each cut, within 0.002 mm of the swept cutter at 0.5 mm scallops), `levels`, `paths`, `min_blade_clearance_mm` (clearance query against the true
 //! blades), `level_area_mm2` and `unmachinable_area_mm2` (developed areas over all levels and
 //! channels, trapezoidal on the area grids), the skip, split and bridge counts above.
 //!
@@ -79,7 +89,7 @@ use cam_plan::{
     PlanError, PlannedOperation, Plot, PlotKind, PlotSeries,
 };
 use impeller_model::levels::{depth_level, offset_surface_on_level, DepthLevel, LevelSpacing};
-use impeller_model::ruled::ruled_approximation;
+use impeller_model::ruled::{prolong_rulings, ruled_approximation};
 use impeller_model::{Blade, Impeller, Side};
 use nalgebra::{Rotation3, Unit, Vector3};
 use nurbs::NurbsSurface;
@@ -95,13 +105,23 @@ pub const CHANNEL_ROUGHING: &str = "channel_roughing";
 const BOUNDARY_SAMPLES: usize = 61;
 
 /// Midpoint queries allowed per motion check (beyond them the motion counts as not clear).
-const SEGMENT_QUERIES: usize = 24;
+/// A motion between postures with little clearance to spare (a shank beside a twisted blade)
+/// needs many certified bisections: at 24 queries such motions ran out and were bridged or
+/// split although clear (impeller-11+11-freeform: 451 split motions and 11 506 bridge
+/// postures; at 384: 33 and 165, and planning faster, since failed checks were retried
+/// through bridge postures).
+const SEGMENT_QUERIES: usize = 384;
 
 /// Largest spacing of path points along the flow (mm) when the chord rule allows more.
 const MAX_POINT_SPACING_MM: f64 = 1.0;
 
 /// Grid of scallop measurement per area and level (along × across the flow).
 const SCALLOP_GRID: (usize, usize) = (40, 16);
+
+/// Cutter positions per ball radius along each cut in the scallop measurement (see
+/// `measure_scallop`: the discrete positions' cusps read at most ~0.002 mm above the swept
+/// cutter's scallop at this density for the fixtures' 0.5 mm targets).
+const SCALLOP_DENSIFY: f64 = 16.0;
 
 /// Largest spacing (mm) of the cross-channel samples of where the cutter fits on each grid
 /// section (half the path interval when that is finer).
@@ -224,6 +244,8 @@ struct AreaPlan {
 
 struct LevelPlan {
     level: DepthLevel,
+    /// The level's bounding sides (module docs, step 1).
+    bounds: Vec<Bound>,
     fields: Vec<Field>,
     areas: Vec<AreaPlan>,
     /// Developed area between the offset ruled sides (mm²).
@@ -383,6 +405,7 @@ impl ChannelRoughing {
         PlanError::geometry(&self.name, place, reason)
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn bound(
         &self,
         ctx: &PlanContext<'_>,
@@ -390,14 +413,17 @@ impl ChannelRoughing {
         side: Side,
         label: &str,
         radius: f64,
+        doc: f64,
+        band: (&DepthLevel, Option<&DepthLevel>),
     ) -> Result<Bound, PlanError> {
         let imp = ctx.impeller;
-        let v = side_v_range(imp, blade, side).map_err(|e| {
+        let full = side_v_range(imp, blade, side).map_err(|e| {
             self.geo(
                 label,
                 format!("blade side does not reach both hub and shroud: {e}"),
             )
         })?;
+        let v = level_band(blade.side(side), full, band);
         let ruled =
             ruled_approximation(blade, side, v).map_err(|e| PlanError::model(&self.name, e))?;
         // Orient the offset along the blade's outward normal (into the channel).
@@ -410,9 +436,26 @@ impl ChannelRoughing {
             .ok_or_else(|| self.geo(label, "blade side normal undefined"))?;
         let sign = if n.dot(&out) >= 0.0 { 1.0 } else { -1.0 };
         let delta = radius + ctx.process.blade_allowance_mm + ruled.allowance_mm;
+        // The offset moves the surface by δ across its rulings, so where the blade leans from
+        // the hub (or shroud) normal the offset surface's edge lies up to δ off the hub (or
+        // shroud): prolong every ruling beyond both edges by δ plus one depth of cut so that
+        // the offset meets the hub level and the first level below the shroud (module docs,
+        // step 1).
+        let shortest = (0..=BOUNDARY_SAMPLES)
+            .map(|i| {
+                let u = u0 + (u1 - u0) * i as f64 / BOUNDARY_SAMPLES as f64;
+                (ruled.surface.point(u, 1.0) - ruled.surface.point(u, 0.0)).norm()
+            })
+            .fold(f64::INFINITY, f64::min);
+        if !(shortest.is_finite() && shortest > 0.0) {
+            return Err(self.geo(label, "ruled approximation has a degenerate ruling"));
+        }
+        let e = (delta + doc) / shortest;
+        let ruled =
+            prolong_rulings(&ruled.surface, e, e).map_err(|e| PlanError::model(&self.name, e))?;
         Ok(Bound {
             label: label.into(),
-            ruled: ruled.surface,
+            ruled,
             offset: sign * delta,
         })
     }
@@ -485,15 +528,37 @@ impl ChannelRoughing {
         let imp = ctx.impeller;
         let hub_allow = ctx.process.hub_allowance_mm;
         let ch = imp.channel(0);
-        let mut bounds = vec![
-            self.bound(ctx, &ch.left, ch.left_side(), "left blade", radius)?,
-            self.bound(ctx, &ch.right, ch.right_side(), "right blade", radius)?,
-        ];
-        if let Some(sp) = &ch.splitter {
-            let minus = sp.plus_theta_side().other();
-            bounds.push(self.bound(ctx, sp, minus, "splitter −θ side", radius)?);
-            bounds.push(self.bound(ctx, sp, sp.plus_theta_side(), "splitter +θ side", radius)?);
-        }
+        // The bounding sides of one level (module docs, step 1): each ruled over the span
+        // band the level's slab reaches.
+        let level_bounds = |band: (&DepthLevel, Option<&DepthLevel>)| {
+            let mut bounds = vec![
+                self.bound(
+                    ctx,
+                    &ch.left,
+                    ch.left_side(),
+                    "left blade",
+                    radius,
+                    doc,
+                    band,
+                )?,
+                self.bound(
+                    ctx,
+                    &ch.right,
+                    ch.right_side(),
+                    "right blade",
+                    radius,
+                    doc,
+                    band,
+                )?,
+            ];
+            if let Some(sp) = &ch.splitter {
+                let minus = sp.plus_theta_side().other();
+                let plus = sp.plus_theta_side();
+                bounds.push(self.bound(ctx, sp, minus, "splitter −θ side", radius, doc, band)?);
+                bounds.push(self.bound(ctx, sp, plus, "splitter +θ side", radius, doc, band)?);
+            }
+            Ok::<_, PlanError>(bounds)
+        };
         // Levels.
         let hub = imp.hub().meridional();
         let shroud = imp.shroud().meridional();
@@ -537,13 +602,17 @@ impl ChannelRoughing {
         let levels: Vec<Result<LevelPlan, PlanError>> = (1..=n_levels)
             .into_par_iter()
             .map(|j| {
-                let spacing = LevelSpacing::Interpolated {
-                    fraction: j as f64 / n_levels as f64,
-                    hub_offset: hub_allow,
+                let at = |j: usize| {
+                    let spacing = LevelSpacing::Interpolated {
+                        fraction: j as f64 / n_levels as f64,
+                        hub_offset: hub_allow,
+                    };
+                    depth_level(imp, spacing).map_err(|e| PlanError::model(&self.name, e))
                 };
-                let level =
-                    depth_level(imp, spacing).map_err(|e| PlanError::model(&self.name, e))?;
-                self.plan_level(ctx, j, level, &bounds, &fit, fit_min)
+                let level = at(j)?;
+                let above = if j > 1 { Some(at(j - 1)?) } else { None };
+                let bounds = level_bounds((&level, above.as_ref()))?;
+                self.plan_level(ctx, j, level, bounds, &fit, fit_min)
             })
             .collect();
         let levels: Vec<LevelPlan> = levels.into_iter().collect::<Result<_, _>>()?;
@@ -559,7 +628,7 @@ impl ChannelRoughing {
         });
         let per_level: Vec<Result<LevelCl, PlanError>> = levels
             .par_iter()
-            .map(|lp| self.locate_level(ctx, lp, &bounds, &blades_only, &fit, fit_min, doc))
+            .map(|lp| self.locate_level(ctx, lp, &lp.bounds, &blades_only, &fit, fit_min, doc))
             .collect();
         let per_level: Vec<LevelCl> = per_level.into_iter().collect::<Result<_, _>>()?;
 
@@ -632,16 +701,24 @@ impl ChannelRoughing {
             .count("split_motions", split * count)
             .count("bridge_postures", bridged * count);
         let plots = self.plot(&levels);
+        let offsets = levels
+            .iter()
+            .flat_map(|l| l.bounds.iter().map(|b| b.offset.abs()))
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), o| {
+                (lo.min(o), hi.max(o))
+            });
         Ok(PlannedOperation {
             paths,
             metrics,
             plots,
             notes: vec![format!(
-                "{n_levels} levels of ≤ {doc} mm; {} bounding sides (ruled, offset {:.3} mm); \
-                 the cutter does not fit with {:.3} mm from the blades on {:.0} of {:.0} mm² \
-                 of the levels (all channels), left unplanned",
-                bounds.len(),
-                bounds.first().map_or(0.0, |b| b.offset.abs()),
+                "{n_levels} levels of ≤ {doc} mm; {} bounding sides per level (ruled over \
+                 each level's span band, offset {:.3}–{:.3} mm); the cutter does not fit with \
+                 {:.3} mm from the blades on {:.0} of {:.0} mm² of the levels (all channels), \
+                 left unplanned",
+                levels.first().map_or(0, |l| l.bounds.len()),
+                offsets.0,
+                offsets.1,
                 fit_min,
                 (area_mm2 - planned_mm2).max(0.0) * k,
                 area_mm2 * k,
@@ -654,13 +731,13 @@ impl ChannelRoughing {
         ctx: &PlanContext<'_>,
         j: usize,
         level: DepthLevel,
-        bounds: &[Bound],
+        bounds: Vec<Bound>,
         fit: &FitQuery<'_>,
         fit_min: f64,
     ) -> Result<LevelPlan, PlanError> {
         let place = |b: &Bound| format!("level {j}, {}", b.label);
         let mut curves = Vec::with_capacity(bounds.len());
-        for b in bounds {
+        for b in &bounds {
             let ((u0, u1), _) = b.ruled.domain();
             let c = offset_surface_on_level(&b.ruled, b.offset, &level, (u0, u1), BOUNDARY_SAMPLES)
                 .map_err(|e| self.geo(place(b), e.to_string()))?;
@@ -759,7 +836,7 @@ impl ChannelRoughing {
             let axes = Axes {
                 lv: &level,
                 field: &field,
-                bounds,
+                bounds: &bounds,
                 max_tilt: self.params.max_tilt_deg.to_radians(),
                 level: j,
             };
@@ -794,6 +871,7 @@ impl ChannelRoughing {
         }
         Ok(LevelPlan {
             level,
+            bounds,
             fields,
             areas,
             area_mm2,
@@ -884,6 +962,38 @@ impl ChannelRoughing {
             }
         }
         Ok(false)
+    }
+}
+
+/// The span band of a blade side that one level's slab reaches (module docs, step 1): side
+/// parameters v from the lowest crossing of the side with the level `band.0` to the highest
+/// with the level above `band.1` (the shroud edge for the first level), within `full` (the
+/// side's hub–shroud range). A crossing that cannot be found leaves that end of `full`.
+fn level_band(
+    side: &NurbsSurface,
+    full: (f64, f64),
+    band: (&DepthLevel, Option<&DepthLevel>),
+) -> (f64, f64) {
+    let ((u0, u1), _) = side.domain();
+    let crossing_vs = |lv: &DepthLevel| {
+        offset_surface_on_level(side, 0.0, lv, (u0, u1), BOUNDARY_SAMPLES)
+            .ok()
+            .map(|c| c.samples.iter().map(|&(_, v)| v).collect::<Vec<f64>>())
+    };
+    let lo = crossing_vs(band.0)
+        .map(|vs| vs.into_iter().fold(f64::INFINITY, f64::min))
+        .filter(|v| v.is_finite())
+        .map_or(full.0, |v| v.max(full.0));
+    let hi = band
+        .1
+        .and_then(crossing_vs)
+        .map(|vs| vs.into_iter().fold(f64::NEG_INFINITY, f64::max))
+        .filter(|v| v.is_finite())
+        .map_or(full.1, |v| v.min(full.1));
+    if lo < hi {
+        (lo, hi)
+    } else {
+        full
     }
 }
 
@@ -1439,7 +1549,7 @@ fn inside(shape: &CutterShape, flute: f64, cl: &CutterLocation, x: &Vector3<f64>
 /// `runs` (module docs), at most `cap`: the ray is marched at a quarter of the ball radius
 /// and the first entry bisected (40 steps); a cutter crossed by the ray over less than a
 /// march step may be missed, which only reads more. Each run is a sequence of consecutive
-/// locations joined by cutting motions, densified to a quarter radius.
+/// locations joined by cutting motions, densified to `reach / SCALLOP_DENSIFY`.
 /// O(grid · (cap / step) · dense locations near the point).
 fn measure_scallop(
     shape: &CutterShape,
@@ -1461,12 +1571,16 @@ fn measure_scallop(
         } => radius,
         _ => 0.0,
     };
-    // Densify consecutive locations to a quarter radius.
+    // Densify consecutive locations to `reach / SCALLOP_DENSIFY`: the union of discrete
+    // cutters under-reads the swept one between them, so that a point at lateral distance `d`
+    // from the path is reached only as if `√(d² + (a/2)²)` away for spacing `a`. At a quarter
+    // radius this read up to 0.018 mm above a 0.5 mm scallop of a ball R1.5 (the cusps of the
+    // discrete balls); at a sixteenth it is below 0.002 mm.
     let mut dense: Vec<CutterLocation> = Vec::new();
     for cls in runs {
         for w in cls.windows(2) {
             let d = (w[1].tip - w[0].tip).norm();
-            let k = ((d / (0.25 * reach)).ceil() as usize).clamp(1, 64);
+            let k = ((d * SCALLOP_DENSIFY / reach).ceil() as usize).clamp(1, 256);
             for i in 0..k {
                 let t = i as f64 / k as f64;
                 let axis = w[0].axis.into_inner() * (1.0 - t) + w[1].axis.into_inner() * t;
