@@ -238,8 +238,7 @@ mod tests {
     fn a_machine_without_safe_z_is_an_error_naming_the_key() {
         let dir = scratch("nosafe");
         let text = std::fs::read_to_string(
-            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-                .join("embedded/machines/xyzac-trt.toml"),
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("embedded/machines/xyzac-trt.toml"),
         )
         .unwrap();
         let stripped: String = text
