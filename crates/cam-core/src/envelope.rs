@@ -473,15 +473,18 @@ impl SweptEnvelope {
                 let (a, b) = (w[0].s, w[1].s);
                 let mid = 0.5 * (a + b);
                 let (sp0, sp1) = (self.guide0.find_span(mid), self.guide1.find_span(mid));
-                let dp0 = self.guide0.derivative_bound(sp0, None);
-                let dd = if self.shared_basis {
-                    self.guide1.derivative_bound(sp1, Some(&self.guide0))
-                } else {
-                    self.guide1
-                        .derivative_bound(sp1, None)
-                        .zip(dp0)
-                        .map(|(x, y)| x + y)
+                // A hodograph bound of `P0` and of `D = P1 − P0` on this interval (`|D^(k)|`
+                // from the shared basis, else `|P1^(k)| + |P0^(k)|`).
+                let bounds = |bound: fn(&GuideCurve, usize, Option<&GuideCurve>) -> Option<f64>| {
+                    let b0 = bound(&self.guide0, sp0, None);
+                    let bd = if self.shared_basis {
+                        bound(&self.guide1, sp1, Some(&self.guide0))
+                    } else {
+                        bound(&self.guide1, sp1, None).zip(b0).map(|(x, y)| x + y)
+                    };
+                    (b0, bd)
                 };
+                let (dp0, dd) = bounds(GuideCurve::derivative_bound);
                 let (Some(dp0), Some(dd)) = (dp0, dd) else {
                     return (f64::INFINITY, f64::INFINITY);
                 };
@@ -489,15 +492,7 @@ impl SweptEnvelope {
                 if ell_min.is_nan() || ell_min < self.opts.min_axis_length {
                     return (f64::INFINITY, f64::INFINITY);
                 }
-                let d2p0 = self.guide0.second_derivative_bound(sp0, None);
-                let d2d = if self.shared_basis {
-                    self.guide1.second_derivative_bound(sp1, Some(&self.guide0))
-                } else {
-                    self.guide1
-                        .second_derivative_bound(sp1, None)
-                        .zip(d2p0)
-                        .map(|(x, y)| x + y)
-                };
+                let (d2p0, d2d) = bounds(GuideCurve::second_derivative_bound);
                 let curvature = match (d2p0, d2d) {
                     (Some(d2p0), Some(d2d)) => {
                         let a_s = dd / ell_min;
