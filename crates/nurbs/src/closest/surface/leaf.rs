@@ -57,6 +57,7 @@ impl SurfaceProjector {
         index: usize,
         q: &Vector3<f64>,
         best: Option<(Local, bool)>,
+        cert: &CertMemo,
     ) -> Option<(Local, bool)> {
         let leaf = &self.leaves[index];
         // The convexity certificate is computed only when it is needed (skip test below or
@@ -66,7 +67,7 @@ impl SurfaceProjector {
             // A stationary point of the surface inside a leaf where the distance is convex
             // is that leaf's minimum.
             if b.u >= leaf.u0 && b.u <= leaf.u1 && b.v >= leaf.v0 && b.v <= leaf.v1 {
-                let c = leaf.hess.certifies(&leaf.obb, q);
+                let c = cert.certifies(self, index, q);
                 certified = Some(c);
                 if c {
                     return None;
@@ -103,7 +104,7 @@ impl SurfaceProjector {
                 }
                 if b.u >= n.u0 && b.u <= n.u1 && b.v >= n.v0 && b.v <= n.v1 {
                     let c = *certified.get_or_insert_with(|| leaf.hess.certifies(&leaf.obb, q));
-                    if c && n.hess.certifies(&n.obb, q) {
+                    if c && cert.certifies(self, nb as usize, q) {
                         return None;
                     }
                     break;
@@ -175,6 +176,28 @@ impl SurfaceProjector {
             _ => l.v >= vb,
         };
         Some((l, l.converged && kkt_u && kkt_v))
+    }
+}
+
+/// The convexity certificate of the last leaf asked for within one query (the leaf holding
+/// the current best): the walk asks for it once when it reaches that leaf and again for each
+/// neighbour that is excluded through it.
+#[derive(Debug, Default)]
+pub(super) struct CertMemo(std::cell::Cell<Option<(usize, bool)>>);
+
+impl CertMemo {
+    /// `leaves[index].hess.certifies(leaves[index].obb, q)` for this query's `q`.
+    #[inline]
+    pub(super) fn certifies(&self, p: &SurfaceProjector, index: usize, q: &Vector3<f64>) -> bool {
+        if let Some((i, c)) = self.0.get() {
+            if i == index {
+                return c;
+            }
+        }
+        let leaf = &p.leaves[index];
+        let c = leaf.hess.certifies(&leaf.obb, q);
+        self.0.set(Some((index, c)));
+        c
     }
 }
 

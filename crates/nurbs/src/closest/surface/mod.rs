@@ -97,7 +97,7 @@ mod leaf;
 mod tree;
 
 pub(crate) use leaf::Leaf;
-use leaf::{leaf_split, lerp, link_edge_neighbours, make_leaf};
+use leaf::{leaf_split, lerp, link_edge_neighbours, make_leaf, CertMemo};
 use tree::{build_bvh, collapse, Node4, LEAF_BIT};
 pub(crate) use tree::{Aabb, Node, Obb};
 
@@ -350,7 +350,7 @@ impl SurfaceProjector {
         for _ in 0..64 {
             let mut pick = None;
             let mut pick_d = f64::INFINITY;
-            let (lb, _) = node.bounds(q);
+            let lb = node.bounds(q);
             for (c, &d) in lb.iter().enumerate().take(node.n as usize) {
                 if d < pick_d || pick.is_none() {
                     pick_d = d;
@@ -398,6 +398,7 @@ impl SurfaceProjector {
         // the overflow scan, so the search always ends, and it ends only when every leaf is
         // pruned by its box or solved.
         let mut overflow = false;
+        let cert = CertMemo::default();
         while sp > 0 {
             sp -= 1;
             let (index, d2) = (stack_i[sp], stack_d[sp]);
@@ -406,7 +407,7 @@ impl SurfaceProjector {
                 continue;
             }
             if index & LEAF_BIT != 0 {
-                if let Some(l) = self.solve_leaf((index & !LEAF_BIT) as usize, q, best) {
+                if let Some(l) = self.solve_leaf((index & !LEAF_BIT) as usize, q, best, &cert) {
                     if l.0.d2 < bound {
                         best = Some(l);
                     }
@@ -414,33 +415,31 @@ impl SurfaceProjector {
                 continue;
             }
             let node = &self.wide[index as usize];
-            // (lower bound, centre distance, child) of the children closer than the bound.
-            let mut kids = [(0.0f64, 0.0f64, 0u32); 4];
-            let mut nk = 0;
-            let (lbs, centres) = node.bounds(q);
+            // The children closer than the bound go on the stack, the nearest on top. The
+            // order only matters while the best improves (a nearer best prunes more): a warm
+            // query's best is usually final before the walk, which then visits the same
+            // nodes in any order.
+            let lbs = node.bounds(q);
+            let mut top = usize::MAX;
             for c in 0..node.n as usize {
                 let lb = lbs[c];
                 if lb >= bound {
                     continue;
                 }
-                let key2 = centres[c];
-                // Insertion sort, nearest first (ties: nearer box centre).
-                let mut at = nk;
-                while at > 0 && (kids[at - 1].0, kids[at - 1].1) > (lb, key2) {
-                    kids[at] = kids[at - 1];
-                    at -= 1;
-                }
-                kids[at] = (lb, key2, node.child[c]);
-                nk += 1;
-            }
-            for k in (0..nk).rev() {
                 if sp < N {
-                    stack_i[sp] = kids[k].2;
-                    stack_d[sp] = kids[k].0;
+                    stack_i[sp] = node.child[c];
+                    stack_d[sp] = lb;
+                    if top == usize::MAX || lb < stack_d[top] {
+                        top = sp;
+                    }
                     sp += 1;
                 } else {
                     overflow = true;
                 }
+            }
+            if top != usize::MAX {
+                stack_i.swap(top, sp - 1);
+                stack_d.swap(top, sp - 1);
             }
         }
         if overflow {
@@ -449,7 +448,7 @@ impl SurfaceProjector {
                 if self.leaves[index].obb.dist2(q) >= bound {
                     continue;
                 }
-                if let Some(l) = self.solve_leaf(index, q, best) {
+                if let Some(l) = self.solve_leaf(index, q, best, &cert) {
                     if l.0.d2 < bound {
                         best = Some(l);
                     }
