@@ -128,7 +128,7 @@ pub struct FinishingParams {
     /// Iteration limit of each SLP run (default 12).
     #[serde(default = "default_iterations")]
     pub max_slp_iterations: usize,
-    /// Initial trust radius (mm of control-point motion; default 0.5).
+    /// Initial and largest trust radius (mm of control-point motion; default 0.5).
     #[serde(default = "default_trust")]
     pub trust_radius_mm: f64,
     /// `two_point` (default) or `mid_normal`.
@@ -253,7 +253,7 @@ pub struct RunSettings {
     pub locations: usize,
     /// SLP iteration limit.
     pub max_iterations: usize,
-    /// Initial trust radius (mm).
+    /// Initial and largest trust radius (mm).
     pub trust_radius: f64,
     /// Cutter locations written.
     pub output_locations: usize,

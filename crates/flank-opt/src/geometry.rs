@@ -4,7 +4,8 @@
 
 use crate::FlankError;
 use cam_core::{CutterShape, GuideCurve, Point3, Vector3};
-use impeller_model::{Blade, Impeller, RevolvedSurface, Side};
+use impeller_model::{Blade, Impeller, MeridionalCurve, RevolvedSurface, Side};
+use nalgebra::Vector2;
 use nurbs::fit::{interpolate_curve, Parametrisation};
 
 /// Fixed-point rounds of the two-point tangency (contact heights depend on the tip, the tip
@@ -13,6 +14,15 @@ const TANGENCY_ROUNDS: usize = 4;
 /// Bisection steps lowering the ball onto the hub: the bracket is at most a few ball radii
 /// wide, 50 halvings leave < 1e-12 mm.
 const HUB_BISECTIONS: usize = 50;
+/// Steps of `r/4` scanned down the axis for the first hub contact: 84 ball radii, the reach
+/// of the former symmetric bracket search (20 widenings of 4 r).
+const HUB_SCAN_STEPS: usize = 336;
+/// Moves of an axis line that misses the hub towards it before giving up (one suffices when
+/// the hub distance is linear near the closest approach, as beyond an end plane).
+const HUB_SHIFTS: usize = 4;
+/// Overlap (fraction of the ball radius) added to the gap when such a line is moved, so the
+/// moved ball meets the hub transversally rather than grazing it.
+const HUB_SHIFT_OVERLAP: f64 = 0.1;
 /// Fine steps per along-sample of the arc-length/turning measure that places the samples
 /// along the side ([`along_parameters`]).
 const FINE_PER_SAMPLE: usize = 40;
@@ -172,6 +182,39 @@ impl FlankSide {
         self.hub.signed_distance(p)
     }
 
+    /// Signed distance of the ball centre `p` from the hub body: the hub surface closed at
+    /// both ends of its meridional contour by the planes through each end perpendicular to
+    /// the contour's end tangent (the inlet face and the outlet rim). Equal to
+    /// [`Self::hub_distance`] on the channel side and near the contour; beyond an end
+    /// (e.g. the ball of a leading-edge location hanging over the hub's inlet face), where
+    /// the closest contour point is the end point and the sign of [`Self::hub_distance`]
+    /// flips from `+|p − end|` to `−|p − end|` across the end normal's line, it is the
+    /// distance beyond the end plane instead, which is continuous there (and C¹: both sides
+    /// have the end tangent as gradient on that line). The ball lowering
+    /// ([`Self::initial_locations`]) and the hub-tangency rows of [`crate::problem`] use it,
+    /// so neither brackets nor linearises that jump (issue 13: the mid-normal start was left
+    /// on it 1.16 mm above the hub of impeller-30-narrow's leading edge). Wherever the
+    /// plain distance is negative the result is the largest of it and the two signed
+    /// distances beyond the end planes, which assumes the contour lies on the inner side of
+    /// both end planes (so for a monotone hub contour: z and r each monotone). O(1) contour
+    /// projections.
+    pub fn hub_body_distance(&self, p: &Vector3) -> f64 {
+        let m = self.hub.meridional();
+        let zr = MeridionalCurve::zr_of(p);
+        let (_, d) = m.closest(zr);
+        if d >= 0.0 {
+            return d;
+        }
+        let (t0, t1) = m.domain();
+        // Unit tangent (increasing t) from the channel-side normal n = (t_r, −t_z)/|t|.
+        let tangent = |t: f64| {
+            let n = m.normal(t);
+            Vector2::new(-n[1], n[0])
+        };
+        let beyond = |t: f64, out: Vector2<f64>| (zr - m.point(t)).dot(&out);
+        d.max(beyond(t0, -tangent(t0))).max(beyond(t1, tangent(t1)))
+    }
+
     /// Initial cutter locations for `shape` at `n` rulings evenly spaced in u: ball centres
     /// `P0` and upper axis points `P1 = P0 + a·upper` (see [`InitialPath`]); `upper` is the
     /// largest contact height of the shroud edge above the ball centre. O(n · (rounds +
@@ -239,33 +282,81 @@ impl FlankSide {
     }
 
     /// Tip on the line `p − λ·a` whose ball (radius `r`, centre tip + r·a) is tangent to the
-    /// hub: bisection on `λ` of `hub_distance(centre) − r` (decreasing in λ as the ball goes
-    /// down into the hub).
+    /// hub body ([`Self::hub_body_distance`]): the first root of `f(λ) = hub_body_distance
+    /// (centre) − r` met going down the line from a height where the ball is clear of the hub
+    /// (scan in steps of `r/4`, then bisection inside the step), so the ball stops where it
+    /// first touches the hub, never at a later crossing or a jump.
+    ///
+    /// When the line misses the hub (the ball passes beyond an end of the hub, e.g. over the
+    /// inlet face at a leading edge, farther than `r` from it: `f > 0` all the way down), the
+    /// line is moved towards the hub, perpendicular to `a`, by the gap at its closest approach
+    /// plus `HUB_SHIFT_OVERLAP·r` (so the next scan meets a transversal root), and lowered
+    /// again (at most `HUB_SHIFTS` times). The returned tip is on the moved line.
+    /// O(`HUB_SCAN_STEPS` + `HUB_BISECTIONS`) hub projections per try.
     fn lower_onto_hub(&self, p: &Vector3, a: &Vector3, r: f64) -> Result<Vector3, FlankError> {
-        let f = |lam: f64| self.hub_distance(&(p - a * lam + a * r)) - r;
-        let (mut lo, mut hi) = (-4.0 * r, 4.0 * r);
-        let mut k = 0;
-        while f(lo) < 0.0 || f(hi) > 0.0 {
-            lo -= 4.0 * r;
-            hi += 4.0 * r;
-            k += 1;
-            if k > 20 {
-                return Err(FlankError::Geometry(format!(
-                    "{:?} side: cannot bring the ball onto the hub near {:.2?}",
-                    self.side,
-                    p.as_slice()
-                )));
+        let fail = |p: &Vector3| {
+            FlankError::Geometry(format!(
+                "{:?} side: cannot bring the ball onto the hub near {:.2?}",
+                self.side,
+                p.as_slice()
+            ))
+        };
+        let step = 0.25 * r;
+        let mut p = *p;
+        for _ in 0..=HUB_SHIFTS {
+            let f = |lam: f64| self.hub_body_distance(&(p - a * lam + a * r)) - r;
+            // A start above the hub.
+            let mut top = -4.0 * r;
+            let mut k = 0;
+            while f(top) < 0.0 {
+                top -= 4.0 * r;
+                k += 1;
+                if k > 20 {
+                    return Err(fail(&p));
+                }
             }
-        }
-        for _ in 0..HUB_BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            if f(mid) > 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
+            let mut bracket = None;
+            let (mut best_f, mut best_lam) = (f(top), top);
+            for i in 1..=HUB_SCAN_STEPS {
+                let lam = top + step * i as f64;
+                let v = f(lam);
+                if v <= 0.0 {
+                    bracket = Some((lam - step, lam));
+                    break;
+                }
+                if v < best_f {
+                    (best_f, best_lam) = (v, lam);
+                }
             }
+            let Some((mut lo, mut hi)) = bracket else {
+                // Missed: move the line towards the hub at its closest approach.
+                let c = p - a * best_lam + a * r;
+                let h = crate::problem::HUB_FD_STEP_MM;
+                let mut g = Vector3::zeros();
+                for k in 0..3 {
+                    let mut dp = Vector3::zeros();
+                    dp[k] = h;
+                    g[k] = (self.hub_body_distance(&(c + dp)) - self.hub_body_distance(&(c - dp)))
+                        / (2.0 * h);
+                }
+                let perp = g - a * g.dot(a);
+                if perp.norm_squared() < 1e-12 {
+                    return Err(fail(&p));
+                }
+                p -= perp * ((best_f + HUB_SHIFT_OVERLAP * r) / perp.norm_squared());
+                continue;
+            };
+            for _ in 0..HUB_BISECTIONS {
+                let mid = 0.5 * (lo + hi);
+                if f(mid) > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            return Ok(p - a * (0.5 * (lo + hi)));
         }
-        Ok(p - a * (0.5 * (lo + hi)))
+        Err(fail(&p))
     }
 }
 

@@ -14,7 +14,8 @@
 //!    end leaves the fillet there (undercut is expected), but it must not cut into the blade
 //!    (issue 13);
 //! 2. hub tangency at each cutter location `s_j`: `ε ± (h(P0(s_j)) − r) >= 0` with `h` the
-//!    signed hub distance;
+//!    signed distance from the hub body ([`FlankSide::hub_body_distance`], continuous beyond
+//!    the ends of the hub contour);
 //! 3. clearance: `d(q_k) − c_min >= 0` for the adjacent-blade samples `q_k` within
 //!    `CLEARANCE_BAND_MM` of the bound (the others cannot become active inside a trust region).
 //!
@@ -277,8 +278,9 @@ impl<'a> FlankProblem<'a> {
         for k in 0..3 {
             let mut dp = Vector3::zeros();
             dp[k] = h;
-            grad_c[k] =
-                (self.side.hub_distance(&(c + dp)) - self.side.hub_distance(&(c - dp))) / (2.0 * h);
+            grad_c[k] = (self.side.hub_body_distance(&(c + dp))
+                - self.side.hub_body_distance(&(c - dp)))
+                / (2.0 * h);
         }
         let mut grad = vec![(0, -1.0)];
         for i in 0..e.count {
@@ -291,7 +293,7 @@ impl<'a> FlankProblem<'a> {
             ]);
         }
         Row {
-            value: self.side.hub_distance(&c) - r,
+            value: self.side.hub_body_distance(&c) - r,
             grad,
         }
     }

@@ -186,3 +186,65 @@ fn slp_merit_never_rises_and_states_its_reason() {
         assert!(res.iterations <= 4);
     }
 }
+
+/// Issue 13: every initial cutter location, from either start, has its ball tangent to the
+/// hub body (the hub-tangency rows' measure, [`FlankSide::hub_body_distance`]). At impeller-30-narrow's leading edge the mid-normal start's axis passed more than a
+/// ball radius beyond the hub's inlet face; the lowering bisection then stopped on the jump
+/// of the hub's signed distance beyond the contour's end and left the ball 1.16 mm above the
+/// hub (the two-point start 0 mm), so the minimax from it stalled.
+#[test]
+fn initial_balls_are_tangent_to_the_hub_from_both_starts() {
+    let narrow = impeller_model::load(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/impeller-30-narrow/impeller.toml"
+    ))
+    .unwrap();
+    for (name, imp) in [("impeller-30-narrow", narrow), ("blunt", impeller(false))] {
+        for side in [Side::Pressure, Side::Suction] {
+            let fs = FlankSide::new(&imp, side, 12, 4).unwrap();
+            for r in [2.5, 3.0] {
+                let shape = CutterShape::TaperedBallEnd {
+                    ball_radius: r,
+                    half_angle: 3f64.to_radians(),
+                };
+                for how in [InitialPath::TwoPoint, InitialPath::MidNormal] {
+                    let (p0, _) = fs.initial_locations(&shape, 30, how).unwrap();
+                    for (i, c) in p0.iter().enumerate() {
+                        let gap = fs.hub_body_distance(c) - r;
+                        assert!(
+                            gap.abs() < 1e-6,
+                            "{name} {side:?} r {r} {how:?} location {i}: hub gap {gap} mm"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The hub body distance is the hub distance on the channel side and continuous beyond the
+/// inlet end of the hub contour, where the plain signed distance jumps (its sign flips across
+/// the end normal's line while its magnitude is the distance to the end point).
+#[test]
+fn hub_body_distance_is_continuous_beyond_the_inlet() {
+    let imp = impeller(false);
+    let fs = FlankSide::new(&imp, Side::Pressure, 4, 2).unwrap();
+    // Hub inlet at (z, r) = (70, 47) with an axial end tangent: its end plane is z = 70.
+    let at = |z: f64, r: f64| cam_core::Vector3::new(r, 0.0, z);
+    let d = 1e-6;
+    for dz in [0.5, 2.0, 4.16] {
+        let (above, below) = (at(70.0 + dz, 47.0 + d), at(70.0 + dz, 47.0 - d));
+        assert!((fs.hub_distance(&above) - dz).abs() < 1e-5);
+        assert!(
+            (fs.hub_distance(&below) + dz).abs() < 1e-5,
+            "the jump this guards"
+        );
+        assert!((fs.hub_body_distance(&above) - dz).abs() < 1e-5);
+        assert!((fs.hub_body_distance(&below) - dz).abs() < 1e-5);
+    }
+    // Channel side and inside the hub away from the ends: the plain distance.
+    for p in [at(40.0, 90.0), at(60.0, 45.0), at(30.0, 60.0)] {
+        let (a, b) = (fs.hub_distance(&p), fs.hub_body_distance(&p));
+        assert!((a - b).abs() < 1e-12 || (a < 0.0 && b < 0.0), "{a} {b}");
+    }
+}
