@@ -67,14 +67,13 @@
 //! a last free step short enough (`s² ≤ step_tol · 1 µm`) to be applied through the
 //! second-order Taylor expansion instead of a new evaluation (`newton::TAYLOR_LENGTH`); steps
 //! are accepted up to the round-off of `|S − q|²`. Cost, criterion medians per query
-//! (release; figures of 2026-11 on a shared 2-core machine under a load of about 3, where
-//! the code before the gradient-sign test measured 1.35 µs / 0.72 µs on the first surface):
-//! the 12×12 bicubic reference surface of `benches/nurbs.rs`, ≈ 1.04 µs cold, ≈ 0.65 µs warm
-//! (idle-machine figures of the earlier code: 0.83 / 0.47 µs); the suction side of the
+//! (release, 2026-11-26, 2-core machine at a load of about 1): the 12×12 bicubic reference
+//! surface of `benches/nurbs.rs`, ≈ 0.89 µs cold, ≈ 0.54 µs warm; the suction side of the
 //! default impeller's main blade (ruled, 161 × 2 control points, 1260 leaves;
-//! `impeller-model/benches/queries.rs`), ≈ 1.8 µs cold, ≈ 0.75 µs warm along a path. A cold
-//! query costs a greedy descent, one Newton run and the certifying walk (about 12 nodes and
-//! 2 leaves visited on the blade). Memory: per leaf, besides its boxes and bounds, the
+//! `impeller-model/benches/queries.rs`), ≈ 1.53 µs cold, ≈ 0.48 µs warm along a path
+//! (callgrind: about 5600 instructions, of which 3.2 surface evaluations ≈ 1200, the walk's
+//! box bounds ≈ 1000). A cold query costs a greedy descent, one Newton run and the certifying
+//! walk (about 12 nodes and 2 leaves visited on the blade). Memory: per leaf, besides its boxes and bounds, the
 //! gradient-sign coefficients (`(2p)(2q+1)` scalars and vectors per direction for a
 //! polynomial leaf). Queries take `&self` and, outside the branch-and-bound fallback, do not
 //! allocate; the projector is `Send + Sync`.
@@ -137,8 +136,12 @@ pub struct SurfaceProjector {
     step_tol: f64,
 }
 
-/// Entries of the query walk's stack (see `closest_point_with_hint`).
-const WALK_STACK: usize = 64;
+/// Entries of the query walk's stack (see `walk`). A walk of the 4-wide tree holds at most
+/// three siblings per level plus the node being expanded, so 32 entries serve trees of
+/// depth 10 (about a million leaves) without overflow; an overflow is still correct (every
+/// leaf is then scanned). Smaller than before (64) because the stack is initialised on every
+/// query: criterion, warm blade query, 0.49 → 0.48 µs.
+const WALK_STACK: usize = 32;
 
 impl SurfaceProjector {
     /// Builds the query structure: Bézier decomposition, leaf subdivision, bounds, cones,
@@ -427,16 +430,11 @@ impl SurfaceProjector {
             // nodes in any order.
             let lbs = node.bounds(q);
             let mut top = usize::MAX;
-            // Lanes nearer than the bound (unused lanes masked off), then only those.
-            let mut near = 0u32;
-            for (c, &lb) in lbs.iter().enumerate() {
-                near |= u32::from(lb < bound) << c;
-            }
-            near &= (1u32 << node.n) - 1;
-            while near != 0 {
-                let c = near.trailing_zeros() as usize;
-                near &= near - 1;
+            for c in 0..node.n as usize {
                 let lb = lbs[c];
+                if lb >= bound {
+                    continue;
+                }
                 if sp < N {
                     stack_i[sp] = node.child[c];
                     stack_d[sp] = lb;

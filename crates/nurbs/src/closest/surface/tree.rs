@@ -110,7 +110,9 @@ pub(super) const LEAF_BIT: u32 = 1 << 31;
 /// children's own oriented boxes and axis-aligned boxes tested together: 12.2 instead of
 /// 11.2 nodes visited per query, but each bound costs a third as much; with the other
 /// changes of the walk the query fell from 6990 to 5600 instructions (12 × 12 reference
-/// surface: 9240 → 7540 cold, 7410 → 5980 warm), with the same answers.
+/// surface: 9240 → 7540 cold, 7410 → 5980 warm), with the same answers; criterion, warm
+/// blade query, 0.51 → 0.49 µs. (Selecting the lanes nearer than the bound by a bit mask
+/// saved another 2 % of instructions but cost 20 % of the time: branch mispredictions.)
 #[derive(Debug, Clone)]
 pub(super) struct Node4 {
     /// The node's frame: origin and orthonormal axes (rows).
