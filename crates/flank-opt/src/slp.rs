@@ -385,19 +385,24 @@ mod tests {
         }
     }
 
-    #[test]
-    fn converges_on_a_disc_with_monotone_merit() {
-        let opts = SlpOptions {
-            max_iterations: 60,
+    /// Options of the two-variable tests: trust radius 0.5, penalty 10, box ±10.
+    fn plane_options(max_iterations: usize, tol: f64) -> SlpOptions {
+        SlpOptions {
+            max_iterations,
             radius: 0.5,
             min_radius: 1e-9,
-            tol: 1e-12,
+            tol,
             penalty: 10.0,
             feas_tol: 1e-6,
             scale: vec![1.0; 2],
             lower: vec![-10.0; 2],
             upper: vec![10.0; 2],
-        };
+        }
+    }
+
+    #[test]
+    fn converges_on_a_disc_with_monotone_merit() {
+        let opts = plane_options(60, 1e-12);
         let r = solve(&mut Disc, vec![0.1, -0.3], &opts).unwrap();
         assert_eq!(r.termination, Termination::Converged);
         let h = std::f64::consts::FRAC_1_SQRT_2;
@@ -444,17 +449,7 @@ mod tests {
 
     #[test]
     fn a_curved_constraint_band_does_not_stall_the_steps() {
-        let opts = SlpOptions {
-            max_iterations: 30,
-            radius: 0.5,
-            min_radius: 1e-9,
-            tol: 1e-10,
-            penalty: 10.0,
-            feas_tol: 1e-6,
-            scale: vec![1.0; 2],
-            lower: vec![-10.0; 2],
-            upper: vec![10.0; 2],
-        };
+        let opts = plane_options(30, 1e-10);
         let r = solve(&mut Band, vec![0.6, 0.8], &opts).unwrap();
         assert!(r.x[0] < -0.99 && r.x[1].abs() < 0.1, "{:?}", r.x);
         assert!(r.eval.max_violation() < 1e-2, "{}", r.eval.max_violation());

@@ -40,3 +40,24 @@ use crate::NurbsSurface;
 pub fn closest_point_on_surface(surface: &NurbsSurface, q: &Vector3<f64>) -> SurfacePoint {
     SurfaceProjector::new(surface).closest_point(q)
 }
+
+/// A wavy bicubic test surface: 8 × 8 control points `(x, y, a·sin(x/wx)·cos(y/wy))` with
+/// `x, y = step·(0..8)` (mm), clamped uniform knots, unit weights.
+#[cfg(test)]
+pub(crate) fn wavy_test_surface(step: f64, a: f64, wx: f64, wy: f64) -> NurbsSurface {
+    let ctrl: Vec<Vec<Vector3<f64>>> = (0..8)
+        .map(|i| {
+            (0..8)
+                .map(|j| {
+                    let (x, y) = (step * i as f64, step * j as f64);
+                    Vector3::new(x, y, a * (x / wx).sin() * (y / wy).cos())
+                })
+                .collect()
+        })
+        .collect();
+    let knots = crate::KnotVector::clamped_uniform(3, 8)
+        .unwrap()
+        .knots()
+        .to_vec();
+    NurbsSurface::new(3, 3, knots.clone(), knots, ctrl, None).unwrap()
+}

@@ -263,24 +263,8 @@ pub(crate) fn minimise<F: Fn(f64, f64) -> SurfaceDerivs2>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{KnotVector, NurbsSurface};
+    use crate::closest::wavy_test_surface;
     use std::cell::Cell;
-
-    /// A wavy bicubic surface of about 100 mm (step tolerance ≈ 1.4e-11 mm).
-    fn wavy() -> NurbsSurface {
-        let ctrl: Vec<Vec<Vector3<f64>>> = (0..8)
-            .map(|i| {
-                (0..8)
-                    .map(|j| {
-                        let (x, y) = (14.0 * i as f64, 14.0 * j as f64);
-                        Vector3::new(x, y, 9.0 * (x / 19.0).sin() * (y / 23.0).cos())
-                    })
-                    .collect()
-            })
-            .collect();
-        let knots = KnotVector::clamped_uniform(3, 8).unwrap().knots().to_vec();
-        NurbsSurface::new(3, 3, knots.clone(), knots, ctrl, None).unwrap()
-    }
 
     /// Newton runs that end with a step applied through the Taylor expansion answer the same
     /// point, normal and distance as an evaluation at the returned parameters (to round-off:
@@ -289,7 +273,8 @@ mod tests {
     /// end that way, one evaluation earlier.
     #[test]
     fn taylor_final_step_matches_an_evaluation() {
-        let s = wavy();
+        // About 100 mm (step tolerance ≈ 1.4e-11 mm).
+        let s = wavy_test_surface(14.0, 9.0, 19.0, 23.0);
         let step_tol = 1e-13 * (1.0 + 140.0);
         let mut taylor_ends = 0;
         let runs = 200;

@@ -471,24 +471,12 @@ impl SurfaceProjector {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::KnotVector;
 
     /// A walk whose stack overflows (capacity 2 < the root's children) scans every leaf and
     /// finds the same minimum as the full walk, to Newton's tolerance.
     #[test]
     fn overflowing_walk_scans_all_leaves() {
-        let ctrl: Vec<Vec<Vector3<f64>>> = (0..8)
-            .map(|i| {
-                (0..8)
-                    .map(|j| {
-                        let (x, y) = (10.0 * i as f64, 10.0 * j as f64);
-                        Vector3::new(x, y, 6.0 * (x / 13.0).sin() * (y / 17.0).cos())
-                    })
-                    .collect()
-            })
-            .collect();
-        let knots = KnotVector::clamped_uniform(3, 8).unwrap().knots().to_vec();
-        let s = NurbsSurface::new(3, 3, knots.clone(), knots, ctrl, None).unwrap();
+        let s = crate::closest::wavy_test_surface(10.0, 6.0, 13.0, 17.0);
         let p = SurfaceProjector::new(&s);
         assert!(
             p.wide[0].n > 2,
