@@ -4,7 +4,10 @@
 use crate::allowance::{hub_allowance, HubAllowance};
 use crate::axis_optimisation::{optimise_row_within, OptimisedRow, DEFAULT_W_STEP};
 use crate::conventional_axes::{Posture, PostureBuilder};
-use crate::interference::{core_travel, interfering_count, ClearedRegion, Material, Stroke};
+use crate::interference::{
+    core_travel, interfering_count, travel_of, ClearedRegion, Material, Stroke,
+    INTERFERENCE_TRAVEL_TOL_MM,
+};
 use crate::rows::{plan_rows, stations, ChannelFrame, RowSettings};
 use crate::stock_clearance::StockClearance;
 use crate::toolpath::channel_path;
@@ -278,8 +281,33 @@ impl PlungeRoughing {
             self.params.end_fraction,
         )?;
         lap("rows");
-        let lead_in = (self.params.start_fraction >= 1.0).then(|| (ctx.stock.max_radius(), core));
-        let ms = stations(&frame, &rows, step, lead_in);
+        // The lead-in plunge of every row (beyond the outlet, before any material is cut)
+        // must not drill: its hub point lies outside the blank by the core radius plus a
+        // margin, and its centre disk's whole stroke, from the start above the blank to the
+        // depth, passes through no blank material (the axis leans, so the top of the stroke
+        // can lie inside the blank radius).
+        let blank = Material {
+            stock: ctx.stock,
+            cleared: None,
+        };
+        let lead_in_clear = |m: f64| -> bool {
+            (0..rows.count).all(|j| {
+                let s = rows.s(j, m);
+                let hub = frame.hub_point(m, s);
+                let need = ctx.stock.max_radius() + core + crate::rows::LEAD_IN_MARGIN_MM;
+                hub.x.hypot(hub.y) >= need
+                    && builder.conventional(&frame, m, s).is_ok_and(|p| {
+                        let stroke = strokes(&[vec![p]], radius, core);
+                        travel_of(&stroke, 0, &blank) <= INTERFERENCE_TRAVEL_TOL_MM
+                    })
+            })
+        };
+        let ms = stations(
+            &frame,
+            &rows,
+            step,
+            (self.params.start_fraction >= 1.0).then_some(&lead_in_clear as &dyn Fn(f64) -> bool),
+        );
         // Each position is checked with the fine query; one that misses the allowance
         // (between the row table's stations the interpolated row may approach a blade by
         // more than the search margin) is moved across the channel toward its middle by
@@ -527,6 +555,19 @@ impl Operation for PlungeRoughing {
         let after = interfering_count(&plan.travel_after);
         m.count("interference_positions_before", before * channels);
         m.count("interference_positions_after", after * channels);
+        if self.params.start_fraction >= 1.0 {
+            // The first plunge of every row is the lead-in beyond the outlet: its centre
+            // must not drill (see `plan_section`).
+            let mut k = 0;
+            let mut lead_in: f64 = 0.0;
+            for r in &plan.optimised {
+                if let Some(t) = plan.travel_after.get(k) {
+                    lead_in = lead_in.max(*t);
+                }
+                k += r.postures.len();
+            }
+            m.number("lead_in_max_core_travel_mm", lead_in);
+        }
         m.count("plunges", per_channel * channels);
         m.count("plunges_per_channel", per_channel);
         m.count("rows", rows.len());

@@ -426,29 +426,21 @@ pub fn plan_rows(
 
 /// The stations of a section (outlet → inlet): consecutive hub points of every row at most
 /// `step_mm` apart; with a lead-in beyond the outlet when the section starts there
-/// (`start ≥ 1`), placed where the hub point's radius exceeds the blank radius by the core
-/// radius plus [`LEAD_IN_MARGIN_MM`].
+/// (`start ≥ 1`): the first meridional fraction `m ≥ 1`, in steps of 0.01 along the hub's
+/// tangent extension, where `lead_in_clear(m)` holds (the caller's test that no row's
+/// lead-in plunge drills with its non-cutting centre, see
+/// [`crate::operation::PlungeRoughing::plan_section`]), at most 2 beyond the outlet.
 pub fn stations(
     frame: &ChannelFrame<'_>,
     rows: &SectionRows,
     step_mm: f64,
-    lead_in: Option<(f64, f64)>,
+    lead_in_clear: Option<&dyn Fn(f64) -> bool>,
 ) -> Vec<f64> {
     let mut first = rows.start.min(1.0);
-    if let Some((blank_radius, core)) = lead_in {
-        // Beyond the outlet the hub continues along its tangent: radius grows with m.
-        let need = blank_radius + core + LEAD_IN_MARGIN_MM;
-        let radius = |m: f64| {
-            (0..rows.count)
-                .map(|j| {
-                    let p = frame.hub_point(m, rows.s(j, m));
-                    p.x.hypot(p.y)
-                })
-                .fold(f64::INFINITY, f64::min)
-        };
+    if let Some(clear) = lead_in_clear {
         let mut m = 1.0;
         let mut guard = 0;
-        while radius(m) < need && guard < 200 {
+        while !clear(m) && guard < 200 {
             m += 0.01;
             guard += 1;
         }
