@@ -27,7 +27,13 @@
 //!    ([`super::plan2d`]) with the path interval that leaves
 //!    `scallop_mm` on the level: the exact inverse of the scallop construction of
 //!    [`cam_core::contact`] at the level's largest convex curvature across the channel
-//!    (`κ = N_r / r`), capped by the process' `width_of_cut_mm`.
+//!    (`κ = N_r / r`), capped by the process' `width_of_cut_mm`. That curvature is the
+//!    level's across the flow only; where the paths run obliquely in the developed plane
+//!    (whose metric is exact along the parallels only) the cusps between them can stand a
+//!    little higher. So each level's scallop is measured (`max_scallop_mm` below) and a level
+//!    above the target is planned again with its interval scaled by
+//!    `0.99·√(target / measured)`, at most [`SCALLOP_REPLANS`] times
+//!    (`scallop_replanned_levels` counts them).
 //! 4. **Where the cutter fits.** On each grid section of an area the cutter alone (ball and
 //!    flutes, the tool without shank and holder, [`cam_plan::DesignClearance`] against the
 //!    blades) must keep `fit_min = blade_allowance − machining_tol/2` from the true blades
@@ -114,6 +120,14 @@ const SEGMENT_QUERIES: usize = 384;
 
 /// Largest spacing of path points along the flow (mm) when the chord rule allows more.
 const MAX_POINT_SPACING_MM: f64 = 1.0;
+
+/// How many times a level is planned again with a narrower path interval when its measured
+/// scallop exceeds the target (module docs, step 3).
+pub const SCALLOP_REPLANS: usize = 3;
+/// Factor applied to the interval correction `√(target / measured)` of a re-plan, so that
+/// the next measurement lands below the target rather than on it (the scallop of a ball
+/// grows about with the square of the step-over).
+pub const SCALLOP_REPLAN_MARGIN: f64 = 0.99;
 
 /// Grid of scallop measurement per area and level (along × across the flow).
 const SCALLOP_GRID: (usize, usize) = (40, 16);
@@ -599,7 +613,18 @@ impl ChannelRoughing {
             },
         };
         let fit_min = ctx.process.blade_allowance_mm - 0.5 * ctx.tolerances.machining_tol;
-        let levels: Vec<Result<LevelPlan, PlanError>> = (1..=n_levels)
+        let blades_only = ctx.clearance.with_options(ClearanceOptions {
+            parts: PartSet {
+                hub: false,
+                blades: true,
+                shroud: false,
+            },
+            ..ClearanceOptions::default()
+        });
+        // Each level planned, located and measured; a level whose measured scallop exceeds
+        // the target is planned again with its path interval narrowed (module docs, step 3).
+        let target = self.params.scallop_mm;
+        let planned: Vec<Result<(LevelPlan, LevelCl, usize), PlanError>> = (1..=n_levels)
             .into_par_iter()
             .map(|j| {
                 let at = |j: usize| {
@@ -609,28 +634,34 @@ impl ChannelRoughing {
                     };
                     depth_level(imp, spacing).map_err(|e| PlanError::model(&self.name, e))
                 };
-                let level = at(j)?;
+                let mut level = at(j)?;
                 let above = if j > 1 { Some(at(j - 1)?) } else { None };
-                let bounds = level_bounds((&level, above.as_ref()))?;
-                self.plan_level(ctx, j, level, bounds, &fit, fit_min)
+                let mut bounds = level_bounds((&level, above.as_ref()))?;
+                let mut scale = 1.0;
+                let mut replans = 0;
+                loop {
+                    let lp = self.plan_level(ctx, j, level, bounds, &fit, fit_min, scale)?;
+                    let lc =
+                        self.locate_level(ctx, &lp, &lp.bounds, &blades_only, &fit, fit_min, doc)?;
+                    if lc.max_scallop <= target || replans == SCALLOP_REPLANS {
+                        return Ok((lp, lc, replans));
+                    }
+                    scale *= (target / lc.max_scallop).sqrt() * SCALLOP_REPLAN_MARGIN;
+                    replans += 1;
+                    level = lp.level;
+                    bounds = lp.bounds;
+                }
             })
             .collect();
-        let levels: Vec<LevelPlan> = levels.into_iter().collect::<Result<_, _>>()?;
-
-        // Cutter locations, level by level.
-        let blades_only = ctx.clearance.with_options(ClearanceOptions {
-            parts: PartSet {
-                hub: false,
-                blades: true,
-                shroud: false,
-            },
-            ..ClearanceOptions::default()
-        });
-        let per_level: Vec<Result<LevelCl, PlanError>> = levels
-            .par_iter()
-            .map(|lp| self.locate_level(ctx, lp, &lp.bounds, &blades_only, &fit, fit_min, doc))
-            .collect();
-        let per_level: Vec<LevelCl> = per_level.into_iter().collect::<Result<_, _>>()?;
+        let mut levels: Vec<LevelPlan> = Vec::with_capacity(n_levels);
+        let mut per_level: Vec<LevelCl> = Vec::with_capacity(n_levels);
+        let mut replanned_levels = 0;
+        for r in planned {
+            let (lp, lc, replans) = r?;
+            levels.push(lp);
+            per_level.push(lc);
+            replanned_levels += usize::from(replans > 0);
+        }
 
         // One channel's path, levels shroud → hub, areas in order, linked over the safety
         // surface between areas.
@@ -687,6 +718,7 @@ impl ChannelRoughing {
             )
             .number("max_scallop_mm", max_scallop)
             .number("scallop_target_mm", self.params.scallop_mm)
+            .count("scallop_replanned_levels", replanned_levels)
             .count("levels", n_levels)
             .count("paths", n_paths * count)
             .number("min_blade_clearance_mm", min_clear)
@@ -734,6 +766,7 @@ impl ChannelRoughing {
         bounds: Vec<Bound>,
         fit: &FitQuery<'_>,
         fit_min: f64,
+        step_scale: f64,
     ) -> Result<LevelPlan, PlanError> {
         let place = |b: &Bound| format!("level {j}, {}", b.label);
         let mut curves = Vec::with_capacity(bounds.len());
@@ -775,7 +808,7 @@ impl ChannelRoughing {
             }
             curves.push(tab[best.0..best.1].to_vec());
         }
-        let step = self.interval(ctx, &level)?;
+        let step = self.interval(ctx, &level)? * step_scale;
         let spacing = (8.0 * min_radius(&level) * ctx.tolerances.chord_tol)
             .sqrt()
             .min(MAX_POINT_SPACING_MM);
