@@ -758,6 +758,7 @@ impl ChannelRoughing {
         })
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn plan_level(
         &self,
         ctx: &PlanContext<'_>,
