@@ -75,6 +75,12 @@
 //! Metrics: `path_length_mm` (pipeline), `triangle_path_length_mm` and
 //! `isoparametric_path_length_mm` (cutting paths of all channels, measured in space on the
 //! levels; the baseline over the same lanes), `saving_ratio = 1 − triangle / isoparametric`,
+//! `isoparametric_channel_path_length_mm` and `saving_ratio_whole_channel` (the baseline
+//! taken over the whole channel instead: paths of constant fraction between the two main
+//! blades' offset sides from inlet to outlet, as many as the channel's widest section needs,
+//! kept where they run inside a planned lane, [`plan2d::clip_to_regions`]; with a splitter
+//! it differs from the per-lane baseline both ways: denser upstream of the splitter, none
+//! where a path runs into the splitter or an unmachinable strip),
 //! `max_scallop_mm` (measured over the machinable region: rays along the level normal from a
 //! grid of points of every lane to the first cutter position of the level, the cutters taken
 //! at the emitted locations of every lane of the level densified to a sixteenth of the ball
@@ -262,6 +268,8 @@ struct LevelPlan {
     bounds: Vec<Bound>,
     fields: Vec<Field>,
     areas: Vec<AreaPlan>,
+    /// The whole-channel isoparametric baseline, clipped to the planned lanes.
+    channel_iso: Vec<Path2>,
     /// Developed area between the offset ruled sides (mm²).
     area_mm2: f64,
     /// Developed area of the planned lanes (mm²).
@@ -669,6 +677,7 @@ impl ChannelRoughing {
         let mut last: Option<CutterLocation> = None;
         let mut tri_len = 0.0;
         let mut iso_len = 0.0;
+        let mut channel_iso_len = 0.0;
         let mut min_clear = f64::INFINITY;
         let mut max_scallop: f64 = 0.0;
         let mut n_paths = 0usize;
@@ -681,6 +690,7 @@ impl ChannelRoughing {
         for lc in &per_level {
             tri_len += lc.tri_len;
             iso_len += lc.iso_len;
+            channel_iso_len += lc.channel_iso_len;
             min_clear = min_clear.min(lc.min_blade_clearance);
             max_scallop = max_scallop.max(lc.max_scallop);
             n_paths += lc.paths;
@@ -712,6 +722,15 @@ impl ChannelRoughing {
                 "saving_ratio",
                 if iso_len > 0.0 {
                     1.0 - tri_len / iso_len
+                } else {
+                    0.0
+                },
+            )
+            .number("isoparametric_channel_path_length_mm", channel_iso_len * k)
+            .number(
+                "saving_ratio_whole_channel",
+                if channel_iso_len > 0.0 {
+                    1.0 - tri_len / channel_iso_len
                 } else {
                     0.0
                 },
@@ -903,11 +922,44 @@ impl ChannelRoughing {
             }
             fields.push(field);
         }
+        // The isoparametric baseline over the whole channel (module docs, metrics): paths of
+        // constant fraction between the two main blades' offset sides from inlet to outlet,
+        // as many as the widest section needs, kept where they run inside a planned lane.
+        let mut channel_iso = Vec::new();
+        if s_hi > s_lo {
+            let n = (((s_hi - s_lo) / spacing).ceil() as usize).max(2) + 1;
+            let s: Vec<f64> = (0..n)
+                .map(|i| s_lo + (s_hi - s_lo) * i as f64 / (n - 1) as f64)
+                .collect();
+            let left = tabulate(&curves[0], &s, 0, &level);
+            let mut right = tabulate(&curves[1], &s, 1, &level);
+            let tau = std::f64::consts::TAU;
+            for ((ry, ly), &si) in right.y.iter_mut().zip(&left.y).zip(&s) {
+                let turn = tau * level.radius_at(si);
+                *ry = ly + (*ry - ly + 0.5 * turn).rem_euclid(turn) - 0.5 * turn;
+            }
+            let right_y: Vec<f64> = right
+                .y
+                .iter()
+                .zip(&left.y)
+                .map(|(r, l)| r.max(*l))
+                .collect();
+            let whole = Region {
+                s,
+                left: left.y,
+                right: right_y,
+            };
+            let paths = plan2d::isoparametric(&whole, step)
+                .map_err(|e| self.geo(format!("level {j}, whole channel"), e.to_string()))?;
+            let lanes: Vec<&Region> = areas.iter().map(|a| &a.region).collect();
+            channel_iso = plan2d::clip_to_regions(paths, &lanes);
+        }
         Ok(LevelPlan {
             level,
             bounds,
             fields,
             areas,
+            channel_iso,
             area_mm2,
             planned_mm2,
         })
@@ -1067,6 +1119,8 @@ struct LevelCl {
     moves: Vec<Vec<Move>>,
     tri_len: f64,
     iso_len: f64,
+    /// Length of the whole-channel isoparametric baseline (mm).
+    channel_iso_len: f64,
     min_blade_clearance: f64,
     max_scallop: f64,
     paths: usize,
@@ -1229,6 +1283,7 @@ impl ChannelRoughing {
             moves: Vec::new(),
             tri_len: 0.0,
             iso_len: 0.0,
+            channel_iso_len: 0.0,
             min_blade_clearance: f64::INFINITY,
             max_scallop: 0.0,
             paths: 0,
@@ -1427,6 +1482,12 @@ impl ChannelRoughing {
                 out.iso_len += polyline_len(path.iter().map(|&q| axes.point_of(q).0));
             }
             out.moves.extend(chunks);
+        }
+        for path in &lp.channel_iso {
+            out.channel_iso_len += polyline_len(
+                path.iter()
+                    .map(|q| lv.at_developed(q[0], q[1] / lv.radius_at(q[0])).0),
+            );
         }
         // The scallop of every lane (its machinable region), against every cutter position
         // of the level.

@@ -156,6 +156,43 @@ pub fn isoparametric(region: &Region, step: f64) -> Result<Vec<Path2>, Plan2dErr
         .collect())
 }
 
+/// Tolerance (mm) of [`clip_to_regions`]' membership test across the flow: grid points of
+/// a path on a region's boundary count as inside.
+pub const CLIP_TOL_MM: f64 = 1e-9;
+
+/// The parts of `paths` that run inside the union of `regions`: maximal runs of consecutive
+/// path points each inside some region (between its boundaries, within its `s` range); runs
+/// of fewer than two points are dropped. A run ends at the last point inside, so each cut
+/// shortens a path by less than one grid spacing. O(points × regions).
+pub fn clip_to_regions(paths: Vec<Path2>, regions: &[&Region]) -> Vec<Path2> {
+    let inside = |q: &[f64; 2]| {
+        regions.iter().any(|r| match (r.s.first(), r.s.last()) {
+            (Some(&a), Some(&b)) if q[0] >= a && q[0] <= b => {
+                let (l, rr) = r.bounds(q[0]);
+                q[1] >= l - CLIP_TOL_MM && q[1] <= rr + CLIP_TOL_MM
+            }
+            _ => false,
+        })
+    };
+    let mut out = Vec::new();
+    for p in paths {
+        let mut cur: Path2 = Vec::new();
+        for q in p {
+            if inside(&q) {
+                cur.push(q);
+            } else if cur.len() >= 2 {
+                out.push(std::mem::take(&mut cur));
+            } else {
+                cur.clear();
+            }
+        }
+        if cur.len() >= 2 {
+            out.push(cur);
+        }
+    }
+    out
+}
+
 fn check_step(step: f64) -> Result<(), Plan2dError> {
     if step.is_finite() && step > 0.0 {
         Ok(())
@@ -347,6 +384,34 @@ pub fn length(paths: &[Path2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clip_keeps_the_runs_inside_the_union_of_regions() {
+        // Two regions side by side along s: [0, 4] × y ∈ [0, 2] and [4, 8] × y ∈ [1, 3].
+        let a = Region {
+            s: vec![0.0, 4.0],
+            left: vec![0.0, 0.0],
+            right: vec![2.0, 2.0],
+        };
+        let b = Region {
+            s: vec![4.0, 8.0],
+            left: vec![1.0, 1.0],
+            right: vec![3.0, 3.0],
+        };
+        let line = |y: f64| -> Path2 { (0..=8).map(|i| [i as f64, y]).collect() };
+        // y = 1.5 lies in both: one run over the whole length; y = 0.5 only in the first
+        // (points s = 0..4); y = 2.5 only in the second (s = 4..8); y = 5 in neither.
+        let out = clip_to_regions(vec![line(1.5), line(0.5), line(2.5), line(5.0)], &[&a, &b]);
+        assert_eq!(out.len(), 3);
+        assert_eq!(out[0].len(), 9);
+        assert_eq!((out[1][0][0], out[1].last().unwrap()[0]), (0.0, 4.0));
+        assert_eq!((out[2][0][0], out[2].last().unwrap()[0]), (4.0, 8.0));
+        // A path that leaves the region ends its run there; a run of one point (the return
+        // at s = 3) is dropped.
+        let zig: Path2 = vec![[0.0, 1.0], [1.0, 1.0], [2.0, 9.0], [3.0, 1.0], [4.0, 9.0]];
+        let out = clip_to_regions(vec![zig], &[&a]);
+        assert_eq!(out, vec![vec![[0.0, 1.0], [1.0, 1.0]]]);
+    }
 
     /// A channel widening from 3 mm at the inlet to 20 mm at the outlet, with a wavy centre.
     fn channel() -> Region {
