@@ -36,8 +36,10 @@
 //! job writes **one `plunge_roughing` operation per section**, each with its own `tool`:
 //! - `start_fraction` (default 1 = the outlet): the meridional fraction of the hub contour
 //!   where the section's rows begin. At the outlet each row begins with a lead-in plunge off
-//!   the blank, placed where its centre disk's whole stroke stays out of the blank, so no
-//!   plunge ever drills with its centre. A later section starts where the
+//!   the blank, placed where its centre disk's whole stroke stays out of the blank; a later
+//!   section's rows begin inside what the previous section cleared, toward the outlet from
+//!   its start until the first plunges' centre disks meet no material. So no row's first
+//!   plunge drills with its centre. A later section starts where the
 //!   previous one ended (its `section_end_fraction` metric), or a little toward the outlet
 //!   from there; everything toward the outlet from its start counts as already roughed by
 //!   the previous section (the interference metric's *cleared region*).
@@ -64,8 +66,8 @@
 //! `interference_positions_before` / `_after` (all channels), `alpha_monotone`,
 //! `hub_allowance_max_mm` / `_mean_mm` (final axes; `_before_` versions for the conventional
 //! axes), `plunges`, plus `plunges_per_channel`, `rows`, `stations`, `interference_share_*`,
-//! `max_core_travel_*_mm`, `lead_in_max_core_travel_mm` (sections from the outlet: the lead-in
-//! plunges' centre travel, 0 when none drills), `min_blade_clearance_mm`, `section_start_fraction`,
+//! `max_core_travel_*_mm`, `first_plunge_max_core_travel_mm` (the first plunge of every row:
+//! its centre travel, 0 when none drills), `min_blade_clearance_mm`, `section_start_fraction`,
 //! `section_end_fraction`, `axes_moved_per_channel`, `axes_kept_for_clearance_per_channel`
 //! (plunges whose α-raising move would break the blade allowance keep their conventional
 //! axis), `positions_skipped_for_stock_per_channel` (plunges left out because shank or holder

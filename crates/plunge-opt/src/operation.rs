@@ -281,33 +281,35 @@ impl PlungeRoughing {
             self.params.end_fraction,
         )?;
         lap("rows");
-        // The lead-in plunge of every row (beyond the outlet, before any material is cut)
-        // must not drill: its hub point lies outside the blank by the core radius plus a
-        // margin, and its centre disk's whole stroke, from the start above the blank to the
-        // depth, passes through no blank material (the axis leans, so the top of the stroke
-        // can lie inside the blank radius).
-        let blank = Material {
+        // What the strokes run through: the stock, less what an earlier section cleared when
+        // this one starts inside the channel (the interference metric's material).
+        let material = Material {
             stock: ctx.stock,
-            cleared: None,
+            cleared: (self.params.start_fraction < 1.0).then(|| ClearedRegion {
+                hub: impeller.hub().meridional(),
+                fraction: self.params.start_fraction,
+            }),
         };
-        let lead_in_clear = |m: f64| -> bool {
+        // The first plunge of every row must not drill: its centre disk's whole stroke, from
+        // the start above the stock to the depth, passes through no material (the axis leans,
+        // so the top of the stroke can reach material its hub point is clear of). At the
+        // outlet it is a lead-in beyond the outlet whose hub point also lies outside the
+        // blank by the core radius plus a margin; inside the channel (a later section) it is
+        // moved toward the outlet into what the previous section cleared.
+        let at_outlet = self.params.start_fraction >= 1.0;
+        let first_clear = |m: f64| -> bool {
             (0..rows.count).all(|j| {
                 let s = rows.s(j, m);
                 let hub = frame.hub_point(m, s);
                 let need = ctx.stock.max_radius() + core + crate::rows::LEAD_IN_MARGIN_MM;
-                hub.x.hypot(hub.y) >= need
+                (!at_outlet || hub.x.hypot(hub.y) >= need)
                     && builder.conventional(&frame, m, s).is_ok_and(|p| {
                         let stroke = strokes(&[vec![p]], radius, core);
-                        travel_of(&stroke, 0, &blank) <= INTERFERENCE_TRAVEL_TOL_MM
+                        travel_of(&stroke, 0, &material) <= INTERFERENCE_TRAVEL_TOL_MM
                     })
             })
         };
-        let ms = stations(
-            &frame,
-            &rows,
-            step,
-            (self.params.start_fraction >= 1.0).then_some(&lead_in_clear as &dyn Fn(f64) -> bool),
-        );
+        let ms = stations(&frame, &rows, step, &first_clear);
         // Each position is checked with the fine query; one that misses the allowance
         // (between the row table's stations the interpolated row may approach a blade by
         // more than the search margin) is moved across the channel toward its middle by
@@ -475,13 +477,6 @@ impl PlungeRoughing {
             ));
         }
         lap("stock_clearance_check");
-        let material = Material {
-            stock: ctx.stock,
-            cleared: (self.params.start_fraction < 1.0).then(|| ClearedRegion {
-                hub: impeller.hub().meridional(),
-                fraction: self.params.start_fraction,
-            }),
-        };
         let before = strokes(&conventional, radius, core);
         let final_rows: Vec<Vec<Posture>> = optimised.iter().map(|r| r.postures.clone()).collect();
         let after = strokes(&final_rows, radius, core);
@@ -555,19 +550,17 @@ impl Operation for PlungeRoughing {
         let after = interfering_count(&plan.travel_after);
         m.count("interference_positions_before", before * channels);
         m.count("interference_positions_after", after * channels);
-        if self.params.start_fraction >= 1.0 {
-            // The first plunge of every row is the lead-in beyond the outlet: its centre
-            // must not drill (see `plan_section`).
-            let mut k = 0;
-            let mut lead_in: f64 = 0.0;
-            for r in &plan.optimised {
-                if let Some(t) = plan.travel_after.get(k) {
-                    lead_in = lead_in.max(*t);
-                }
-                k += r.postures.len();
+        // The first plunge of every row (the lead-in beyond the outlet, or the first plunge
+        // inside what the previous section cleared) must not drill (see `plan_section`).
+        let mut k = 0;
+        let mut first: f64 = 0.0;
+        for r in &plan.optimised {
+            if let Some(t) = plan.travel_after.get(k) {
+                first = first.max(*t);
             }
-            m.number("lead_in_max_core_travel_mm", lead_in);
+            k += r.postures.len();
         }
+        m.number("first_plunge_max_core_travel_mm", first);
         m.count("plunges", per_channel * channels);
         m.count("plunges_per_channel", per_channel);
         m.count("rows", rows.len());

@@ -425,26 +425,22 @@ pub fn plan_rows(
 }
 
 /// The stations of a section (outlet → inlet): consecutive hub points of every row at most
-/// `step_mm` apart; with a lead-in beyond the outlet when the section starts there
-/// (`start ≥ 1`): the first meridional fraction `m ≥ 1`, in steps of 0.01 along the hub's
-/// tangent extension, where `lead_in_clear(m)` holds (the caller's test that no row's
-/// lead-in plunge drills with its non-cutting centre, see
-/// [`crate::operation::PlungeRoughing::plan_section`]), at most 2 beyond the outlet.
+/// `step_mm` apart. The first station is the first meridional fraction `m ≥ start` (start
+/// clamped to the outlet, 1), in steps of 0.01 toward the outlet (beyond it along the hub's
+/// tangent extension), where `first_clear(m)` holds: the caller's test that no row's first
+/// plunge drills with its non-cutting centre (see
+/// [`crate::operation::PlungeRoughing::plan_section`]); at most 2 beyond the start.
 pub fn stations(
     frame: &ChannelFrame<'_>,
     rows: &SectionRows,
     step_mm: f64,
-    lead_in_clear: Option<&dyn Fn(f64) -> bool>,
+    first_clear: &dyn Fn(f64) -> bool,
 ) -> Vec<f64> {
     let mut first = rows.start.min(1.0);
-    if let Some(clear) = lead_in_clear {
-        let mut m = 1.0;
-        let mut guard = 0;
-        while !clear(m) && guard < 200 {
-            m += 0.01;
-            guard += 1;
-        }
-        first = m;
+    let mut guard = 0;
+    while !first_clear(first) && guard < 200 {
+        first += 0.01;
+        guard += 1;
     }
     let dist = |a: f64, b: f64| {
         (0..rows.count)
