@@ -54,8 +54,9 @@ pub struct OptimisedRow {
     pub w_curve: Option<NurbsCurve<3>>,
     /// The discretisation step used.
     pub step: f64,
-    /// Plunges whose smallest α-raising move would break the blade allowance and that kept
-    /// their conventional axis.
+    /// Plunges whose smallest α-raising move was not admissible (it would break the blade
+    /// allowance, or make the centre disk run into more material) and that kept their
+    /// conventional axis.
     pub kept_for_clearance: usize,
 }
 
@@ -123,21 +124,23 @@ pub fn optimise_row(
     step: f64,
     operation: &str,
 ) -> Result<OptimisedRow, PlanError> {
-    optimise_row_within(builder, row, step, operation, &|_| true)
+    optimise_row_within(builder, row, step, operation, &|_, _, _| true)
 }
 
-/// [`optimise_row`] where a moved posture must also pass `admissible` (the blade allowance
-/// of cutter, shank and holder): the smallest move that makes α rise is taken only when the
-/// posture it gives is admissible; otherwise the plunge keeps its conventional axis (placed
-/// clear of the blades by the row planner), the row is not monotone there, and the position
-/// is counted in [`OptimisedRow::kept_for_clearance`]. Checks cost one clearance query per
-/// moved plunge.
+/// [`optimise_row`] where a moved posture must also pass `admissible(moved, unmoved,
+/// before)` (`unmoved` the plunge as given, `before` the plunges before it as optimised so
+/// far; e.g. the blade allowance of cutter, shank and holder, and that the move does not
+/// make its centre disk run into more material): the smallest move that makes α rise is
+/// taken only when the posture it gives is admissible; otherwise the plunge keeps its
+/// conventional axis (placed clear of the blades by the row planner), the row is not
+/// monotone there, and the position is counted in [`OptimisedRow::kept_for_clearance`].
+/// Checks run once per moved plunge.
 pub fn optimise_row_within(
     builder: &PostureBuilder<'_>,
     row: &[Posture],
     step: f64,
     operation: &str,
-    admissible: &(dyn Fn(&Posture) -> bool + Sync),
+    admissible: &(dyn Fn(&Posture, &Posture, &[Posture]) -> bool + Sync),
 ) -> Result<OptimisedRow, PlanError> {
     let alpha_before: Vec<f64> = row.iter().map(|p| p.alpha).collect();
     if row.len() < 2 {
@@ -193,7 +196,7 @@ pub fn optimise_row_within(
         match found {
             Some((k, w, s)) => {
                 let moved = builder.through(p.m, p.s, p.centre, w, Some(s))?;
-                if admissible(&moved) {
+                if admissible(&moved, &row[i], &postures[..i]) {
                     postures[i] = moved;
                     moves[i] = Some((k, k0));
                 } else {

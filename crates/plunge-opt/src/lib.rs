@@ -49,6 +49,7 @@
 //! Other keys: `w_curve_step` (1e-5), `optimise_axes` (true), `start_clearance_mm` (2),
 //! `row_table_stations` (12), `first_channel` (0). From the process row: `width_of_cut_mm`
 //! is the largest lateral gap between rows and `depth_of_cut_mm` the plunge step along a row
+//! (at the hub and at the strokes' starts)
 //! (both default to 0.8 × the cutting-edge length and must stay below it),
 //! `blade_allowance_mm`, `hub_allowance_mm`, the plunge feed.
 //!
@@ -69,8 +70,9 @@
 //! `max_core_travel_*_mm`, `first_plunge_max_core_travel_mm` (the first plunge of every row:
 //! its centre travel, 0 when none drills), `min_blade_clearance_mm`, `section_start_fraction`,
 //! `section_end_fraction`, `axes_moved_per_channel`, `axes_kept_for_clearance_per_channel`
-//! (plunges whose α-raising move would break the blade allowance keep their conventional
-//! axis), `positions_skipped_for_stock_per_channel` (plunges left out because shank or holder
+//! (plunges whose α-raising move would break the blade allowance, or would make the centre
+//! disk run into more material than the conventional axis, keep their conventional axis),
+//! `positions_skipped_for_stock_per_channel` (plunges left out because shank or holder
 //! would enter the stock; every plunge of a section → an error asking for a turned stock or a
 //! longer stick-out), `row_rapids_over_safety_surface_per_channel` (in-row rapids that would
 //! not keep the tool out of the stock and go over the safety surface). With one operation per section these

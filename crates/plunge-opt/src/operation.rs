@@ -309,7 +309,13 @@ impl PlungeRoughing {
                     })
             })
         };
-        let ms = stations(&frame, &rows, step, &first_clear);
+        let start_point = |j: usize, m: f64| {
+            builder
+                .conventional(&frame, m, rows.s(j, m))
+                .ok()
+                .map(|p| p.start.tip.coords)
+        };
+        let ms = stations(&frame, &rows, step, &first_clear, &start_point);
         // Each position is checked with the fine query; one that misses the allowance
         // (between the row table's stations the interpolated row may approach a blade by
         // more than the search margin) is moved across the channel toward its middle by
@@ -397,9 +403,23 @@ impl PlungeRoughing {
             conventional
                 .par_iter()
                 .map(|row| {
-                    optimise_row_within(&builder, row, self.params.w_curve_step, op, &|p| {
-                        blades.clearance(&p.cl).distance_mm >= required
-                    })
+                    // A moved axis must keep the blade allowance, and the move must not
+                    // make its centre disk run into more material than without it, counting
+                    // the row's earlier plunges as optimised (a large move of W turns the
+                    // axis by degrees: the centre disk can leave the previous hole on the
+                    // way down). The next plunge is judged when its own turn comes.
+                    let admissible = |p: &Posture, unmoved: &Posture, before: &[Posture]| {
+                        if blades.clearance(&p.cl).distance_mm < required {
+                            return false;
+                        }
+                        let travel = |this: &Posture| {
+                            let mut list = before.to_vec();
+                            list.push(*this);
+                            travel_of(&strokes(&[list], radius, core), before.len(), &material)
+                        };
+                        travel(p) <= travel(unmoved).max(INTERFERENCE_TRAVEL_TOL_MM)
+                    };
+                    optimise_row_within(&builder, row, self.params.w_curve_step, op, &admissible)
                 })
                 .collect::<Result<_, _>>()?
         } else {

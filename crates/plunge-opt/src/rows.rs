@@ -424,17 +424,26 @@ pub fn plan_rows(
     })
 }
 
-/// The stations of a section (outlet → inlet): consecutive hub points of every row at most
-/// `step_mm` apart. The first station is the first meridional fraction `m ≥ start` (start
-/// clamped to the outlet, 1), in steps of 0.01 toward the outlet (beyond it along the hub's
-/// tangent extension), where `first_clear(m)` holds: the caller's test that no row's first
-/// plunge drills with its non-cutting centre (see
+/// The stations of a section (outlet → inlet): consecutive plunges of every row at most
+/// `step_mm` apart both at the hub and at the start of their strokes (`start_point(j, m)`:
+/// where row `j`'s plunge at `m` starts, `None` when unknown). A plunge's centre disk stays
+/// inside the previous plunge's hole along the whole stroke when both ends are that close
+/// (the distance between corresponding points of two lines is convex along them, so its
+/// largest value is at an end; `step_mm` is below the cutting-edge length `R − r_core`).
+/// Where the axes turn between stations (near-radial strokes at the inlet), the start points
+/// spread further than the hub points and set the spacing.
+///
+/// The first station is the first meridional fraction `m ≥ start` (start clamped to the
+/// outlet, 1), in steps of 0.01 toward the outlet (beyond it along the hub's tangent
+/// extension), where `first_clear(m)` holds: the caller's test that no row's first plunge
+/// drills with its non-cutting centre (see
 /// [`crate::operation::PlungeRoughing::plan_section`]); at most 2 beyond the start.
 pub fn stations(
     frame: &ChannelFrame<'_>,
     rows: &SectionRows,
     step_mm: f64,
     first_clear: &dyn Fn(f64) -> bool,
+    start_point: &dyn Fn(usize, f64) -> Option<cam_core::Vector3>,
 ) -> Vec<f64> {
     let mut first = rows.start.min(1.0);
     let mut guard = 0;
@@ -442,22 +451,37 @@ pub fn stations(
         first += 0.01;
         guard += 1;
     }
-    let dist = |a: f64, b: f64| {
+    // The points of station `m` (hub and stroke start per row), computed once per station.
+    let points = |m: f64| -> Vec<(cam_core::Vector3, Option<cam_core::Vector3>)> {
         (0..rows.count)
-            .map(|j| (frame.hub_point(a, rows.s(j, a)) - frame.hub_point(b, rows.s(j, b))).norm())
+            .map(|j| (frame.hub_point(m, rows.s(j, m)), start_point(j, m)))
+            .collect()
+    };
+    let dist = |a: &[(cam_core::Vector3, Option<cam_core::Vector3>)], b: f64| {
+        a.iter()
+            .enumerate()
+            .map(|(j, (hub, top))| {
+                let d_hub = (hub - frame.hub_point(b, rows.s(j, b))).norm();
+                let d_top = match (top, start_point(j, b)) {
+                    (Some(x), Some(y)) => (x - y).norm(),
+                    _ => 0.0,
+                };
+                d_hub.max(d_top)
+            })
             .fold(0.0, f64::max)
     };
     let mut out = vec![first];
     let mut m = first;
     while m > rows.end {
-        if dist(m, rows.end) <= step_mm {
+        let here = points(m);
+        if dist(&here, rows.end) <= step_mm {
             out.push(rows.end);
             break;
         }
         let (mut lo, mut hi) = (rows.end, m);
         for _ in 0..M_BISECTIONS {
             let mid = 0.5 * (lo + hi);
-            if dist(m, mid) > step_mm {
+            if dist(&here, mid) > step_mm {
                 lo = mid;
             } else {
                 hi = mid;

@@ -88,7 +88,7 @@ fn zigzag_row_becomes_monotone_with_smallest_moves() {
     // With a blade-allowance check that refuses every moved posture, each plunge that would
     // move keeps its conventional axis and is counted; one that refuses only the second
     // moved plunge keeps the first move.
-    let none = optimise_row_within(&builder, &row, 1e-5, "test", &|_| false).unwrap();
+    let none = optimise_row_within(&builder, &row, 1e-5, "test", &|_, _, _| false).unwrap();
     assert_eq!(none.kept_for_clearance, moved);
     assert!(none.moves.iter().all(Option::is_none));
     for i in 0..row.len() {
@@ -97,7 +97,7 @@ fn zigzag_row_becomes_monotone_with_smallest_moves() {
     assert!(!none.monotone);
     let first = opt.moves.iter().position(Option::is_some).unwrap();
     let keep_first =
-        optimise_row_within(&builder, &row, 1e-5, "test", &|p| p.m == row[first].m).unwrap();
+        optimise_row_within(&builder, &row, 1e-5, "test", &|p, _, _| p.m == row[first].m).unwrap();
     assert_eq!(keep_first.postures[first].cl, opt.postures[first].cl);
     assert!(keep_first.kept_for_clearance >= 1);
 }
