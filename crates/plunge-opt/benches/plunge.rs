@@ -45,7 +45,10 @@ fn depth(c: &mut Criterion) {
 fn channel(c: &mut Criterion) {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/impeller-plunge-400");
     let impeller = impeller_model::load(root.join("impeller.toml")).expect("fixture");
-    let stock = impeller.stock().clone();
+    // The stock of `job-plunge.toml`: the blank turned to the shroud contour (from the
+    // uncut blank most plunges of the section are refused by the stock check, and planning
+    // measures mostly that).
+    let stock = impeller.turned_stock(0.0).expect("turned stock");
     let mut cutter = Cutter::new(
         "plunge-d30",
         CutterShape::FlatEnd { radius: 15.0 },

@@ -177,6 +177,39 @@ impl<'a> PostureBuilder<'a> {
         })
     }
 
+    /// The top of the conventional stroke on the axis line through `centre` and `w`, cheaply:
+    /// the point of the line at `w` or, if that lies in the stock, where the line leaves it
+    /// (walking up in [`STOCK_EXIT_STEP_MM`] steps, then bisecting to 1e-3 mm; at most the
+    /// stock's extent). A proxy of the posture's start for spacing the stations (no contact
+    /// solve; the start itself is that height or the disk's exit, plus the clearance).
+    pub fn stroke_top(&self, centre: &Vector3, w: &Vector3) -> Vector3 {
+        let d = w - centre;
+        let len = d.norm();
+        let Some(q) = d.try_normalize(1e-12) else {
+            return *w;
+        };
+        let inside = |t: f64| self.stock.contains(&(centre + q * t));
+        if !inside(len) {
+            return *w;
+        }
+        let (z0, z1) = self.stock.z_range();
+        let reach = len + (z1 - z0) + 2.0 * self.stock.max_radius();
+        let (mut lo, mut hi) = (len, len + STOCK_EXIT_STEP_MM);
+        while inside(hi) && hi < reach {
+            lo = hi;
+            hi += STOCK_EXIT_STEP_MM;
+        }
+        while hi - lo > 1e-3 {
+            let mid = 0.5 * (lo + hi);
+            if inside(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        centre + q * hi
+    }
+
     /// Smallest axial position `≥ from` where the bottom disk (full radius) at `centre + t·q`
     /// lies outside the blank (centre and [`STOCK_EXIT_RIM_SAMPLES`] rim points), walking up in
     /// [`STOCK_EXIT_STEP_MM`] steps then bisecting to 1e-6 mm.

@@ -310,10 +310,8 @@ impl PlungeRoughing {
             })
         };
         let start_point = |j: usize, m: f64| {
-            builder
-                .conventional(&frame, m, rows.s(j, m))
-                .ok()
-                .map(|p| p.start.tip.coords)
+            let s = rows.s(j, m);
+            Some(builder.stroke_top(&frame.hub_point(m, s), &frame.shroud_point(m, s)))
         };
         let ms = stations(&frame, &rows, step, &first_clear, &start_point);
         // Each position is checked with the fine query; one that misses the allowance

@@ -59,6 +59,10 @@ pub const FINAL_CHECK_SAMPLE_TOL_MM: f64 = 0.1;
 pub const CLEARANCE_MARGIN_MM: f64 = 0.3;
 /// Bisection steps on `m` for station spacing and the section end (2⁻³⁰ of the range).
 pub const M_BISECTIONS: usize = 30;
+/// Smallest advance of a station spaced by its strokes' starts, as a fraction of the advance
+/// the hub spacing allows: below it the start points jump between the stations (see
+/// [`stations`]) and the hub spacing is kept.
+pub const MIN_STATION_ADVANCE: f64 = 0.05;
 /// Margin (mm) by which the lead-in plunge's core disk clears the blank radius.
 pub const LEAD_IN_MARGIN_MM: f64 = 1.0;
 
@@ -431,7 +435,10 @@ pub fn plan_rows(
 /// (the distance between corresponding points of two lines is convex along them, so its
 /// largest value is at an end; `step_mm` is below the cutting-edge length `R − r_core`).
 /// Where the axes turn between stations (near-radial strokes at the inlet), the start points
-/// spread further than the hub points and set the spacing.
+/// spread further than the hub points and set the spacing; where they jump (the stroke's top
+/// moves to another face of a non-convex stock) the hub spacing is kept
+/// ([`MIN_STATION_ADVANCE`]). The start points come from `start_point`, a cheap proxy (e.g.
+/// [`crate::conventional_axes::PostureBuilder::stroke_top`]).
 ///
 /// The first station is the first meridional fraction `m ≥ start` (start clamped to the
 /// outlet, 1), in steps of 0.01 toward the outlet (beyond it along the hub's tangent
@@ -457,37 +464,55 @@ pub fn stations(
             .map(|j| (frame.hub_point(m, rows.s(j, m)), start_point(j, m)))
             .collect()
     };
-    let dist = |a: &[(cam_core::Vector3, Option<cam_core::Vector3>)], b: f64| {
+    // Largest distance from station `a`'s points to station `b`'s, at the hub only or at
+    // the hub and the stroke starts (a posture solve per row: done only where it matters).
+    let dist = |a: &[(cam_core::Vector3, Option<cam_core::Vector3>)], b: f64, tops: bool| {
         a.iter()
             .enumerate()
             .map(|(j, (hub, top))| {
                 let d_hub = (hub - frame.hub_point(b, rows.s(j, b))).norm();
-                let d_top = match (top, start_point(j, b)) {
-                    (Some(x), Some(y)) => (x - y).norm(),
+                let d_top = match (tops, top) {
+                    (true, Some(x)) => start_point(j, b).map_or(0.0, |y| (x - y).norm()),
                     _ => 0.0,
                 };
                 d_hub.max(d_top)
             })
             .fold(0.0, f64::max)
     };
-    let mut out = vec![first];
-    let mut m = first;
-    while m > rows.end {
-        let here = points(m);
-        if dist(&here, rows.end) <= step_mm {
-            out.push(rows.end);
-            break;
-        }
-        let (mut lo, mut hi) = (rows.end, m);
+    let bisect = |here: &[(cam_core::Vector3, Option<cam_core::Vector3>)],
+                  (mut lo, mut hi): (f64, f64),
+                  tops: bool| {
         for _ in 0..M_BISECTIONS {
             let mid = 0.5 * (lo + hi);
-            if dist(&here, mid) > step_mm {
+            if dist(here, mid, tops) > step_mm {
                 lo = mid;
             } else {
                 hi = mid;
             }
         }
-        m = hi;
+        hi
+    };
+    let mut out = vec![first];
+    let mut m = first;
+    while m > rows.end {
+        let here = points(m);
+        if dist(&here, rows.end, true) <= step_mm {
+            out.push(rows.end);
+            break;
+        }
+        // The hub spacing first; where the stroke starts spread further, the bisection
+        // again between that station and this one with both (the full distance is never
+        // below the hub distance, so the station moves toward this one).
+        let mut next = bisect(&here, (rows.end, m), false);
+        if dist(&here, next, true) > step_mm {
+            // Where the stroke start jumps (the axis line leaves a non-convex stock at
+            // another face) no spacing satisfies it: keep the hub spacing there.
+            let closer = bisect(&here, (next, m), true);
+            if m - closer > MIN_STATION_ADVANCE * (m - next) {
+                next = closer;
+            }
+        }
+        m = next;
         out.push(m);
     }
     out
