@@ -193,21 +193,9 @@ impl<'a> PostureBuilder<'a> {
             return *w;
         }
         let (z0, z1) = self.stock.z_range();
-        let reach = len + (z1 - z0) + 2.0 * self.stock.max_radius();
-        let (mut lo, mut hi) = (len, len + STOCK_EXIT_STEP_MM);
-        while inside(hi) && hi < reach {
-            lo = hi;
-            hi += STOCK_EXIT_STEP_MM;
-        }
-        while hi - lo > 1e-3 {
-            let mid = 0.5 * (lo + hi);
-            if inside(mid) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        centre + q * hi
+        let reach = (z1 - z0) + 2.0 * self.stock.max_radius();
+        let top = exit_along(&inside, len, reach, 1e-3).unwrap_or(len + reach);
+        centre + q * top
     }
 
     /// Smallest axial position `≥ from` where the bottom disk (full radius) at `centre + t·q`
@@ -230,30 +218,54 @@ impl<'a> PostureBuilder<'a> {
         }
         let (z0, z1) = self.stock.z_range();
         let reach = (z1 - z0) + 2.0 * self.stock.max_radius() + 2.0 * radius;
-        let mut lo = from;
-        let mut hi = from + STOCK_EXIT_STEP_MM;
-        while inside(hi) {
-            lo = hi;
-            hi += STOCK_EXIT_STEP_MM;
-            if hi - from > reach {
-                return Err(PlanError::geometry(
-                    self.operation,
-                    format!(
-                        "plunge axis through ({:.3}, {:.3}, {:.3})",
-                        centre.x, centre.y, centre.z
-                    ),
-                    "the tool axis never leaves the blank",
-                ));
-            }
+        exit_along(&inside, from, reach, 1e-6).ok_or_else(|| {
+            PlanError::geometry(
+                self.operation,
+                format!(
+                    "plunge axis through ({:.3}, {:.3}, {:.3})",
+                    centre.x, centre.y, centre.z
+                ),
+                "the tool axis never leaves the blank",
+            )
+        })
+    }
+}
+
+/// The first parameter after `from` (where `inside` holds) at which `inside` fails: a walk in
+/// [`STOCK_EXIT_STEP_MM`] steps, then bisection of the last step to `tol` (the result is on
+/// the outside end). `None` when the walk passes `from + reach` still inside. Assumes one
+/// crossing within a step. O(reach / step + log₂(step / tol)) tests.
+fn exit_along(inside: &dyn Fn(f64) -> bool, from: f64, reach: f64, tol: f64) -> Option<f64> {
+    let (mut lo, mut hi) = (from, from + STOCK_EXIT_STEP_MM);
+    while inside(hi) {
+        lo = hi;
+        hi += STOCK_EXIT_STEP_MM;
+        if hi - from > reach {
+            return None;
         }
-        while hi - lo > 1e-6 {
-            let mid = 0.5 * (lo + hi);
-            if inside(mid) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
+    }
+    while hi - lo > tol {
+        let mid = 0.5 * (lo + hi);
+        if inside(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
         }
-        Ok(hi)
+    }
+    Some(hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exit_along_finds_the_crossing_within_its_tolerance() {
+        // Inside below 7.3: a walk from 0.5 in 2 mm steps, then bisection to 1e-6.
+        let inside = |t: f64| t < 7.3;
+        let t = exit_along(&inside, 0.5, 100.0, 1e-6).unwrap_or(f64::NAN);
+        assert!((7.3..=7.3 + 1e-6).contains(&t), "{t}");
+        // Never leaving within the reach is reported, not guessed.
+        assert_eq!(exit_along(&|_| true, 0.0, 10.0, 1e-6), None);
     }
 }

@@ -173,16 +173,22 @@ impl SectionPlan {
 /// blade allowance somewhere across the channel, the posture and whether it was moved.
 type Tried = (f64, Option<(Posture, bool)>);
 
+/// The stroke of one plunge.
+fn stroke(p: &Posture, radius: f64, core: f64) -> Stroke {
+    Stroke {
+        start: p.start.tip,
+        end: p.cl.tip,
+        axis: p.cl.axis.into_inner(),
+        radius,
+        core_radius: core,
+    }
+}
+
+/// The strokes of `rows` in machining order.
 fn strokes(rows: &[Vec<Posture>], radius: f64, core: f64) -> Vec<Stroke> {
     rows.iter()
         .flatten()
-        .map(|p| Stroke {
-            start: p.start.tip,
-            end: p.cl.tip,
-            axis: p.cl.axis.into_inner(),
-            radius,
-            core_radius: core,
-        })
+        .map(|p| stroke(p, radius, core))
         .collect()
 }
 
@@ -304,8 +310,8 @@ impl PlungeRoughing {
                 let need = ctx.stock.max_radius() + core + crate::rows::LEAD_IN_MARGIN_MM;
                 (!at_outlet || hub.x.hypot(hub.y) >= need)
                     && builder.conventional(&frame, m, s).is_ok_and(|p| {
-                        let stroke = strokes(&[vec![p]], radius, core);
-                        travel_of(&stroke, 0, &material) <= INTERFERENCE_TRAVEL_TOL_MM
+                        travel_of(&[stroke(&p, radius, core)], 0, &material)
+                            <= INTERFERENCE_TRAVEL_TOL_MM
                     })
             })
         };
@@ -410,12 +416,13 @@ impl PlungeRoughing {
                         if blades.clearance(&p.cl).distance_mm < required {
                             return false;
                         }
-                        let travel = |this: &Posture| {
-                            let mut list = before.to_vec();
-                            list.push(*this);
-                            travel_of(&strokes(&[list], radius, core), before.len(), &material)
-                        };
-                        travel(p) <= travel(unmoved).max(INTERFERENCE_TRAVEL_TOL_MM)
+                        let n = before.len();
+                        let mut list: Vec<Stroke> =
+                            before.iter().map(|q| stroke(q, radius, core)).collect();
+                        list.push(stroke(p, radius, core));
+                        let moved = travel_of(&list, n, &material);
+                        list[n] = stroke(unmoved, radius, core);
+                        moved <= travel_of(&list, n, &material).max(INTERFERENCE_TRAVEL_TOL_MM)
                     };
                     optimise_row_within(&builder, row, self.params.w_curve_step, op, &admissible)
                 })

@@ -718,22 +718,11 @@ impl ChannelRoughing {
         metrics
             .number("triangle_path_length_mm", tri_len * k)
             .number("isoparametric_path_length_mm", iso_len * k)
-            .number(
-                "saving_ratio",
-                if iso_len > 0.0 {
-                    1.0 - tri_len / iso_len
-                } else {
-                    0.0
-                },
-            )
+            .number("saving_ratio", saving(tri_len, iso_len))
             .number("isoparametric_channel_path_length_mm", channel_iso_len * k)
             .number(
                 "saving_ratio_whole_channel",
-                if channel_iso_len > 0.0 {
-                    1.0 - tri_len / channel_iso_len
-                } else {
-                    0.0
-                },
+                saving(tri_len, channel_iso_len),
             )
             .number("max_scallop_mm", max_scallop)
             .number("scallop_target_mm", self.params.scallop_mm)
@@ -865,13 +854,7 @@ impl ChannelRoughing {
                 .collect();
             let left = tabulate(&curves[a], &s, a, &level);
             let mut right = tabulate(&curves[b], &s, b, &level);
-            // Unwrap the right boundary to the turn nearest the left one: the channel spans
-            // less than half a turn, so a negative width means the offset boundaries cross.
-            let tau = std::f64::consts::TAU;
-            for ((ry, ly), &si) in right.y.iter_mut().zip(&left.y).zip(&s) {
-                let turn = tau * level.radius_at(si);
-                *ry = ly + (*ry - ly + 0.5 * turn).rem_euclid(turn) - 0.5 * turn;
-            }
+            unwrap_to_left(&mut right.y, &left.y, &s, &level);
             let field = Field {
                 region: Region {
                     s,
@@ -933,11 +916,7 @@ impl ChannelRoughing {
                 .collect();
             let left = tabulate(&curves[0], &s, 0, &level);
             let mut right = tabulate(&curves[1], &s, 1, &level);
-            let tau = std::f64::consts::TAU;
-            for ((ry, ly), &si) in right.y.iter_mut().zip(&left.y).zip(&s) {
-                let turn = tau * level.radius_at(si);
-                *ry = ly + (*ry - ly + 0.5 * turn).rem_euclid(turn) - 0.5 * turn;
-            }
+            unwrap_to_left(&mut right.y, &left.y, &s, &level);
             let right_y: Vec<f64> = right
                 .y
                 .iter()
@@ -1100,6 +1079,26 @@ fn min_radius(level: &DepthLevel) -> f64 {
 
 /// Boundary y = r(s)·θ(s) and ruled u at each grid s (linear in the boundary's samples,
 /// which are dense: the developed curve is their interpolant).
+/// `1 − triangle / baseline` (0 without a baseline).
+fn saving(triangle: f64, baseline: f64) -> f64 {
+    if baseline > 0.0 {
+        1.0 - triangle / baseline
+    } else {
+        0.0
+    }
+}
+
+/// Moves each right boundary `y` by whole turns of its parallel (`2π·r(s)`) to the turn
+/// nearest the left one: the channel spans less than half a turn, so a negative width then
+/// means the offset boundaries cross.
+fn unwrap_to_left(right: &mut [f64], left: &[f64], s: &[f64], level: &DepthLevel) {
+    let tau = std::f64::consts::TAU;
+    for ((ry, ly), &si) in right.iter_mut().zip(left).zip(s) {
+        let turn = tau * level.radius_at(si);
+        *ry = ly + (*ry - ly + 0.5 * turn).rem_euclid(turn) - 0.5 * turn;
+    }
+}
+
 fn tabulate(tab: &[(f64, f64, f64)], s: &[f64], ruled: usize, level: &DepthLevel) -> Tab {
     let mut y = Vec::with_capacity(s.len());
     let mut u = Vec::with_capacity(s.len());
