@@ -50,6 +50,7 @@
 
 pub mod collision;
 pub mod crosscheck;
+mod cull;
 pub mod design;
 pub mod dexel;
 pub mod endpoints;
