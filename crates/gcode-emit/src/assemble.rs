@@ -426,7 +426,7 @@ mod tests {
     use crate::LinuxCnc;
     use cam_core::{Point3, ToolPath, Vector3};
     use postproc_kinematics::ReverseMotionOptions;
-    use std::cell::Cell;
+    use std::sync::atomic::{AtomicUsize, Ordering};
 
     fn machine() -> Machine {
         let text = include_str!("../embedded/machines/xyzac-trt.toml");
@@ -517,9 +517,9 @@ mod tests {
     #[test]
     fn checked_removal_leaves_no_reverse_motion_and_checks_changed_postures() {
         let ops = [swing_op()];
-        let calls = Cell::new(0usize);
+        let calls = AtomicUsize::new(0);
         let accept = |_: &CutterLocation| {
-            calls.set(calls.get() + 1);
+            calls.fetch_add(1, Ordering::Relaxed);
             true
         };
         let a = assemble_program_checked(
@@ -534,7 +534,10 @@ mod tests {
         let m = a.metrics[0].1;
         assert!(m.reverse_motions_before >= 2, "{m:?}");
         assert_eq!(m.reverse_motions_after, 0, "{m:?}");
-        assert!(calls.get() > 0, "the checker saw the changed postures");
+        assert!(
+            calls.load(Ordering::Relaxed) > 0,
+            "the checker saw the changed postures"
+        );
         let p = &a.operations[0];
         assert!(p.reverse_motion_removal && p.reverse_motion.is_some());
         assert_eq!(p.before.values.len(), p.after.values.len());

@@ -103,11 +103,12 @@ fn basis(knots: &[f64], p: usize, span: usize, t: f64, n: &mut [f64; 4]) {
     }
 }
 
-/// Least-squares fit of values `y` at parameters `t ∈ [0,1]` by a clamped uniform B-spline of
-/// degree `min(3, n_ctrl − 1)` with `n_ctrl` control values (`n_ctrl` is reduced to the
-/// number of samples). `None` when there are no samples or the system is rank deficient.
-pub fn fit_least_squares(t: &[f64], y: &[f64], n_ctrl: usize) -> Option<ScalarBSpline> {
-    let m = t.len().min(y.len());
+/// The clamped uniform B-spline of [`fit_least_squares`] for `m` samples and `n_ctrl`
+/// control values (all zero) and its collocation matrix at `t` (`m × n`,
+/// `A[i][j] = N_j(t_i)`, banded: p + 1 non-zeros per row). `None` without samples.
+/// Cost O(m·p²) plus the O(m·n) zeroed matrix.
+pub(crate) fn collocation(t: &[f64], n_ctrl: usize) -> Option<(ScalarBSpline, DMatrix<f64>)> {
+    let m = t.len();
     let n = n_ctrl.min(m).max(1);
     if m == 0 {
         return None;
@@ -119,13 +120,28 @@ pub fn fit_least_squares(t: &[f64], y: &[f64], n_ctrl: usize) -> Option<ScalarBS
     knots.extend(std::iter::repeat_n(1.0, p + 1));
     let mut a = DMatrix::<f64>::zeros(m, n);
     let mut nb = [0.0; 4];
-    for (row, &ti) in t.iter().take(m).enumerate() {
+    for (row, &ti) in t.iter().enumerate() {
         let span = find_span(&knots, p, n, ti);
         basis(&knots, p, span, ti.clamp(0.0, 1.0), &mut nb);
         for i in 0..=p {
             a[(row, span - p + i)] = nb[i];
         }
     }
+    let spline = ScalarBSpline {
+        degree: p,
+        knots,
+        ctrl: vec![0.0; n],
+    };
+    Some((spline, a))
+}
+
+/// Least-squares fit of values `y` at parameters `t ∈ [0,1]` by a clamped uniform B-spline of
+/// degree `min(3, n_ctrl − 1)` with `n_ctrl` control values (`n_ctrl` is reduced to the
+/// number of samples). `None` when there are no samples or the system is rank deficient
+/// (smallest singular value of the collocation matrix below 10⁻¹⁰ of the largest).
+pub fn fit_least_squares(t: &[f64], y: &[f64], n_ctrl: usize) -> Option<ScalarBSpline> {
+    let m = t.len().min(y.len());
+    let (mut spline, a) = collocation(&t[..m], n_ctrl)?;
     let b = DVector::from_column_slice(&y[..m]);
     let svd = a.svd(true, true);
     let smax = svd.singular_values.max();
@@ -133,11 +149,8 @@ pub fn fit_least_squares(t: &[f64], y: &[f64], n_ctrl: usize) -> Option<ScalarBS
         return None;
     }
     let x = svd.solve(&b, 1e-12 * smax).ok()?;
-    Some(ScalarBSpline {
-        degree: p,
-        knots,
-        ctrl: x.iter().copied().collect(),
-    })
+    spline.ctrl = x.iter().copied().collect();
+    Some(spline)
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! displacement of an axis changes direction (paper 004: such reversals leave tool marks,
 //! because the feed drive stops and backlash acts).
 
-use crate::bspline_fit::{fit_least_squares, ScalarBSpline};
+use crate::bspline_fit::{collocation, ScalarBSpline};
 use crate::error::PostError;
 use crate::joints::{AxisId, Joints};
 use crate::kinematics::LIMIT_SLACK;
@@ -10,6 +10,7 @@ use crate::machine::Machine;
 use crate::post::PostedBlock;
 use cam_core::{CutterLocation, MoveKind};
 use nalgebra::{DMatrix, DVector, Dyn, SVD};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Angular steps smaller than this (rad) count as standing still when looking for direction
@@ -79,13 +80,14 @@ pub fn count_path_reverse_motions(blocks: &[PostedBlock]) -> usize {
 // Removal (paper 004, "Modification of reverse movements" and steps 3–7 of its procedure).
 
 /// Caller-supplied 5-axis accessibility test (gouge and collision) of a cutter location,
-/// used to re-check postures changed by reverse-motion removal.
-pub trait AccessibilityChecker {
+/// used to re-check postures changed by reverse-motion removal. `Sync`: the cutting runs of
+/// a path are checked in parallel.
+pub trait AccessibilityChecker: Sync {
     /// `true` when the cutter location is free of gouge and collision.
     fn is_accessible(&self, cl: &CutterLocation) -> bool;
 }
 
-impl<F: Fn(&CutterLocation) -> bool> AccessibilityChecker for F {
+impl<F: Fn(&CutterLocation) -> bool + Sync> AccessibilityChecker for F {
     fn is_accessible(&self, cl: &CutterLocation) -> bool {
         self(cl)
     }
@@ -427,7 +429,7 @@ struct Pins {
 /// count, with optionally pinned first / last control values: the collocation matrix `A`
 /// (`m × n`, `A[i][j] = N_j(t_i)`) and the SVD of its free columns, factored once (O(m·n²))
 /// and reused by every shift-and-smooth iteration (O(m·n) each). Without pins the solve is
-/// the one of [`fit_least_squares`] (same basis, same rank test and singular-value cut-off).
+/// the one of [`crate::bspline_fit::fit_least_squares`] (same basis, same rank test and singular-value cut-off).
 struct SplineProjector {
     template: ScalarBSpline,
     a: DMatrix<f64>,
@@ -438,31 +440,31 @@ struct SplineProjector {
 }
 
 impl SplineProjector {
-    /// `None` when the fit with these parameters is rank deficient or nothing is free.
+    /// `None` when the fit with these parameters is rank deficient (the test of
+    /// [`crate::bspline_fit::fit_least_squares`] on the whole collocation matrix) or nothing is free. One SVD
+    /// with vectors of the free columns, plus the singular values of the whole matrix when
+    /// an end is pinned. O(m·n²).
     fn new(t: &[f64], n_ctrl: usize, pins: Pins) -> Option<Self> {
-        let m = t.len();
-        let template = fit_least_squares(t, &vec![0.0; m], n_ctrl)?;
-        let k = template.control_points().len();
-        let mut a = DMatrix::<f64>::zeros(m, k);
-        let mut unit = vec![0.0; k];
-        for j in 0..k {
-            unit[j] = 1.0;
-            let basis_j = template.with_control_points(unit.clone())?;
-            for (i, &ti) in t.iter().enumerate() {
-                a[(i, j)] = basis_j.eval(ti);
-            }
-            unit[j] = 0.0;
-        }
+        let (template, a) = collocation(t, n_ctrl)?;
+        let k = a.ncols();
+        let full_rank = |sv: &DVector<f64>| {
+            let smax = sv.max();
+            !(smax.is_nan() || smax <= 0.0 || sv.min() < 1e-10 * smax)
+        };
         let lo = usize::from(pins.start.is_some());
         let hi = k - usize::from(pins.end.is_some());
         if lo >= hi {
             return None;
         }
-        let svd = a.columns(lo, hi - lo).into_owned().svd(true, true);
-        let smax = svd.singular_values.max();
-        if smax.is_nan() || smax <= 0.0 || svd.singular_values.min() < 1e-10 * smax {
+        // Without pins the free columns are the whole matrix and its SVD is the test.
+        if (lo, hi) != (0, k) && !full_rank(&a.clone().singular_values()) {
             return None;
         }
+        let svd = a.columns(lo, hi - lo).into_owned().svd(true, true);
+        if !full_rank(&svd.singular_values) {
+            return None;
+        }
+        let smax = svd.singular_values.max();
         Some(Self {
             template,
             a,
@@ -837,7 +839,8 @@ type SmoothingStrategy = fn(&[f64], &[f64], &ReverseMotionOptions) -> Option<Smo
 ///
 /// Cost: per run and reversing axis at most `⌈log₂(cap / n0)⌉ + 1` fits of
 /// O(m·n² + max_iterations·m·n) each (see [`smooth_monotone_adaptive`]), plus
-/// `c_max / c_step` checker passes per run whose smoothed postures fail.
+/// `c_max / c_step` checker passes per run whose smoothed postures fail; runs in parallel
+/// (rayon), reports added in run order.
 pub fn remove_reverse_motions(
     machine: &Machine,
     blocks: &mut [PostedBlock],
@@ -852,166 +855,216 @@ pub fn remove_reverse_motions(
         before: DisplacementCurves::of_blocks(machine, blocks),
         ..Default::default()
     };
-    for (s, e) in cutting_runs(blocks) {
-        let run = &mut blocks[s..e];
-        let original: Vec<(Joints, CutterLocation)> =
-            run.iter().map(|b| (b.joints, b.cl)).collect();
-        let t = run_parameters(run);
-        let mut changed = false;
-        let mut ok = true;
-        let mut run_max_change: f64 = 0.0;
-        let mut run_control_points = Vec::new();
-        let mut run_windowed = 0;
-        for axis in [AxisId::Tilt, AxisId::Rotate] {
-            let angles: Vec<f64> = run.iter().map(|b| b.joints.get(axis)).collect();
-            if count_reverse_motions(&angles, REVERSE_DEAD_BAND_RAD) == 0 {
-                continue;
-            }
-            // Windows around the reversals first; the whole run when they cannot be made
-            // monotone within the limit.
-            let strategies: [SmoothingStrategy; 2] =
-                [smooth_monotone_windowed, smooth_monotone_adaptive];
-            let mut accepted = None;
-            let mut fits_tried = 0;
-            for smooth in strategies {
-                let Some(fit) = smooth(&t, &angles, opts) else {
-                    continue;
-                };
-                rep.iterations += fit.iterations;
-                rep.projections += fit.projections;
-                fits_tried += fit.fits;
-                if fit.accepted {
-                    accepted = Some(fit);
-                    break;
-                }
-            }
-            rep.refits += fits_tried.saturating_sub(1);
-            let Some(fit) = accepted else {
-                ok = false;
-                break;
-            };
-            if fit.windows != [(0, angles.len() - 1)] {
-                run_windowed += 1;
-            }
-            run_control_points.push(fit.control_points);
-            run_max_change = run_max_change.max(fit.max_change);
-            for (b, v) in run.iter_mut().zip(fit.angles) {
-                b.joints.set(axis, v);
-            }
-            changed = true;
-        }
-        if ok && changed {
-            // Recompute the positions for the changed postures and re-check them; when a
-            // posture is not accessible, turn C of the whole run by ±k·ΔC (k = 1, 2, … up to
-            // C_max) — a constant offset keeps the run free of reverse motions.
-            let smoothed: Vec<(f64, f64)> = run
-                .iter()
-                .map(|b| (b.joints.tilt, b.joints.rotate))
-                .collect();
-            let steps = (opts.c_max / opts.c_step).floor() as usize;
-            // The C repair counts toward the angle limit.
-            let offsets = std::iter::once(0.0)
-                .chain((1..=steps).flat_map(|k| {
-                    let d = k as f64 * opts.c_step;
-                    [d, -d]
-                }))
-                .filter(|off| run_max_change + off.abs() <= opts.max_angle_change + LIMIT_SLACK);
-            let mut accepted: Option<PlacedRun> = None;
-            let mut first_failure: Option<usize> = None;
-            let mut contact_failure = false;
-            'offsets: for off in offsets {
-                let mut placed: Vec<(Joints, CutterLocation)> = Vec::with_capacity(run.len());
-                let mut shift: f64 = 0.0;
-                for (b, ((tilt, rot), (oj, ocl))) in run.iter().zip(smoothed.iter().zip(&original))
-                {
-                    let rot = rot + off;
-                    if *tilt == oj.tilt && rot == oj.rotate {
-                        placed.push((*oj, *ocl));
-                        continue;
-                    }
-                    // Turn about the pivot: the point `pivot` up the original axis stays.
-                    let axis = machine.tool_axis(*tilt, rot);
-                    let pivot = ocl.tip + ocl.axis.into_inner() * opts.pivot_height_mm;
-                    let tip = pivot - axis.into_inner() * opts.pivot_height_mm;
-                    let angle = ocl.axis.dot(&axis).clamp(-1.0, 1.0).acos();
-                    let s = opts.contact_shift(angle);
-                    if s > opts.max_contact_shift_mm {
-                        contact_failure = true;
-                        if first_failure.is_none() {
-                            first_failure = Some(b.source_index);
-                        }
-                        continue 'offsets;
-                    }
-                    shift = shift.max(s);
-                    let j = machine.joints_for_angles(&tip, tool_length, *tilt, rot);
-                    let cl = CutterLocation { tip, axis };
-                    let fits = machine.check_limits(&j, LIMIT_SLACK).is_ok();
-                    if !fits || !checker.is_none_or(|c| c.is_accessible(&cl)) {
-                        if first_failure.is_none() {
-                            first_failure = Some(b.source_index);
-                        }
-                        continue 'offsets;
-                    }
-                    placed.push((j, cl));
-                }
-                // The motion between postures: the midpoint of every segment touching a
-                // changed posture, as the controller interpolates it (joints linear).
-                if let Some(c) = checker {
-                    for (k, w) in placed.windows(2).enumerate() {
-                        let (a, b) = (&w[0], &w[1]);
-                        if a.0 == original[k].0 && b.0 == original[k + 1].0 {
-                            continue;
-                        }
-                        let mid = machine.forward(&a.0.lerp(&b.0, 0.5), tool_length);
-                        if !c.is_accessible(&mid) {
-                            if first_failure.is_none() {
-                                first_failure = Some(run[k + 1].source_index);
-                            }
-                            continue 'offsets;
-                        }
-                    }
-                }
-                accepted = Some((off, placed, shift));
-                break;
-            }
-            match accepted {
-                Some((off, placed, shift)) => {
-                    rep.max_contact_shift_mm = rep.max_contact_shift_mm.max(shift);
-                    for (b, (j, cl)) in run.iter_mut().zip(placed) {
-                        b.joints = j;
-                        b.cl = cl;
-                    }
-                    rep.runs_changed += 1;
-                    rep.control_points_used.append(&mut run_control_points);
-                    rep.windowed += run_windowed;
-                    if off != 0.0 {
-                        rep.c_repaired_runs += 1;
-                        rep.c_offsets_deg.push(off.to_degrees());
-                    }
-                    let change = run_max_change + off.abs();
-                    rep.max_angle_change_deg = rep.max_angle_change_deg.max(change.to_degrees());
-                }
-                None => {
-                    if contact_failure {
-                        rep.runs_kept_for_contact += 1;
-                    }
-                    rep.inaccessible_blocks.extend(first_failure);
-                    ok = false;
-                }
-            }
-        }
-        if !ok {
-            rep.runs_kept += 1;
-            for (b, (j, cl)) in run.iter_mut().zip(original) {
-                b.joints = j;
-                b.cl = cl;
-            }
-        }
+    // Runs are independent (each changes only its own blocks): smooth them in parallel and
+    // add their reports in run order, so the result does not depend on the thread count.
+    let mut runs: Vec<&mut [PostedBlock]> = Vec::new();
+    let mut rest: &mut [PostedBlock] = &mut *blocks;
+    let mut at = 0;
+    for (s, e) in cutting_runs(rest) {
+        let (_, tail) = std::mem::take(&mut rest).split_at_mut(s - at);
+        let (run, tail) = tail.split_at_mut(e - s);
+        runs.push(run);
+        rest = tail;
+        at = e;
+    }
+    let outcomes: Vec<ReverseMotionReport> = runs
+        .into_par_iter()
+        .map(|run| {
+            let mut rep = ReverseMotionReport::default();
+            smooth_run(machine, run, tool_length, opts, checker, &mut rep);
+            rep
+        })
+        .collect();
+    for o in outcomes {
+        rep.add_run(o);
     }
     rep.tilt_after = count_axis_reverse_motions(blocks, AxisId::Tilt);
     rep.rotate_after = count_axis_reverse_motions(blocks, AxisId::Rotate);
     rep.after = DisplacementCurves::of_blocks(machine, blocks);
     Ok(rep)
+}
+
+/// One cutting run of [`remove_reverse_motions`]: smooths its reversing axes, places and
+/// checks the changed postures (with the C repair), or keeps the original postures; adds the
+/// run's figures to `rep`.
+fn smooth_run(
+    machine: &Machine,
+    run: &mut [PostedBlock],
+    tool_length: f64,
+    opts: &ReverseMotionOptions,
+    checker: Option<&dyn AccessibilityChecker>,
+    rep: &mut ReverseMotionReport,
+) {
+    let original: Vec<(Joints, CutterLocation)> = run.iter().map(|b| (b.joints, b.cl)).collect();
+    let t = run_parameters(run);
+    let mut changed = false;
+    let mut ok = true;
+    let mut run_max_change: f64 = 0.0;
+    let mut run_control_points = Vec::new();
+    let mut run_windowed = 0;
+    for axis in [AxisId::Tilt, AxisId::Rotate] {
+        let angles: Vec<f64> = run.iter().map(|b| b.joints.get(axis)).collect();
+        if count_reverse_motions(&angles, REVERSE_DEAD_BAND_RAD) == 0 {
+            continue;
+        }
+        // Windows around the reversals first; the whole run when they cannot be made
+        // monotone within the limit.
+        let strategies: [SmoothingStrategy; 2] =
+            [smooth_monotone_windowed, smooth_monotone_adaptive];
+        let mut accepted = None;
+        let mut fits_tried = 0;
+        for smooth in strategies {
+            let Some(fit) = smooth(&t, &angles, opts) else {
+                continue;
+            };
+            rep.iterations += fit.iterations;
+            rep.projections += fit.projections;
+            fits_tried += fit.fits;
+            if fit.accepted {
+                accepted = Some(fit);
+                break;
+            }
+        }
+        rep.refits += fits_tried.saturating_sub(1);
+        let Some(fit) = accepted else {
+            ok = false;
+            break;
+        };
+        if fit.windows != [(0, angles.len() - 1)] {
+            run_windowed += 1;
+        }
+        run_control_points.push(fit.control_points);
+        run_max_change = run_max_change.max(fit.max_change);
+        for (b, v) in run.iter_mut().zip(fit.angles) {
+            b.joints.set(axis, v);
+        }
+        changed = true;
+    }
+    if ok && changed {
+        // Recompute the positions for the changed postures and re-check them; when a
+        // posture is not accessible, turn C of the whole run by ±k·ΔC (k = 1, 2, … up to
+        // C_max) — a constant offset keeps the run free of reverse motions.
+        let smoothed: Vec<(f64, f64)> = run
+            .iter()
+            .map(|b| (b.joints.tilt, b.joints.rotate))
+            .collect();
+        let steps = (opts.c_max / opts.c_step).floor() as usize;
+        // The C repair counts toward the angle limit.
+        let offsets = std::iter::once(0.0)
+            .chain((1..=steps).flat_map(|k| {
+                let d = k as f64 * opts.c_step;
+                [d, -d]
+            }))
+            .filter(|off| run_max_change + off.abs() <= opts.max_angle_change + LIMIT_SLACK);
+        let mut accepted: Option<PlacedRun> = None;
+        let mut first_failure: Option<usize> = None;
+        let mut contact_failure = false;
+        'offsets: for off in offsets {
+            let mut placed: Vec<(Joints, CutterLocation)> = Vec::with_capacity(run.len());
+            let mut shift: f64 = 0.0;
+            for (b, ((tilt, rot), (oj, ocl))) in run.iter().zip(smoothed.iter().zip(&original)) {
+                let rot = rot + off;
+                if *tilt == oj.tilt && rot == oj.rotate {
+                    placed.push((*oj, *ocl));
+                    continue;
+                }
+                // Turn about the pivot: the point `pivot` up the original axis stays.
+                let axis = machine.tool_axis(*tilt, rot);
+                let pivot = ocl.tip + ocl.axis.into_inner() * opts.pivot_height_mm;
+                let tip = pivot - axis.into_inner() * opts.pivot_height_mm;
+                let angle = ocl.axis.dot(&axis).clamp(-1.0, 1.0).acos();
+                let s = opts.contact_shift(angle);
+                if s > opts.max_contact_shift_mm {
+                    contact_failure = true;
+                    if first_failure.is_none() {
+                        first_failure = Some(b.source_index);
+                    }
+                    continue 'offsets;
+                }
+                shift = shift.max(s);
+                let j = machine.joints_for_angles(&tip, tool_length, *tilt, rot);
+                let cl = CutterLocation { tip, axis };
+                let fits = machine.check_limits(&j, LIMIT_SLACK).is_ok();
+                if !fits || !checker.is_none_or(|c| c.is_accessible(&cl)) {
+                    if first_failure.is_none() {
+                        first_failure = Some(b.source_index);
+                    }
+                    continue 'offsets;
+                }
+                placed.push((j, cl));
+            }
+            // The motion between postures: the midpoint of every segment touching a
+            // changed posture, as the controller interpolates it (joints linear).
+            if let Some(c) = checker {
+                for (k, w) in placed.windows(2).enumerate() {
+                    let (a, b) = (&w[0], &w[1]);
+                    if a.0 == original[k].0 && b.0 == original[k + 1].0 {
+                        continue;
+                    }
+                    let mid = machine.forward(&a.0.lerp(&b.0, 0.5), tool_length);
+                    if !c.is_accessible(&mid) {
+                        if first_failure.is_none() {
+                            first_failure = Some(run[k + 1].source_index);
+                        }
+                        continue 'offsets;
+                    }
+                }
+            }
+            accepted = Some((off, placed, shift));
+            break;
+        }
+        match accepted {
+            Some((off, placed, shift)) => {
+                rep.max_contact_shift_mm = rep.max_contact_shift_mm.max(shift);
+                for (b, (j, cl)) in run.iter_mut().zip(placed) {
+                    b.joints = j;
+                    b.cl = cl;
+                }
+                rep.runs_changed += 1;
+                rep.control_points_used.append(&mut run_control_points);
+                rep.windowed += run_windowed;
+                if off != 0.0 {
+                    rep.c_repaired_runs += 1;
+                    rep.c_offsets_deg.push(off.to_degrees());
+                }
+                let change = run_max_change + off.abs();
+                rep.max_angle_change_deg = rep.max_angle_change_deg.max(change.to_degrees());
+            }
+            None => {
+                if contact_failure {
+                    rep.runs_kept_for_contact += 1;
+                }
+                rep.inaccessible_blocks.extend(first_failure);
+                ok = false;
+            }
+        }
+    }
+    if !ok {
+        rep.runs_kept += 1;
+        for (b, (j, cl)) in run.iter_mut().zip(original) {
+            b.joints = j;
+            b.cl = cl;
+        }
+    }
+}
+
+impl ReverseMotionReport {
+    /// Adds the per-run figures of `o` (one run's report from [`smooth_run`]).
+    fn add_run(&mut self, o: ReverseMotionReport) {
+        self.runs_changed += o.runs_changed;
+        self.runs_kept += o.runs_kept;
+        self.iterations += o.iterations;
+        self.projections += o.projections;
+        self.control_points_used.extend(o.control_points_used);
+        self.refits += o.refits;
+        self.windowed += o.windowed;
+        self.c_repaired_runs += o.c_repaired_runs;
+        self.c_offsets_deg.extend(o.c_offsets_deg);
+        self.inaccessible_blocks.extend(o.inaccessible_blocks);
+        self.max_angle_change_deg = self.max_angle_change_deg.max(o.max_angle_change_deg);
+        self.max_contact_shift_mm = self.max_contact_shift_mm.max(o.max_contact_shift_mm);
+        self.runs_kept_for_contact += o.runs_kept_for_contact;
+    }
 }
 
 #[cfg(test)]
