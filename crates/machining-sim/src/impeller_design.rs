@@ -398,29 +398,21 @@ impl ImpellerDesign {
 }
 
 /// Signed distance to a surface of revolution through its meridional contour, without
-/// allocation: nearest of `CONTOUR_SAMPLES` contour samples, then golden-section refinement of
-/// |C(t) − p| on the two neighbouring sample intervals (to 1e-9 of the interval), sign from the
-/// channel-side normal (contour tangent rotated, as in impeller-model).
+/// allocation: the global closest point of the contour to the query's `(z, r)`
+/// ([`impeller_model::MeridionalCurve::closest`], the `nurbs` crate's certified search over
+/// the contour's Bézier segments; it replaced a scan of 257 samples with golden-section
+/// refinement, and the verification's measurement stage of the default job at 0.25 mm went
+/// from 1.61 s to 1.22 s), sign from the channel-side normal (contour tangent rotated, as in
+/// impeller-model).
 #[derive(Debug, Clone)]
 struct ContourDistance {
     curve: impeller_model::MeridionalCurve,
-    ts: Vec<f64>,
-    pts: Vec<nalgebra::Vector2<f64>>,
 }
-
-const CONTOUR_SAMPLES: usize = 256;
 
 impl ContourDistance {
     fn new(curve: &impeller_model::MeridionalCurve) -> Self {
-        let (t0, t1) = curve.domain();
-        let ts: Vec<f64> = (0..=CONTOUR_SAMPLES)
-            .map(|k| t0 + (t1 - t0) * k as f64 / CONTOUR_SAMPLES as f64)
-            .collect();
-        let pts = ts.iter().map(|&t| curve.point(t)).collect();
         Self {
             curve: curve.clone(),
-            ts,
-            pts,
         }
     }
 
@@ -431,38 +423,7 @@ impl ContourDistance {
     /// The signed distance and the foot point `(z, r)` on the contour.
     fn foot(&self, p: &Point3) -> (f64, nalgebra::Vector2<f64>) {
         let zr = nalgebra::Vector2::new(p.z, (p.x * p.x + p.y * p.y).sqrt());
-        let mut k = 0;
-        let mut best = f64::INFINITY;
-        for (i, q) in self.pts.iter().enumerate() {
-            let d = (q - zr).norm_squared();
-            if d < best {
-                best = d;
-                k = i;
-            }
-        }
-        let n = self.ts.len() - 1;
-        let (mut a, mut b) = (self.ts[k.saturating_sub(1)], self.ts[(k + 1).min(n)]);
-        let f = |t: f64| (self.curve.point(t) - zr).norm_squared();
-        let g = 0.618_033_988_749_895;
-        let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
-        let (mut f1, mut f2) = (f(x1), f(x2));
-        let tol = 1e-9 * (b - a).abs().max(1e-300);
-        while (b - a).abs() > tol {
-            if f1 < f2 {
-                b = x2;
-                x2 = x1;
-                f2 = f1;
-                x1 = b - g * (b - a);
-                f1 = f(x1);
-            } else {
-                a = x1;
-                x1 = x2;
-                f1 = f2;
-                x2 = a + g * (b - a);
-                f2 = f(x2);
-            }
-        }
-        let t = 0.5 * (a + b);
+        let (t, _) = self.curve.closest(zr);
         let c = self.curve.point(t);
         // Tangent by central difference (step well above round-off, far below curvature).
         let (t0, t1) = self.curve.domain();
