@@ -289,6 +289,59 @@ impl Machine {
         }
     }
 
+    /// Inverse kinematics for a posture on the motion from `a` to `b` (the midpoint a
+    /// linearisation inserts): of the two tilt-sign solutions, each with the rotary
+    /// equivalents nearest the middle of `a` and `b`, the one within limits with the least
+    /// rotary travel `|a → j| + |j → b|` (`|ΔT| + |ΔC|` each).
+    ///
+    /// [`Machine::inverse`] from `a` alone can pick the wrong branch near the singular
+    /// direction: an axis a few hundredths of a degree from the C axis is reached by both
+    /// tilt signs with C 180° apart, so the solution nearest `a` may lie on the other branch
+    /// than `b`, and the motion on to `b` swings C by 180° (on impeller-8+8's hub finishing
+    /// the linearisation then interpolated the joints instead and left 0.16 mm of deviation
+    /// at the top of the flutes). At a singular pose C is the middle of `a`'s and `b`'s.
+    /// Errors as [`Machine::inverse`].
+    pub fn inverse_between(
+        &self,
+        cl: &CutterLocation,
+        tool_length: f64,
+        a: &Joints,
+        b: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        if !(cl.tip.x.is_finite() && cl.tip.y.is_finite() && cl.tip.z.is_finite()) {
+            return Err(KinematicsError::NonFinite("tool tip"));
+        }
+        let u = cl.axis.into_inner();
+        if !(u.x.is_finite() && u.y.is_finite() && u.z.is_finite()) {
+            return Err(KinematicsError::NonFinite("tool axis"));
+        }
+        let middle = 0.5 * (a.rotate + b.rotate);
+        let sols = self.rotary_solutions(&cl.axis, middle)?;
+        let tilt_spec = self.axis(AxisId::Tilt);
+        let rot_spec = self.axis(AxisId::Rotate);
+        let mid_tilt = 0.5 * (a.tilt + b.tilt);
+        let mut best: Option<(f64, Joints)> = None;
+        for (t, c) in sols {
+            let (t, t_ok) = equivalent_angle(t, tilt_spec, mid_tilt);
+            let (c, c_ok) = equivalent_angle(c, rot_spec, middle);
+            if !(t_ok && c_ok) {
+                continue;
+            }
+            let j = self.joints_for_angles(&cl.tip, tool_length, t, c);
+            if self.check_limits(&j, LIMIT_SLACK).is_err() {
+                continue;
+            }
+            let cost = a.rotary_travel(&j) + j.rotary_travel(b);
+            if best.as_ref().is_none_or(|(bc, _)| cost < *bc) {
+                best = Some((cost, j));
+            }
+        }
+        match best {
+            Some((_, j)) => Ok(j),
+            None => self.inverse(cl, tool_length, Some(a)),
+        }
+    }
+
     /// All postures that reach `cl` within the limits: both tilt signs and, for each, the
     /// 2π-equivalents of the rotary angles next to the one nearest `reference` (at most three
     /// per axis). Used to look ahead along a path when the greedy choice runs into a limit.

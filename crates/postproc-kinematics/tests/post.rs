@@ -474,10 +474,13 @@ fn linearisation_through_the_singular_direction_converges() {
         posted.blocks.last().unwrap().joints.rotate,
     );
     let mut worst: f64 = 0.0;
+    // No swing: C stays within its end values widened by half their difference (the exact
+    // motion of an axis passing this close to the pole overshoots the far end by a fraction
+    // of the difference before it turns back; the swing the fix removed was up to 180°).
+    let slack = 0.5 * (c1 - c0).abs().to_degrees() + 1e-6;
     for w in posted.blocks.windows(2) {
-        // C stays between its end values (no swing)
-        assert!(w[1].joints.rotate.to_degrees() >= c0.min(c1).to_degrees() - 1e-6);
-        assert!(w[1].joints.rotate.to_degrees() <= c0.max(c1).to_degrees() + 1e-6);
+        assert!(w[1].joints.rotate.to_degrees() >= c0.min(c1).to_degrees() - slack);
+        assert!(w[1].joints.rotate.to_degrees() <= c0.max(c1).to_degrees() + slack);
         for k in 1..400 {
             let s = k as f64 / 400.0;
             let tip = m.forward(&w[0].joints.lerp(&w[1].joints, s), 0.0).tip;
@@ -817,4 +820,93 @@ fn swinging_rapids_name_a_branch_change() {
     ];
     let p = post_path(&m, &same, &opts).unwrap();
     assert!(swinging_rapids(&m, &p).is_empty());
+}
+
+/// Hub finishing of impeller-8+8 near the inlet: the tool axis comes within 0.03° of the
+/// table's axis (two postures there) and tilts to 1.4° on the far side, the sweep passing
+/// the pole at about 0.03°. The nearest posture changes the tilt's sign through the pole
+/// (73.6° of C) where the sweep turns C by 106° around it; linearising that branch change
+/// left 0.16 mm at the top of the flutes (20 mm). With the branch kept (and the exact
+/// midpoints of the linearisation chosen between the ends) every output segment stays
+/// within the tolerance at the tip and at the checked height (400 samples per segment).
+#[test]
+fn a_sweep_beside_the_pole_keeps_the_branch_and_the_tolerance() {
+    let m = fixture("xyzac-trt");
+    let tol = 0.005;
+    let h = 20.0;
+    let cl = |t: [f64; 3], a: [f64; 3]| {
+        CutterLocation::new(
+            Point3::new(t[0], t[1], t[2]),
+            Vector3::new(a[0], a[1], a[2]),
+        )
+        .unwrap()
+    };
+    let cls = [
+        cl(
+            [28.187495193832387, 25.365860616607076, 5.007334726547114],
+            [
+                0.01942599572729957,
+                0.015460698526409916,
+                0.9996917512368892,
+            ],
+        ),
+        cl(
+            [28.602821562824936, 25.758683827569627, 5.000001770391529],
+            [
+                -0.0005687426884338177,
+                0.00013225108408044053,
+                0.999999829520688,
+            ],
+        ),
+        cl(
+            [28.207803992190055, 26.19034400144854, 5.000001730554508],
+            [
+                -0.00042315938797714774,
+                0.0002867415134406531,
+                0.9999998693577099,
+            ],
+        ),
+        cl(
+            [27.80026653484413, 25.789336066719198, 5.007340288965701],
+            [
+                0.019331683436615524,
+                0.015931412412096002,
+                0.9996861888183023,
+            ],
+        ),
+    ];
+    let opts = PostOptions {
+        linearisation_tol: Some(tol),
+        check_height_mm: h,
+        tool_length: 115.0,
+        ..Default::default()
+    };
+    let posted = post_locations(&m, &cls, &opts).unwrap();
+    assert!(
+        posted.metrics.max_linearisation_error_mm <= tol,
+        "{:?}",
+        posted.metrics
+    );
+    assert_eq!(posted.metrics.reconfigurations, 0);
+    // Dense check of every output segment against the source segment it belongs to.
+    let mut worst: f64 = 0.0;
+    for w in posted.blocks.windows(2) {
+        let k = w[1].source_index;
+        let (a, b) = (&cls[k - 1], &cls[k]);
+        let (qa, qb) = (
+            a.tip + a.axis.into_inner() * h,
+            b.tip + b.axis.into_inner() * h,
+        );
+        for i in 1..400 {
+            let s = i as f64 / 400.0;
+            let c = m.forward(&w[0].joints.lerp(&w[1].joints, s), opts.tool_length);
+            worst = worst.max(point_segment_distance(&c.tip, &a.tip, &b.tip));
+            worst = worst.max(point_segment_distance(
+                &(c.tip + c.axis.into_inner() * h),
+                &qa,
+                &qb,
+            ));
+        }
+    }
+    assert!(worst <= tol * 1.05, "dense deviation {worst}");
 }
