@@ -751,6 +751,15 @@ pub fn post(
                 m.max_linearisation_error_mm, job.tolerances.linearisation_tol
             ));
         }
+        if m.max_rapid_linearisation_error_mm > job.tolerances.linearisation_tol {
+            report.notes.push(format!(
+                "post: {name}: rapid moves leave their intended motion by up to {:.4} mm (joint interpolation near the rotary axis' singular direction); they cut nothing, and the verification of the written program checks what they sweep",
+                m.max_rapid_linearisation_error_mm
+            ));
+        }
+        post.max_rapid_linearisation_error_mm = post
+            .max_rapid_linearisation_error_mm
+            .max(m.max_rapid_linearisation_error_mm);
         post.reverse_motions_before += m.reverse_motions_before;
         post.reverse_motions_after += m.reverse_motions_after;
         post.max_linearisation_error_mm = post

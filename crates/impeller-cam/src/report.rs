@@ -53,8 +53,12 @@ pub struct PostReport {
     pub reverse_motions_before: usize,
     /// Rotary direction reversals after smoothing.
     pub reverse_motions_after: usize,
-    /// Largest tool-tip deviation from the straight line between blocks (mm).
+    /// Largest deviation of the tool tip or the flute top from the intended motion between
+    /// cutting blocks (mm).
     pub max_linearisation_error_mm: f64,
+    /// The same between the blocks of rapid moves (mm): they cut nothing; the verification
+    /// of the written program checks what their real motion sweeps.
+    pub max_rapid_linearisation_error_mm: f64,
     /// Blocks outside the machine limits.
     pub limit_violations: usize,
     /// Cutting moves between which the rotary axes change solution branch (e.g. the tilt sign)
@@ -76,8 +80,12 @@ pub struct PostOperationReport {
     pub reverse_motions_before: usize,
     /// Rotary direction reversals after smoothing.
     pub reverse_motions_after: usize,
-    /// Largest tool-tip deviation from the straight line between blocks (mm).
+    /// Largest deviation of the tool tip or the flute top from the intended motion between
+    /// cutting blocks (mm).
     pub max_linearisation_error_mm: f64,
+    /// The same between the blocks of rapid moves (mm): they cut nothing; the verification
+    /// of the written program checks what their real motion sweeps.
+    pub max_rapid_linearisation_error_mm: f64,
     /// Blocks outside the machine limits.
     pub limit_violations: usize,
     /// Cutting moves with a change of solution branch (see [`PostReport::reconfigurations`]).
@@ -113,6 +121,7 @@ impl PostOperationReport {
             reverse_motions_before: m.reverse_motions_before,
             reverse_motions_after: m.reverse_motions_after,
             max_linearisation_error_mm: m.max_linearisation_error_mm,
+            max_rapid_linearisation_error_mm: m.max_rapid_linearisation_error_mm,
             limit_violations: m.limit_violations,
             reconfigurations: m.reconfigurations,
             reverse_motion_removal: p.reverse_motion_removal,
@@ -541,11 +550,11 @@ impl Report {
         }
         table_of_object(&mut h, &post);
         if !self.post.operations.is_empty() {
-            h.push_str("<table><tr><th>operation</th><th>blocks</th><th>reverse motions before</th><th>after</th><th>removal</th><th>smoothed runs</th><th>kept runs</th><th>max angle change (deg)</th><th>max linearisation error (mm)</th><th>limit violations</th></tr>");
+            h.push_str("<table><tr><th>operation</th><th>blocks</th><th>reverse motions before</th><th>after</th><th>removal</th><th>smoothed runs</th><th>kept runs</th><th>max angle change (deg)</th><th>max linearisation error (mm)</th><th>rapids (mm)</th><th>limit violations</th></tr>");
             for o in &self.post.operations {
                 let _ = write!(
                     h,
-                    "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.3}</td><td>{:.5}</td><td>{}</td></tr>",
+                    "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.3}</td><td>{:.5}</td><td>{:.5}</td><td>{}</td></tr>",
                     esc(&o.name),
                     o.blocks,
                     o.reverse_motions_before,
@@ -555,6 +564,7 @@ impl Report {
                     o.kept_runs,
                     o.max_angle_change_deg,
                     o.max_linearisation_error_mm,
+                    o.max_rapid_linearisation_error_mm,
                     o.limit_violations
                 );
             }

@@ -164,9 +164,14 @@ pub struct PostMetrics {
     pub reverse_motions_before: usize,
     /// The same after removal (equals `before` without removal).
     pub reverse_motions_after: usize,
-    /// Largest tool-tip deviation (mm) of any joint-interpolated cutting block after
-    /// linearisation control.
+    /// Largest deviation (mm) of any joint-interpolated cutting (non-rapid) block after
+    /// linearisation control: of the tool tip and of the checked flute height.
     pub max_linearisation_error_mm: f64,
+    /// The same over the rapid moves that are linearised (with
+    /// [`PostOptions::linearise_rapids`]): they cut nothing, and the read-back verification
+    /// checks what the real motion sweeps.
+    #[serde(default)]
+    pub max_rapid_linearisation_error_mm: f64,
     /// Blocks outside the axis limits (only non-zero with [`LimitPolicy::Report`]).
     pub limit_violations: usize,
     /// Output blocks.
@@ -325,6 +330,7 @@ pub fn post_path_checked(
     let mut out: Vec<PostedBlock> = Vec::with_capacity(blocks.len());
     let mut inserted_blocks = 0;
     let mut max_err: f64 = 0.0;
+    let mut max_rapid_err: f64 = 0.0;
     let settings = LinearisationSettings {
         tol: options.linearisation_tol.unwrap_or(f64::INFINITY),
         height: options.check_height_mm,
@@ -383,7 +389,11 @@ pub fn post_path_checked(
         let mut b = b;
         if linearise && dev <= settings.tol {
             b.linearisation_error_mm = dev;
-            max_err = max_err.max(dev);
+            if b.kind == MoveKind::Rapid {
+                max_rapid_err = max_rapid_err.max(dev);
+            } else {
+                max_err = max_err.max(dev);
+            }
             set_feed(machine, &p, &mut b);
         } else if linearise {
             scratch.clear();
@@ -447,13 +457,21 @@ pub fn post_path_checked(
                     nb.limit_violation = Some(e);
                 }
                 set_feed(machine, &from, &mut nb);
-                max_err = max_err.max(err);
+                if b.kind == MoveKind::Rapid {
+                    max_rapid_err = max_rapid_err.max(err);
+                } else {
+                    max_err = max_err.max(err);
+                }
                 inserted_blocks += 1;
                 from = nb.clone();
                 out.push(nb);
             }
             b.linearisation_error_mm = last;
-            max_err = max_err.max(last);
+            if b.kind == MoveKind::Rapid {
+                max_rapid_err = max_rapid_err.max(last);
+            } else {
+                max_err = max_err.max(last);
+            }
             set_feed(machine, &from, &mut b);
         } else {
             set_feed(machine, &p, &mut b);
@@ -464,6 +482,7 @@ pub fn post_path_checked(
         reverse_motions_before,
         reverse_motions_after,
         max_linearisation_error_mm: max_err,
+        max_rapid_linearisation_error_mm: max_rapid_err,
         limit_violations: out.iter().filter(|b| b.limit_violation.is_some()).count(),
         blocks: out.len(),
         inserted_blocks,
