@@ -89,12 +89,11 @@ impl TileBounds {
     pub(crate) fn new(grid: &DexelGrid) -> Self {
         let (nu, _) = grid.size();
         let nt_u = nu.div_ceil(TILE);
-        let rows: Vec<&[Segments]> = grid.rows_par().collect();
-        let bounds = rows
-            .par_chunks(TILE)
+        let bounds = grid
+            .row_bands_par(TILE)
             .flat_map_iter(|tile_rows| {
                 let mut line = vec![ChunkBound::EMPTY; nt_u];
-                for row in tile_rows {
+                for row in tile_rows.chunks(nu.max(1)) {
                     for (ti, rays) in row.chunks(TILE).enumerate() {
                         if let Some(b) = line.get_mut(ti) {
                             for r in rays {

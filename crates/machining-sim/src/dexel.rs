@@ -207,9 +207,9 @@ impl DexelGrid {
     pub(crate) fn rows_mut(&mut self) -> rayon::slice::ChunksMut<'_, Segments> {
         self.rays.par_chunks_mut(self.nu.max(1))
     }
-    /// Rows of rays (each `nu` long), for parallel reading.
-    pub(crate) fn rows_par(&self) -> rayon::slice::Chunks<'_, Segments> {
-        self.rays.par_chunks(self.nu.max(1))
+    /// Bands of `rows` consecutive rows of rays (each row `nu` long), for parallel reading.
+    pub(crate) fn row_bands_par(&self, rows: usize) -> rayon::slice::Chunks<'_, Segments> {
+        self.rays.par_chunks(self.nu.max(1) * rows.max(1))
     }
     /// Rows of rays (each `nu` long), mutable, in order.
     pub(crate) fn rows_seq_mut(&mut self) -> std::slice::ChunksMut<'_, Segments> {

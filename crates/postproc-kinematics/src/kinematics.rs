@@ -252,6 +252,31 @@ impl Machine {
         tool_length: f64,
         prev: Option<&Joints>,
     ) -> Result<(Joints, Option<KinematicsError>), KinematicsError> {
+        let reference = prev.copied().unwrap_or(self.home);
+        let (best, fallback) =
+            self.choose_solution(cl, tool_length, &reference, |j| reference.rotary_travel(j))?;
+        let a = cl.axis.into_inner();
+        match (best, fallback) {
+            (Some((_, j)), _) => Ok((j, None)),
+            (None, Some((_, j))) => match self.check_limits(&j, LIMIT_SLACK) {
+                Err(e) => Ok((j, Some(e))),
+                Ok(()) => Err(KinematicsError::UnreachableOrientation(a.x, a.y, a.z)),
+            },
+            (None, None) => Err(KinematicsError::UnreachableOrientation(a.x, a.y, a.z)),
+        }
+    }
+
+    /// Of the two tilt-sign solutions for `cl`, each with the rotary equivalents nearest
+    /// `reference` (which also holds the rotate angle at a singular pose), the cheapest by
+    /// `cost` within the limits and the cheapest outside them: `(best, fallback)`, each with
+    /// its cost. Errors: non-finite input, an orientation the rotary axes cannot produce.
+    fn choose_solution(
+        &self,
+        cl: &CutterLocation,
+        tool_length: f64,
+        reference: &Joints,
+        cost: impl Fn(&Joints) -> f64,
+    ) -> Result<(Scored, Scored), KinematicsError> {
         if !(cl.tip.x.is_finite() && cl.tip.y.is_finite() && cl.tip.z.is_finite()) {
             return Err(KinematicsError::NonFinite("tool tip"));
         }
@@ -262,7 +287,6 @@ impl Machine {
         if !tool_length.is_finite() {
             return Err(KinematicsError::NonFinite("tool length"));
         }
-        let reference = prev.copied().unwrap_or(self.home);
         let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
         let tilt_spec = self.axis(AxisId::Tilt);
         let rot_spec = self.axis(AxisId::Rotate);
@@ -272,21 +296,14 @@ impl Machine {
             let (t, t_ok) = equivalent_angle(t, tilt_spec, reference.tilt);
             let (c, c_ok) = equivalent_angle(c, rot_spec, reference.rotate);
             let j = self.joints_for_angles(&cl.tip, tool_length, t, c);
-            let cost = (t - reference.tilt).abs() + (c - reference.rotate).abs();
+            let cost = cost(&j);
             let feasible = t_ok && c_ok && self.check_limits(&j, LIMIT_SLACK).is_ok();
             let slot = if feasible { &mut best } else { &mut fallback };
             if slot.as_ref().is_none_or(|(bc, _)| cost < *bc) {
                 *slot = Some((cost, j));
             }
         }
-        match (best, fallback) {
-            (Some((_, j)), _) => Ok((j, None)),
-            (None, Some((_, j))) => match self.check_limits(&j, LIMIT_SLACK) {
-                Err(e) => Ok((j, Some(e))),
-                Ok(()) => Err(KinematicsError::UnreachableOrientation(a.x, a.y, a.z)),
-            },
-            (None, None) => Err(KinematicsError::UnreachableOrientation(a.x, a.y, a.z)),
-        }
+        Ok((best, fallback))
     }
 
     /// Inverse kinematics for a posture on the motion from `a` to `b` (the midpoint a
@@ -308,34 +325,14 @@ impl Machine {
         a: &Joints,
         b: &Joints,
     ) -> Result<Joints, KinematicsError> {
-        if !(cl.tip.x.is_finite() && cl.tip.y.is_finite() && cl.tip.z.is_finite()) {
-            return Err(KinematicsError::NonFinite("tool tip"));
-        }
-        let u = cl.axis.into_inner();
-        if !(u.x.is_finite() && u.y.is_finite() && u.z.is_finite()) {
-            return Err(KinematicsError::NonFinite("tool axis"));
-        }
-        let middle = 0.5 * (a.rotate + b.rotate);
-        let sols = self.rotary_solutions(&cl.axis, middle)?;
-        let tilt_spec = self.axis(AxisId::Tilt);
-        let rot_spec = self.axis(AxisId::Rotate);
-        let mid_tilt = 0.5 * (a.tilt + b.tilt);
-        let mut best: Option<(f64, Joints)> = None;
-        for (t, c) in sols {
-            let (t, t_ok) = equivalent_angle(t, tilt_spec, mid_tilt);
-            let (c, c_ok) = equivalent_angle(c, rot_spec, middle);
-            if !(t_ok && c_ok) {
-                continue;
-            }
-            let j = self.joints_for_angles(&cl.tip, tool_length, t, c);
-            if self.check_limits(&j, LIMIT_SLACK).is_err() {
-                continue;
-            }
-            let cost = a.rotary_travel(&j) + j.rotary_travel(b);
-            if best.as_ref().is_none_or(|(bc, _)| cost < *bc) {
-                best = Some((cost, j));
-            }
-        }
+        let middle = Joints {
+            tilt: 0.5 * (a.tilt + b.tilt),
+            rotate: 0.5 * (a.rotate + b.rotate),
+            ..*a
+        };
+        let (best, _) = self.choose_solution(cl, tool_length, &middle, |j| {
+            a.rotary_travel(j) + j.rotary_travel(b)
+        })?;
         match best {
             Some((_, j)) => Ok(j),
             None => self.inverse(cl, tool_length, Some(a)),
@@ -411,6 +408,9 @@ pub fn wrap_pi(a: f64) -> f64 {
         w
     }
 }
+
+/// A posture with its cost, if any (see `Machine::choose_solution`).
+type Scored = Option<(f64, Joints)>;
 
 /// The 2π-equivalent of `angle` nearest `reference` within the axis travel; `false` when no
 /// equivalent lies within the travel (then the one nearest the travel is returned).
