@@ -746,6 +746,9 @@ pub struct DesignClearance<'a> {
     /// Largest distance of a tool point from the tip (top of the holder plus its radius):
     /// the lever arm of a change of tool axis in [`DesignClearance::segment_clearance`].
     reach_mm: f64,
+    /// The same lever arm for the cutter samples alone (highest sample plus the widest
+    /// sample radius): the flutes' part of [`DesignClearance::segment_clearance`].
+    flute_reach_mm: f64,
 }
 
 impl std::fmt::Debug for DesignClearance<'_> {
@@ -876,6 +879,8 @@ impl<'a> DesignClearance<'a> {
         if let Some(s) = impeller.splitter() {
             rows.push((Row::Splitter, RowAngles::new(s)));
         }
+        let flute_reach_mm = samples.iter().map(|s| s.0).fold(0.0, f64::max)
+            + samples.iter().map(|s| s.1).fold(0.0, f64::max);
         let widest = samples
             .iter()
             .chain(&upper_samples)
@@ -901,6 +906,7 @@ impl<'a> DesignClearance<'a> {
             ],
             rows,
             reach_mm: top + widest,
+            flute_reach_mm,
         })
     }
 
@@ -1079,6 +1085,7 @@ impl<'a> DesignClearance<'a> {
             Want {
                 cap: min_clearance_mm,
                 fail_below: min_clearance_mm,
+                upper: true,
             },
         )
         .distance_mm
@@ -1098,6 +1105,7 @@ impl<'a> DesignClearance<'a> {
             Want {
                 cap: f64::INFINITY,
                 fail_below: min_clearance_mm,
+                upper: true,
             },
         );
         (c.distance_mm >= min_clearance_mm).then_some(c)
@@ -1116,9 +1124,19 @@ impl<'a> DesignClearance<'a> {
     /// whose bound reaches `min_clearance_mm − tol_mm` are accepted; the others are split at
     /// their midpoint, which is queried. The bound is as exact as [`Self::clearance`] itself.
     ///
+    /// The lever arm is split by tool part: the shank and holder (with the shroud samples
+    /// above the flutes) reach `R`, the cutter samples only `R_f` (highest sample plus the
+    /// widest sample radius), typically a fifth of `R`. The upper parts are checked first
+    /// over the whole motion: when both ends keep them `floor + D_u/2` clear
+    /// (`D_u = |Δtip| + θ·R`), the bound `(c₀ + c₁ − D_u)/2 ≥ floor` holds for them on `[0, 1]`,
+    /// and the bisection measures the cutter alone with `D_f = |Δtip| + θ·R_f` (the ends'
+    /// whole-tool clearances bound the cutter's from below). Otherwise the whole tool is
+    /// bisected with `D_u`, as above.
+    ///
     /// Cost: 2 queries when the ends are clear by more than `D/2`; about
     /// `log₂(D/tol_mm)` more per place where the motion comes within `D/2` of the design,
-    /// at most `max_queries` (then the motion counts as not clear, at the last midpoint).
+    /// at most `max_queries` (then the motion counts as not clear, at the last midpoint);
+    /// two capped shank/holder queries more when the cutter's `D_f` is the one bisected.
     pub fn segment_clearance(
         &self,
         a: &CutterLocation,
@@ -1158,8 +1176,29 @@ impl<'a> DesignClearance<'a> {
             tip: a.tip + (b.tip - a.tip) * s,
             axis: a.axis.slerp(&b.axis, s),
         };
-        let span = (b.tip - a.tip).norm() + a.axis.angle(&b.axis) * self.reach_mm;
         let floor = min_clearance_mm - tol_mm.max(0.0);
+        let (shift, turn) = ((b.tip - a.tip).norm(), a.axis.angle(&b.axis));
+        let whole = shift + turn * self.reach_mm;
+        // The shank and holder over the whole motion: clear when both ends keep them
+        // `floor + whole/2` away; then only the cutter samples are bisected, with their own
+        // lever arm.
+        let upper_clear = 0.5 * (ca + cb - whole) < floor && {
+            let need = floor + 0.5 * whole;
+            let only_upper = Want {
+                cap: need,
+                fail_below: need,
+                upper: true,
+            };
+            [a, b].iter().all(|cl| {
+                let mut best = NO_CLEARANCE;
+                !self.upper_and_frusta(cl, only_upper, &mut best) && best.distance_mm >= need
+            })
+        };
+        let (span, upper) = if upper_clear {
+            (shift + turn * self.flute_reach_mm, false)
+        } else {
+            (whole, true)
+        };
         let mut stack = vec![(0.0, ca, 1.0, cb)];
         let mut queries = 0;
         while let Some((s0, c0, s1, c1)) = stack.pop() {
@@ -1179,6 +1218,7 @@ impl<'a> DesignClearance<'a> {
                     Want {
                         cap: settle.max(min_clearance_mm),
                         fail_below: min_clearance_mm,
+                        upper,
                     },
                 )
                 .distance_mm;
@@ -1288,7 +1328,9 @@ impl<'a> DesignClearance<'a> {
         if parts.blades && !samples.is_empty() && self.blade_search(cl, samples, want, &mut best) {
             return best;
         }
-        self.upper_and_frusta(cl, want, &mut best);
+        if want.upper {
+            self.upper_and_frusta(cl, want, &mut best);
+        }
         best
     }
 
@@ -1680,6 +1722,9 @@ impl ContourEnd {
 struct Want {
     cap: f64,
     fail_below: f64,
+    /// Whether the shank, the holder and the shroud samples above the flutes are measured
+    /// (else the cutter samples alone).
+    upper: bool,
 }
 
 impl Want {
@@ -1687,6 +1732,7 @@ impl Want {
     const MINIMUM: Self = Self {
         cap: f64::INFINITY,
         fail_below: f64::NEG_INFINITY,
+        upper: true,
     };
 
     /// The value below which a sample or part still matters, given the answer so far.
