@@ -44,6 +44,7 @@ use cam_plan::{
     PlotSeries,
 };
 use impeller_model::Side;
+use rayon::prelude::*;
 use serde::Deserialize;
 
 /// Which sides of the blade are finished.
@@ -712,18 +713,62 @@ impl FlankFinishing {
         let mut final_dev = 0.0f64;
         let mut one_path = ToolPath::new(&self.name, &self.tool);
         let count = ctx.impeller.main().count();
-        for (k, &side) in sides.iter().enumerate() {
-            let mut fs = FlankSide::new(ctx.impeller, side, p.samples_along, p.samples_across)?;
-            let mut runs: Vec<(String, Vec<HistoryRow>)> = Vec::new();
-            if k == 0 && p.optimise_shape {
-                let start = match cutter.shape {
-                    CutterShape::TaperedBallEnd { .. } => cutter.shape,
-                    other => CutterShape::TaperedBallEnd {
-                        ball_radius: ball_radius(&other),
-                        half_angle: 1f64.to_radians(),
-                    },
+        // The SLP runs are independent of each other (each side's job path; on the first
+        // side also the shape study, the best cylinder and the second start): run them in
+        // parallel, then report them in the order of the sides.
+        let study_start = match cutter.shape {
+            CutterShape::TaperedBallEnd { .. } => cutter.shape,
+            other => CutterShape::TaperedBallEnd {
+                ball_radius: ball_radius(&other),
+                half_angle: 1f64.to_radians(),
+            },
+        };
+        let side_runs: Vec<Result<SideRuns, FlankError>> = sides
+            .par_iter()
+            .enumerate()
+            .map(|(k, &side)| {
+                let fresh = FlankSide::new(ctx.impeller, side, p.samples_along, p.samples_across)?;
+                let first = k == 0;
+                let job = || {
+                    let mut fs = fresh.clone();
+                    minimax_measured(&mut fs, cutter.shape, p.initial_path, &run).map(|m| (fs, m))
                 };
-                let study = optimise(&fs, start, p.initial_path, Mode::Shape, &run)?;
+                let study = || {
+                    (first && p.optimise_shape)
+                        .then(|| optimise(&fresh, study_start, p.initial_path, Mode::Shape, &run))
+                };
+                let cylinder = || {
+                    (first && p.compare_cylindrical)
+                        .then(|| best_cylinder(&fresh, &catalogue, p.initial_path, &run))
+                };
+                let second = || {
+                    p.second_initial_path.filter(|_| first).map(|how| {
+                        let mut second_side = fresh.clone();
+                        minimax_measured(&mut second_side, cutter.shape, how, &run)
+                    })
+                };
+                let ((job, study), (cylinder, second)) =
+                    rayon::join(|| rayon::join(job, study), || rayon::join(cylinder, second));
+                Ok(SideRuns {
+                    fresh,
+                    job,
+                    study,
+                    cylinder,
+                    second,
+                })
+            })
+            .collect();
+        for (&side, runs_of_side) in sides.iter().zip(side_runs) {
+            let SideRuns {
+                fresh: job_side,
+                job,
+                study,
+                cylinder,
+                second,
+            } = runs_of_side?;
+            let mut runs: Vec<(String, Vec<HistoryRow>)> = Vec::new();
+            if let Some(study) = study {
+                let study = study?;
                 iterations += study.iterations;
                 let (r_opt, t_opt) = (study.x[0], study.x[1]);
                 metrics.number("optimal_ball_radius_mm", r_opt);
@@ -759,8 +804,7 @@ impl FlankFinishing {
                 }
                 runs.push(("shape and path".into(), study.history));
             }
-            let job_side = fs.clone();
-            let measured = minimax_measured(&mut fs, cutter.shape, p.initial_path, &run)?;
+            let (fs, measured) = job?;
             iterations += measured.iterations;
             termination = worse(termination, measured.termination);
             let (res, dense) = (&measured.path, &measured.dense);
@@ -789,8 +833,8 @@ impl FlankFinishing {
                 &format!("flank finishing: signed deviation over the {side:?} side (mm)"),
             ));
             runs.push(("job tool path (minimax)".into(), res.history.clone()));
-            if k == 0 && p.compare_cylindrical {
-                match best_cylinder(&job_side, &catalogue, p.initial_path, &run)? {
+            if let Some(cylinder) = cylinder {
+                match cylinder? {
                     Some(cyl) => {
                         let (cp, cd) = (&cyl.path, &cyl.dense);
                         cylinder_k = cp.stiffness_n_per_mm;
@@ -847,11 +891,10 @@ impl FlankFinishing {
                         .push("no catalogue cylindrical ball end keeps the clearance".into()),
                 }
             }
-            if let (0, Some(how)) = (k, p.second_initial_path) {
+            if let (Some(how), Some(second)) = (p.second_initial_path, second) {
                 // Issue 13: the minimax from a second initial path, measured the same way;
                 // both largest deviations and their ratio (larger over smaller) are reported.
-                let mut second_side = job_side.clone();
-                let second = minimax_measured(&mut second_side, cutter.shape, how, &run)?;
+                let second = second?;
                 let d2 = second
                     .dense
                     .max_overcut_mm
@@ -959,6 +1002,20 @@ impl FlankFinishing {
         out.metrics = metrics;
         Ok(out)
     }
+}
+
+/// The SLP runs of one blade side, computed in parallel before they are reported.
+struct SideRuns {
+    /// The side as built, before the job path's refinement added samples to it.
+    fresh: FlankSide,
+    /// The job tool's measured minimax path and the side with its refinement samples.
+    job: Result<(FlankSide, MeasuredPath), FlankError>,
+    /// The cutter-shape study (first side, `optimise_shape`).
+    study: Option<Result<PathResult, FlankError>>,
+    /// The best cylindrical ball end (first side, `compare_cylindrical`).
+    cylinder: Option<Result<Option<MeasuredPath>, FlankError>>,
+    /// The job tool from the second initial path (first side, `second_initial_path`).
+    second: Option<Result<MeasuredPath, FlankError>>,
 }
 
 /// Refinement rounds (dense measurement, overcut points added as samples, re-optimisation)
