@@ -58,6 +58,7 @@ pub mod error;
 pub mod export;
 pub mod impeller_design;
 pub mod measure;
+pub mod merge;
 pub mod motion;
 pub mod removal;
 pub mod simulate;

@@ -2,7 +2,11 @@
 //! measure overcut and residual over the design surfaces.
 //!
 //! Each move is sampled at the positions of [`crate::motion::positions_for_move`] (sweep
-//! tolerance default `h/4` for cell `h`); positions are applied in batches with
+//! tolerance default `h/4` for cell `h`), except that runs of feed blocks that stay within a
+//! quarter of that tolerance of one straight chord get positions spaced along the run as a
+//! whole, on the actual motion ([`crate::merge`]: the swept volume is under-read by at most
+//! the tolerance either way, never over-read);
+//! positions are applied in batches with
 //! [`crate::removal::apply_batch`] (parallel over ray rows, exact sequential semantics, rays
 //! culled where provably untouched), and each batch's shank/holder placements are checked
 //! against the design mesh in parallel over contiguous chunks, skipping the pieces whose
@@ -16,7 +20,8 @@ use crate::dexel::TriDexel;
 use crate::endpoints::overcut_error_bound;
 use crate::error::SimError;
 use crate::measure::{extremum, measure, Extremum, SurfaceMap};
-use crate::motion::{positions_for_move, Interpolation};
+use crate::merge::{run_step, Run};
+use crate::motion::{has_flat_face, positions_for_move, scallop_radius, Interpolation};
 use crate::removal::{apply_batch, PartKind, Placement, ToolBody};
 use cam_core::{Cutter, MoveKind, ToolPath};
 use rayon::prelude::*;
@@ -44,6 +49,10 @@ pub struct SimOptions {
     pub probe_depth_mm: f64,
     /// Positions per batch.
     pub batch_positions: usize,
+    /// Space the positions of runs of short feed blocks along the run as a whole when the
+    /// run stays within a quarter of the sweep tolerance of one straight chord
+    /// ([`crate::merge`]); the under-read bound is unchanged and nothing is over-read.
+    pub merge_blocks: bool,
     /// Print progress on stderr (lines every 2 s; see also `on_progress`).
     pub progress: bool,
     /// Called after every batch of positions and when the measurement starts, instead of
@@ -86,6 +95,7 @@ impl Default for SimOptions {
             collision_tol_mm: None,
             probe_depth_mm: 3.0,
             batch_positions: 4096,
+            merge_blocks: true,
             progress: false,
             on_progress: None,
         }
@@ -316,7 +326,69 @@ pub fn cut(
     };
 
     let mut done_moves = 0usize;
+    // Deviation budget of a run of blocks sampled as a whole (`merge`: the rest of the
+    // tolerance spaces its positions).
+    let budget = if options.merge_blocks {
+        0.25 * tol
+    } else {
+        -1.0
+    };
+    let sub = match options.interpolation {
+        Interpolation::Tcp => 2,
+        Interpolation::Custom(_) => 8,
+    };
+    let mut run = Run::default();
+    let mut samples: Vec<cam_core::CutterLocation> = Vec::with_capacity(sub);
     for (oi, (cutter, path)) in ops.iter().enumerate() {
+        // Positions of the pending run of blocks (one block: its own positions, as the
+        // controller moves; several: along their chord).
+        let emit = |run: &mut Run, batch: &mut Vec<Placement>, meta: &mut Vec<(usize, usize)>| {
+            let mut push = |c: &cam_core::CutterLocation, mi: usize| {
+                batch.push(Placement {
+                    tip: [c.tip.x, c.tip.y, c.tip.z],
+                    axis: [c.axis.x, c.axis.y, c.axis.z],
+                    tool: oi,
+                    rapid: false,
+                });
+                meta.push((oi, mi));
+            };
+            match (run.start, run.blocks.as_slice()) {
+                (Some(from), &[(mi, _, cl, _)]) => {
+                    let n =
+                        positions_for_move(cutter, &options.interpolation, oi, mi, &from, &cl, tol);
+                    for k in 1..=n {
+                        let c = if k == n {
+                            cl
+                        } else {
+                            options
+                                .interpolation
+                                .at(oi, mi, &from, &cl, k as f64 / n as f64)
+                        };
+                        push(&c, mi);
+                    }
+                }
+                (Some(_), [.., (_, _, end, _)]) => {
+                    let step = run_step(scallop_radius(&cutter.shape), tol, run.deviation_mm)
+                        .unwrap_or(f64::INFINITY)
+                        .max(1e-9);
+                    let n = ((run.displacement_mm() / step).ceil() as usize).clamp(1, 1_000_000);
+                    let end = *end;
+                    for (mi, a, b, f) in run.positions(n) {
+                        let c = if f >= 1.0 {
+                            b
+                        } else {
+                            options.interpolation.at(oi, mi, &a, &b, f)
+                        };
+                        push(&c, mi);
+                    }
+                    debug_assert!(batch
+                        .last()
+                        .is_some_and(|p| p.tip == [end.tip.x, end.tip.y, end.tip.z]));
+                }
+                _ => {}
+            }
+            run.clear();
+        };
         for (mi, mv) in path.moves.iter().enumerate() {
             let cl = mv.cl;
             let finite =
@@ -328,29 +400,53 @@ pub fn cut(
                 });
             }
             let rapid = mv.kind == MoveKind::Rapid;
-            let mut push = |c: &cam_core::CutterLocation| {
+            if mi == 0 {
+                emit(&mut run, &mut batch, &mut meta);
                 batch.push(Placement {
-                    tip: [c.tip.x, c.tip.y, c.tip.z],
-                    axis: [c.axis.x, c.axis.y, c.axis.z],
+                    tip: [cl.tip.x, cl.tip.y, cl.tip.z],
+                    axis: [cl.axis.x, cl.axis.y, cl.axis.z],
                     tool: oi,
                     rapid,
                 });
                 meta.push((oi, mi));
-            };
-            if mi == 0 {
-                push(&cl);
             } else {
                 let from = path.moves[mi - 1].cl;
-                let n = positions_for_move(cutter, &options.interpolation, oi, mi, &from, &cl, tol);
-                for k in 1..=n {
-                    let c = if k == n {
-                        cl
-                    } else {
+                if rapid {
+                    emit(&mut run, &mut batch, &mut meta);
+                    let n =
+                        positions_for_move(cutter, &options.interpolation, oi, mi, &from, &cl, tol);
+                    for k in 1..=n {
+                        let c = if k == n {
+                            cl
+                        } else {
+                            options
+                                .interpolation
+                                .at(oi, mi, &from, &cl, k as f64 / n as f64)
+                        };
+                        batch.push(Placement {
+                            tip: [c.tip.x, c.tip.y, c.tip.z],
+                            axis: [c.axis.x, c.axis.y, c.axis.z],
+                            tool: oi,
+                            rapid,
+                        });
+                        meta.push((oi, mi));
+                    }
+                } else {
+                    samples.clear();
+                    samples.extend((1..=sub).map(|k| {
                         options
                             .interpolation
-                            .at(oi, mi, &from, &cl, k as f64 / n as f64)
+                            .at(oi, mi, &from, &cl, k as f64 / sub as f64)
+                    }));
+                    let budget = if has_flat_face(&cutter.shape) {
+                        -1.0
+                    } else {
+                        budget
                     };
-                    push(&c);
+                    if !run.try_extend(cutter, mi, cl, &samples, budget) {
+                        emit(&mut run, &mut batch, &mut meta);
+                        run.begin(cutter, from, mi, cl, &samples);
+                    }
                 }
             }
             done_moves += 1;
@@ -380,6 +476,7 @@ pub fn cut(
                 }
             }
         }
+        emit(&mut run, &mut batch, &mut meta);
     }
     flush(
         &mut batch,
