@@ -102,7 +102,6 @@ use cam_core::{CutterLocation, CutterShape};
 use impeller_model::export::stl::tessellate;
 use impeller_model::query::blade_side_distance;
 use impeller_model::{BladeSet, Impeller, Side};
-use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::math::{Pose, Rotation, Vector as PVec};
 use parry3d_f64::query::{self, PointQueryWithLocation};
 use parry3d_f64::shape::{CompositeShapeRef, TriMesh};
@@ -680,50 +679,91 @@ fn frustum_shape(h0: f64, h1: f64, r0: f64, r1: f64, chord: f64) -> Option<RingF
 }
 
 /// Deepest contact (or nearest within `prediction`) between a frustum at `pose` and a mesh
-/// in the world frame: the mesh's triangles whose boxes meet the frustum's box loosened by
-/// `prediction`, each by GJK/EPA against the frustum's support function (what parry's
-/// `query::contact` does for a convex shape against a mesh). Returns the distance (negative:
-/// penetration depth) and the point on the mesh.
+/// in the world frame: the least signed distance (negative: penetration depth) over the
+/// mesh's triangles, each by GJK/EPA against the frustum's support function (what parry's
+/// `query::contact` does for a convex shape against a mesh), and the point on the mesh.
+///
+/// Branch and bound over the mesh's BVH (parry's best-first `find_best`): a node or triangle
+/// is bounded from below by its bounding sphere against the solid cylinder of the largest
+/// ring radius between the two ring planes (which contains the polyhedron), a node also by
+/// the gap between its box and the frustum's, and one whose
+/// bound is positive and not below the least distance found so far (initially
+/// `prediction`) holds no triangle that could lower the answer, so it is skipped whole. A
+/// bound ≤ 0 says nothing of a penetration's depth, so such nodes are always opened and
+/// such triangles always solved. The answer is that of solving every triangle within
+/// `prediction` (up to ties); only the number of GJK solves changes — on the blade-root
+/// finishing of the default job, 816 solves among 12 000 candidate triangles per frustum
+/// query when the triangles were taken in the order of an AABB query.
 fn frustum_mesh_contact(
     pose: &Pose,
     f: &RingFrustum,
     mesh: &TriMesh,
     prediction: f64,
 ) -> Option<(f64, PVec)> {
-    let aabb = f.world_aabb(pose).loosened(prediction);
     let axis = pose.rotation * PVec::Z;
     let (h_lo, h_hi) = (f.h[0].min(f.h[1]), f.h[0].max(f.h[1]));
     let r_max = f.rho[0].max(f.rho[1]);
-    let mut best: Option<(f64, PVec)> = None;
-    for id in mesh.bvh().intersect_aabb(&aabb) {
-        let tri = mesh.triangle(id);
-        // A lower bound of the triangle's distance to the frustum (its bounding sphere
-        // against the solid cylinder of the largest ring radius between the two ring planes,
-        // which contains the polyhedron): a triangle that is certainly apart from the
-        // frustum (bound > 0) and cannot come nearer than the best so far (or the
-        // prediction) is skipped without GJK, which does not change the answer. (A bound
-        // ≤ 0 says nothing of a penetration's depth, so such triangles are always solved.)
-        let m = (tri.a + tri.b + tri.c) / 3.0;
-        let tri_r = (tri.a - m)
-            .length()
-            .max((tri.b - m).length())
-            .max((tri.c - m).length());
+    // Lower bound of the distance from a ball (centre `m`, radius `r`) to the frustum.
+    let lower = |m: PVec, r: f64| {
         let w = m - pose.translation;
         let z = w.dot(axis);
         let rho = (w.length_squared() - z * z).max(0.0).sqrt();
         let (dr, dz) = ((rho - r_max).max(0.0), (h_lo - z).max(z - h_hi).max(0.0));
-        let lower = (dr * dr + dz * dz).sqrt() - tri_r;
-        if lower > 0.0 && lower > best.map_or(prediction, |(d, _)| d) {
-            continue;
+        let d = (dr * dr + dz * dz).sqrt() - r;
+        if d > 0.0 {
+            d
+        } else {
+            f64::NEG_INFINITY
         }
-        if let Some(c) = query::contact::contact_support_map_support_map(pose, &tri, f, prediction)
-        {
-            if best.is_none_or(|(d, _)| c.dist < d) {
-                best = Some((c.dist, c.point1));
+    };
+    let frame = f.world_aabb(pose);
+    let (_, hit) = mesh.bvh().find_best(
+        prediction.next_up(),
+        |node, _| {
+            let (lo, hi) = (node.mins(), node.maxs());
+            // The gap between the node's box and the frustum's box bounds it too.
+            let gap = (frame.mins - hi)
+                .max(lo - frame.maxs)
+                .max(PVec::ZERO)
+                .length();
+            let ball = lower(0.5 * (lo + hi), 0.5 * (hi - lo).length());
+            if gap > 0.0 {
+                gap.max(ball)
+            } else {
+                ball
             }
-        }
+        },
+        |id, best| {
+            let tri = mesh.triangle(id);
+            let m = (tri.a + tri.b + tri.c) / 3.0;
+            let tri_r = (tri.a - m)
+                .length()
+                .max((tri.b - m).length())
+                .max((tri.c - m).length());
+            if lower(m, tri_r) >= best {
+                return None;
+            }
+            query::contact::contact_support_map_support_map(pose, &tri, f, prediction).map(|c| {
+                MeshContact {
+                    dist: c.dist,
+                    point: c.point1,
+                }
+            })
+        },
+    )?;
+    Some((hit.dist, hit.point))
+}
+
+/// A frustum–triangle contact as a cost of the BVH search (its signed distance).
+struct MeshContact {
+    dist: f64,
+    point: PVec,
+}
+
+impl parry3d_f64::partitioning::BvhLeafCost for MeshContact {
+    fn cost(&self) -> f64 {
+        self.dist
     }
-    best
 }
 
 /// Clearance of one tool against one impeller's design.
