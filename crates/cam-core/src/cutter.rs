@@ -136,46 +136,112 @@ impl CutterShape {
     }
 
     /// Radius of the cutting end's solid of revolution at height `h >= 0` above the tip,
-    /// assuming the flutes continue indefinitely (closed form, O(1)).
+    /// assuming the flutes continue indefinitely (closed form, O(1)). For many queries of one
+    /// shape, [`RadiusProfile`] computes the same values without the trigonometry per call.
     pub fn radius_at(&self, h: f64) -> f64 {
-        let h = h.max(0.0);
-        match *self {
-            CutterShape::FlatEnd { radius } => radius,
-            CutterShape::BallEnd { radius } => {
-                if h >= radius {
-                    radius
-                } else {
-                    (radius * radius - (radius - h) * (radius - h))
-                        .max(0.0)
-                        .sqrt()
-                }
-            }
+        RadiusProfile::new(self).radius_at(h)
+    }
+
+    /// The shape's [`RadiusProfile`].
+    pub fn profile(&self) -> RadiusProfile {
+        RadiusProfile::new(self)
+    }
+}
+
+/// The radius of a cutting end as a function of the height above the tip, with the shape's
+/// trigonometric constants (taper and the ball–cone tangency) evaluated once:
+/// [`CutterShape::radius_at`] for repeated queries, bit for bit the same values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadiusProfile(Profile);
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Profile {
+    /// A cylinder of this radius.
+    Flat(f64),
+    /// A rounded end: a quarter circle of radius `corner` whose centre lies `offset` from
+    /// the axis, then the cylinder of radius `radius` = `offset + corner` (ball end:
+    /// offset 0).
+    Rounded {
+        radius: f64,
+        offset: f64,
+        corner: f64,
+    },
+    /// A ball of radius `r` tangent at height `h_t` (radius `r_t`) to a cone of slope `tan`.
+    TaperedBall {
+        r: f64,
+        h_t: f64,
+        r_t: f64,
+        tan: f64,
+    },
+    /// A cone of tip radius `r0` and slope `tan`.
+    TaperedFlat { r0: f64, tan: f64 },
+}
+
+impl RadiusProfile {
+    /// The profile of `shape`.
+    pub fn new(shape: &CutterShape) -> Self {
+        Self(match *shape {
+            CutterShape::FlatEnd { radius } => Profile::Flat(radius),
+            CutterShape::BallEnd { radius } => Profile::Rounded {
+                radius,
+                offset: 0.0,
+                corner: radius,
+            },
             CutterShape::BullNose {
                 radius,
-                corner_radius: rc,
+                corner_radius,
+            } => Profile::Rounded {
+                radius,
+                offset: radius - corner_radius,
+                corner: corner_radius,
+            },
+            CutterShape::TaperedBallEnd {
+                ball_radius: r,
+                half_angle: t,
+            } => Profile::TaperedBall {
+                // Tangency of the cone and the ball lies at height r(1 - sin θ), radius r cos θ.
+                r,
+                h_t: r * (1.0 - t.sin()),
+                r_t: r * t.cos(),
+                tan: t.tan(),
+            },
+            CutterShape::TaperedFlatEnd {
+                tip_radius,
+                half_angle,
+            } => Profile::TaperedFlat {
+                r0: tip_radius,
+                tan: half_angle.tan(),
+            },
+        })
+    }
+
+    /// Radius at height `h` (heights below the tip count as 0), as
+    /// [`CutterShape::radius_at`].
+    #[inline]
+    pub fn radius_at(&self, h: f64) -> f64 {
+        let h = h.max(0.0);
+        match self.0 {
+            Profile::Flat(radius) => radius,
+            Profile::Rounded {
+                radius,
+                offset,
+                corner: rc,
             } => {
                 if h >= rc {
                     radius
                 } else {
-                    radius - rc + (rc * rc - (rc - h) * (rc - h)).max(0.0).sqrt()
+                    // `0 + x` is `x` for the ball end's `x ≥ 0`.
+                    offset + (rc * rc - (rc - h) * (rc - h)).max(0.0).sqrt()
                 }
             }
-            CutterShape::TaperedBallEnd {
-                ball_radius: r,
-                half_angle: t,
-            } => {
-                // Tangency of the cone and the ball lies at height r(1 - sin θ), radius r cos θ.
-                let h_t = r * (1.0 - t.sin());
+            Profile::TaperedBall { r, h_t, r_t, tan } => {
                 if h <= h_t {
                     (r * r - (r - h) * (r - h)).max(0.0).sqrt()
                 } else {
-                    r * t.cos() + (h - h_t) * t.tan()
+                    r_t + (h - h_t) * tan
                 }
             }
-            CutterShape::TaperedFlatEnd {
-                tip_radius,
-                half_angle,
-            } => tip_radius + h * half_angle.tan(),
+            Profile::TaperedFlat { r0, tan } => r0 + h * tan,
         }
     }
 }

@@ -30,7 +30,7 @@ pub use contact::{
     bull_nose_step_over, contact_location, contact_location_at_height, scallop_approx,
     step_over_approx, Contact, ContactError, ContactPart,
 };
-pub use cutter::{Cutter, CutterShape, HolderSegment};
+pub use cutter::{Cutter, CutterShape, HolderSegment, RadiusProfile};
 pub use envelope::{
     ControlPointGradient, EnvelopeDistance, EnvelopeGradient, EnvelopeOptions, EnvelopeParam,
     SweptEnvelope,

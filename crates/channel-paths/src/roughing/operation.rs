@@ -1628,14 +1628,19 @@ fn polyline_len(pts: impl Iterator<Item = Vector3<f64>>) -> f64 {
 }
 
 /// Whether `x` lies inside the cutter at `cl` (solid of revolution up to the flute length).
-fn inside(shape: &CutterShape, flute: f64, cl: &CutterLocation, x: &Vector3<f64>) -> bool {
+fn inside(
+    profile: &cam_core::RadiusProfile,
+    flute: f64,
+    cl: &CutterLocation,
+    x: &Vector3<f64>,
+) -> bool {
     let a = cl.axis.into_inner();
     let d = x - cl.tip.coords;
     let h = d.dot(&a);
     if !(0.0..=flute).contains(&h) {
         return false;
     }
-    (d - a * h).norm() <= shape.radius_at(h)
+    (d - a * h).norm() <= profile.radius_at(h)
 }
 
 /// Largest scallop over a grid of the lane `region` (its machinable region): from each grid
@@ -1690,6 +1695,8 @@ fn measure_scallop(
     }
     let (ns, ny) = SCALLOP_GRID;
     let (s0, s1) = (region.s[0], region.s[region.s.len() - 1]);
+    let profile = shape.profile();
+    let mut near: Vec<&CutterLocation> = Vec::new();
     let mut worst: f64 = 0.0;
     for i in 0..=ns {
         let s = s0 + (s1 - s0) * i as f64 / ns as f64;
@@ -1697,13 +1704,15 @@ fn measure_scallop(
         for j in 0..=ny {
             let y = l + (r - l) * j as f64 / ny as f64;
             let (p, n) = lv.at_developed(s, y / lv.radius_at(s));
-            let near: Vec<&CutterLocation> = dense
-                .iter()
-                .filter(|c| (c.tip.coords - p).norm() <= 2.0 * reach + cap)
-                .collect();
+            near.clear();
+            near.extend(
+                dense
+                    .iter()
+                    .filter(|c| (c.tip.coords - p).norm() <= 2.0 * reach + cap),
+            );
             let hit = |t: f64| {
                 let x = p + n * t;
-                near.iter().any(|c| inside(shape, flute, c, &x))
+                near.iter().any(|c| inside(&profile, flute, c, &x))
             };
             if hit(0.0) {
                 continue;
