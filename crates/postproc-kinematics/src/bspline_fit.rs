@@ -108,6 +108,23 @@ fn basis(knots: &[f64], p: usize, span: usize, t: f64, n: &mut [f64; 4]) {
 /// `A[i][j] = N_j(t_i)`, banded: p + 1 non-zeros per row). `None` without samples.
 /// Cost O(m·p²) plus the O(m·n) zeroed matrix.
 pub(crate) fn collocation(t: &[f64], n_ctrl: usize) -> Option<(ScalarBSpline, DMatrix<f64>)> {
+    let (spline, rows) = collocation_rows(t, n_ctrl)?;
+    let (n, p) = (spline.ctrl.len(), spline.degree);
+    let mut a = DMatrix::<f64>::zeros(t.len(), n);
+    for (row, (first, nb)) in rows.iter().enumerate() {
+        for i in 0..=p {
+            a[(row, first + i)] = nb[i];
+        }
+    }
+    Some((spline, a))
+}
+
+/// A row of a banded matrix: its first non-zero column and the values from there.
+pub(crate) type BandRow = (usize, [f64; 4]);
+
+/// [`collocation`] by rows: for each parameter, the first column of its `p + 1` non-zeros
+/// and their values (the rest of the row is zero). O(m·p²).
+pub(crate) fn collocation_rows(t: &[f64], n_ctrl: usize) -> Option<(ScalarBSpline, Vec<BandRow>)> {
     let m = t.len();
     let n = n_ctrl.min(m).max(1);
     if m == 0 {
@@ -118,21 +135,21 @@ pub(crate) fn collocation(t: &[f64], n_ctrl: usize) -> Option<(ScalarBSpline, DM
     let mut knots = vec![0.0; p + 1];
     knots.extend((1..=inner).map(|i| i as f64 / (inner + 1) as f64));
     knots.extend(std::iter::repeat_n(1.0, p + 1));
-    let mut a = DMatrix::<f64>::zeros(m, n);
-    let mut nb = [0.0; 4];
-    for (row, &ti) in t.iter().enumerate() {
-        let span = find_span(&knots, p, n, ti);
-        basis(&knots, p, span, ti.clamp(0.0, 1.0), &mut nb);
-        for i in 0..=p {
-            a[(row, span - p + i)] = nb[i];
-        }
-    }
+    let rows = t
+        .iter()
+        .map(|&ti| {
+            let span = find_span(&knots, p, n, ti);
+            let mut nb = [0.0; 4];
+            basis(&knots, p, span, ti.clamp(0.0, 1.0), &mut nb);
+            (span - p, nb)
+        })
+        .collect();
     let spline = ScalarBSpline {
         degree: p,
         knots,
         ctrl: vec![0.0; n],
     };
-    Some((spline, a))
+    Some((spline, rows))
 }
 
 /// Least-squares fit of values `y` at parameters `t ∈ [0,1]` by a clamped uniform B-spline of

@@ -58,6 +58,7 @@
 //! assert_eq!(posted.blocks.len(), 1);
 //! ```
 
+pub mod banded_lsq;
 pub mod bspline_fit;
 pub mod error;
 pub mod feed;

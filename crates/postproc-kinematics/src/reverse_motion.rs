@@ -2,14 +2,15 @@
 //! displacement of an axis changes direction (paper 004: such reversals leave tool marks,
 //! because the feed drive stops and backlash acts).
 
-use crate::bspline_fit::{collocation, ScalarBSpline};
+use crate::banded_lsq::{BandedQr, MAX_BAND};
+use crate::bspline_fit::{collocation_rows, ScalarBSpline};
 use crate::error::PostError;
 use crate::joints::{AxisId, Joints};
 use crate::kinematics::LIMIT_SLACK;
 use crate::machine::Machine;
 use crate::post::PostedBlock;
 use cam_core::{CutterLocation, MoveKind};
-use nalgebra::{DMatrix, DVector, Dyn, SVD};
+use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -427,27 +428,34 @@ struct Pins {
 
 /// Least-squares projection onto the cubic B-splines of one parameter set and control-value
 /// count, with optionally pinned first / last control values: the collocation matrix `A`
-/// (`m × n`, `A[i][j] = N_j(t_i)`) and the SVD of its free columns, factored once (O(m·n²))
-/// and reused by every shift-and-smooth iteration (O(m·n) each). Without pins the solve is
-/// the one of [`crate::bspline_fit::fit_least_squares`] (same basis, same rank test and singular-value cut-off).
+/// (`m × n`, `A[i][j] = N_j(t_i)`, `p + 1` non-zeros per row) kept by rows, and the Givens QR
+/// of its free columns ([`crate::banded_lsq`]), factored once (O(m·p²)) and reused by every
+/// shift-and-smooth iteration (O(m·p) each). The rank test is the one of
+/// [`crate::bspline_fit::fit_least_squares`] (smallest singular value at least 10⁻¹⁰ of the
+/// largest), read from the singular values of the triangular factor (those of `A`, O(n³)).
 struct SplineProjector {
     template: ScalarBSpline,
-    a: DMatrix<f64>,
-    free: std::ops::Range<usize>,
-    svd: SVD<f64, Dyn, Dyn>,
-    eps: f64,
+    /// Row `i` of `A`: its first non-zero column and the `p + 1` values from there.
+    rows: Vec<(usize, [f64; MAX_BAND])>,
+    /// Number of columns (control values).
+    k: usize,
+    qr: BandedQr,
     pins: Pins,
 }
 
 impl SplineProjector {
     /// `None` when the fit with these parameters is rank deficient (the test of
-    /// [`crate::bspline_fit::fit_least_squares`] on the whole collocation matrix) or nothing is free. One SVD
-    /// with vectors of the free columns, plus the singular values of the whole matrix when
-    /// an end is pinned. O(m·n²).
+    /// [`crate::bspline_fit::fit_least_squares`] on the whole collocation matrix, and on its
+    /// free columns when an end is pinned) or nothing is free. O(m·p² + n³).
     fn new(t: &[f64], n_ctrl: usize, pins: Pins) -> Option<Self> {
-        let (template, a) = collocation(t, n_ctrl)?;
-        let k = a.ncols();
-        let full_rank = |sv: &DVector<f64>| {
+        let (template, rows) = collocation_rows(t, n_ctrl)?;
+        let k = template.control_points().len();
+        let w = template.degree() + 1;
+        let full_rank = |qr: &BandedQr| {
+            if !qr.is_complete() {
+                return false;
+            }
+            let sv = qr.r_dense().singular_values();
             let smax = sv.max();
             !(smax.is_nan() || smax <= 0.0 || sv.min() < 1e-10 * smax)
         };
@@ -456,41 +464,86 @@ impl SplineProjector {
         if lo >= hi {
             return None;
         }
-        // Without pins the free columns are the whole matrix and its SVD is the test.
-        if (lo, hi) != (0, k) && !full_rank(&a.clone().singular_values()) {
+        // Without pins the free columns are the whole matrix and its factor is the test.
+        if (lo, hi) != (0, k) && !full_rank(&BandedQr::new(k, w, rows.iter().copied())) {
             return None;
         }
-        let svd = a.columns(lo, hi - lo).into_owned().svd(true, true);
-        if !full_rank(&svd.singular_values) {
+        // The free columns `lo..hi`, renumbered from 0.
+        let free_rows = rows.iter().map(|&(first, v)| {
+            let mut out = [0.0; MAX_BAND];
+            let mut start = first;
+            for (d, x) in v.iter().enumerate().take(w) {
+                let col = first + d;
+                if col >= lo && col < hi {
+                    out[col - first] = *x;
+                }
+            }
+            if start < lo {
+                out.copy_within(lo - start..w, 0);
+                out[w - (lo - start)..w].iter_mut().for_each(|x| *x = 0.0);
+                start = lo;
+            }
+            (start - lo, out)
+        });
+        let qr = BandedQr::new(hi - lo, w, free_rows);
+        if !full_rank(&qr) {
             return None;
         }
-        let smax = svd.singular_values.max();
         Some(Self {
             template,
-            a,
-            free: lo..hi,
-            svd,
-            eps: 1e-12 * smax,
+            rows,
+            k,
+            qr,
             pins,
         })
     }
 
     /// Least-squares control values of `y` (pinned ones fixed) and the fitted values `A·x`.
     fn fit(&self, y: &[f64]) -> Option<(DVector<f64>, Vec<f64>)> {
-        let k = self.a.ncols();
-        let mut rhs = DVector::from_column_slice(y);
+        let k = self.k;
+        if y.len() != self.rows.len() {
+            return None;
+        }
+        let (start, end) = (self.pins.start, self.pins.end);
+        let rhs: Vec<f64> = self
+            .rows
+            .iter()
+            .zip(y)
+            .map(|(&(first, v), &yi)| {
+                let mut r = yi;
+                for (d, x) in v.iter().enumerate() {
+                    match (first + d, start, end) {
+                        (0, Some(s), _) => r -= x * s,
+                        (c, _, Some(e)) if c + 1 == k => r -= x * e,
+                        _ => {}
+                    }
+                }
+                r
+            })
+            .collect();
+        let xf = self.qr.solve(&rhs)?;
         let mut x = DVector::<f64>::zeros(k);
-        if let Some(v) = self.pins.start {
-            rhs -= self.a.column(0) * v;
+        let lo = usize::from(start.is_some());
+        if let Some(v) = start {
             x[0] = v;
         }
-        if let Some(v) = self.pins.end {
-            rhs -= self.a.column(k - 1) * v;
+        if let Some(v) = end {
             x[k - 1] = v;
         }
-        let xf = self.svd.solve(&rhs, self.eps).ok()?;
-        x.rows_mut(self.free.start, self.free.len()).copy_from(&xf);
-        let values = (&self.a * &x).iter().copied().collect();
+        for (j, v) in xf.into_iter().enumerate() {
+            x[lo + j] = v;
+        }
+        let values = self
+            .rows
+            .iter()
+            .map(|&(first, v)| {
+                v.iter()
+                    .enumerate()
+                    .filter(|(d, _)| first + d < k)
+                    .map(|(d, c)| c * x[first + d])
+                    .sum()
+            })
+            .collect();
         Some((x, values))
     }
 
