@@ -38,6 +38,7 @@ use crate::FlankError;
 use cam_core::{
     CutterLocation, CutterShape, EnvelopeOptions, GuideCurve, Point3, SphereFamily, SweptEnvelope,
 };
+use rayon::prelude::*;
 
 /// Certification tolerance of the measurement (mm): a member nearer than the answer by less
 /// than this may go unsearched, far below the 0.01 mm machining tolerances measured.
@@ -171,50 +172,73 @@ pub fn measure_written_path(
         uncertified_max_overcut_mm: 0.0,
         spacing_mm: 0.0,
     };
+    // The rows of constant `u` are independent (each chains its envelope hint along `v`
+    // from none): measured in parallel, then taken in order, so the result is that of the
+    // sequential scan.
+    let rows: Vec<Result<Vec<Measured>, FlankError>> = us
+        .par_iter()
+        .map(|&u| {
+            let mut hint = None;
+            let mut row = Vec::with_capacity(vs.len());
+            for &v in &vs {
+                let p = Point3::from(s.point(u, v));
+                let h = side.hub_distance(&p.coords);
+                if h < 0.0 {
+                    row.push(Measured { p, reading: None });
+                    continue;
+                }
+                let d = env.signed_distance(&p, hint)?;
+                hint = Some(d.param);
+                let pt = DensePoint {
+                    uv: (u, v),
+                    point: p,
+                    hub_height_mm: h,
+                    distance_mm: d.distance,
+                    segment: segment_of(d.param.s, m),
+                    member: d.param.t,
+                };
+                row.push(Measured {
+                    p,
+                    reading: Some((pt, d.certified, d.lower_bound)),
+                });
+            }
+            Ok(row)
+        })
+        .collect();
     let mut prev_row: Vec<Option<Point3>> = vec![None; vs.len()];
-    for &u in &us {
-        let mut hint = None;
+    for row in rows {
         let mut below: Option<Point3> = None;
-        for (j, &v) in vs.iter().enumerate() {
-            let p = Point3::from(s.point(u, v));
+        for (j, item) in row?.into_iter().enumerate() {
+            let p = item.p;
             for q in [below, prev_row[j]].into_iter().flatten() {
                 out.spacing_mm = out.spacing_mm.max((p - q).norm());
             }
             below = Some(p);
             prev_row[j] = Some(p);
-            let h = side.hub_distance(&p.coords);
-            if h < 0.0 {
+            let Some((pt, certified, lower_bound)) = item.reading else {
                 continue;
-            }
-            let d = env.signed_distance(&p, hint)?;
-            hint = Some(d.param);
-            out.points += 1;
-            if !d.certified {
-                out.uncertified += 1;
-                out.uncertified_max_overcut_mm = out.uncertified_max_overcut_mm.max(-d.lower_bound);
-            }
-            let pt = DensePoint {
-                uv: (u, v),
-                point: p,
-                hub_height_mm: h,
-                distance_mm: d.distance,
-                segment: segment_of(d.param.s, m),
-                member: d.param.t,
             };
-            if -d.distance > out.max_overcut_mm {
-                out.max_overcut_mm = -d.distance;
+            let h = pt.hub_height_mm;
+            let distance = pt.distance_mm;
+            out.points += 1;
+            if !certified {
+                out.uncertified += 1;
+                out.uncertified_max_overcut_mm = out.uncertified_max_overcut_mm.max(-lower_bound);
+            }
+            if -distance > out.max_overcut_mm {
+                out.max_overcut_mm = -distance;
                 out.worst_overcut = Some(pt);
             }
             let counted = if h >= 2.0 * root {
-                d.distance.abs()
+                distance.abs()
             } else {
-                -d.distance
+                -distance
             };
             if counted > report_mm {
                 out.outside_points.push(pt);
             }
-            if h >= 2.0 * root && d.distance > out.max_undercut_mm {
-                out.max_undercut_mm = d.distance;
+            if h >= 2.0 * root && distance > out.max_undercut_mm {
+                out.max_undercut_mm = distance;
                 out.worst_undercut = Some(pt);
             }
         }
@@ -222,6 +246,13 @@ pub fn measure_written_path(
     out.outside_points
         .sort_by(|a, b| b.distance_mm.abs().total_cmp(&a.distance_mm.abs()));
     Ok(out)
+}
+
+/// One grid point of [`measure_written_path`]: the point, and unless it lies below the hub,
+/// its dense point with whether the distance is certified and its lower bound.
+struct Measured {
+    p: Point3,
+    reading: Option<(DensePoint, bool, f64)>,
 }
 
 /// The swept envelope of `shape` moved linearly between the written `locations` (tip and

@@ -34,6 +34,7 @@ use cam_core::{
     Vector3,
 };
 use cutter_stiffness::{ConicalCutter, RitzOptions};
+use rayon::prelude::*;
 
 /// Adjacent-blade samples farther than this beyond the clearance bound are left out of the
 /// LP (the trust region moves the cutter far less in one step).
@@ -243,8 +244,43 @@ impl<'a> FlankProblem<'a> {
         hint_slot: usize,
         gradients: bool,
     ) -> Result<Row, FlankError> {
-        let d = env.signed_distance(p, self.hints[hint_slot])?;
-        self.hints[hint_slot] = Some(d.param);
+        let (row, param) = self.row_from(env, p, self.hints[hint_slot], gradients)?;
+        self.hints[hint_slot] = Some(param);
+        Ok(row)
+    }
+
+    /// Distance rows of the samples `slots` (each warm-started from its own hint), computed
+    /// in parallel; their hints are updated and the rows returned in the order of `slots`,
+    /// exactly as [`Self::distance_row`] one after another would give them.
+    fn distance_rows(
+        &mut self,
+        env: &SweptEnvelope,
+        slots: &[usize],
+        gradients: bool,
+    ) -> Result<Vec<Row>, FlankError> {
+        let this = &*self;
+        let found: Vec<Result<(Row, EnvelopeParam), FlankError>> = slots
+            .par_iter()
+            .map(|&i| this.row_from(env, &this.side.samples[i], this.hints[i], gradients))
+            .collect();
+        let mut rows = Vec::with_capacity(slots.len());
+        for (&i, r) in slots.iter().zip(found) {
+            let (row, param) = r?;
+            self.hints[i] = Some(param);
+            rows.push(row);
+        }
+        Ok(rows)
+    }
+
+    /// The distance row of `p` from the warm start `hint`, and the parameter found.
+    fn row_from(
+        &self,
+        env: &SweptEnvelope,
+        p: &Point3,
+        hint: Option<EnvelopeParam>,
+        gradients: bool,
+    ) -> Result<(Row, EnvelopeParam), FlankError> {
+        let d = env.signed_distance(p, hint)?;
         let mut row = Row {
             value: d.distance,
             grad: Vec::new(),
@@ -265,7 +301,7 @@ impl<'a> FlankProblem<'a> {
                 }
             }
         }
-        Ok(row)
+        Ok((row, d.param))
     }
 
     /// The hub rows of location `j`: value `h − r` and its gradient.
@@ -333,9 +369,8 @@ impl Model for FlankProblem<'_> {
         let mut eval = Evaluation::default();
         let mut deviations = vec![f64::NAN; self.side.samples.len()];
         let samples = self.samples.clone();
-        for &i in &samples {
-            let p = self.side.samples[i];
-            let row = self.distance_row(&env, &p, i, gradients)?;
+        let rows = self.distance_rows(&env, &samples, gradients)?;
+        for (&i, row) in samples.iter().zip(rows) {
             deviations[i] = row.value;
             match self.mode {
                 Mode::Minimax => eval.minimax.push(row),
@@ -353,9 +388,7 @@ impl Model for FlankProblem<'_> {
             }
         }
         let band = self.band.clone();
-        for &i in &band {
-            let p = self.side.samples[i];
-            let mut row = self.distance_row(&env, &p, i, gradients)?;
+        for mut row in self.distance_rows(&env, &band, gradients)? {
             row.value += st.overcut_tol;
             eval.constraints.push(row);
         }
