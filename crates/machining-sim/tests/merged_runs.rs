@@ -1,6 +1,7 @@
 //! Runs of short feed blocks sampled as a whole ([`machining_sim::merge`]) against
-//! block-by-block sampling of the same path: far fewer positions, the same removed volume
-//! within what the sweep tolerance allows, and a planted dip of one block still cut.
+//! block-by-block sampling of the same path and against the exact swept volume: far fewer
+//! positions, never more material removed than the path sweeps, never more than the sweep
+//! tolerance left, and a planted dip of one block still cut.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use cam_core::{Cutter, CutterLocation, CutterShape, Move, MoveKind, Point3, ToolPath, Vector3};
@@ -71,4 +72,96 @@ fn a_dipping_block_is_not_merged_away() {
         extra_runs >= 0.8 * extra_blocks,
         "runs: {extra_runs} mm³ of the dip's {extra_blocks} mm³"
     );
+}
+
+/// A ball end with a vertical axis moving at constant height along a wiggling polyline of
+/// 0.05 mm blocks: its swept floor is exactly `z_c − √(R² − d²)`, `d` the distance in the
+/// plane from the ray to the polyline. Every ray of the Z grid within `R/2` of the path
+/// (floor slope ≤ 30°) must lie between the exact floor (no over-read; the dexels store
+/// `f32`) and the exact floor plus the sweep tolerance read along the ray
+/// (`tol / cos 30°`).
+fn floor_against_exact(wiggle: f64, merge: bool) -> (usize, usize) {
+    let r = 2.0;
+    let z_tip = -0.5;
+    let pts: Vec<(f64, f64)> = (0..=400)
+        .map(|k| {
+            let x = -10.0 + 0.05 * k as f64;
+            (x, wiggle * (k as f64 * 0.9).sin())
+        })
+        .collect();
+    let mut path = ToolPath::new("wiggle", "b2");
+    for &(x, y) in &pts {
+        path.moves.push(Move {
+            kind: MoveKind::Feed,
+            cl: CutterLocation::new(Point3::new(x, y, z_tip), Vector3::z()).unwrap(),
+            feed_mm_per_min: None,
+        });
+    }
+    let cutter = Cutter::new("b2", CutterShape::BallEnd { radius: r }, 8.0, 2.0, 30.0).unwrap();
+    let stock = BoxStock::new([-12.0, -4.0, -6.0], [12.0, 4.0, 0.0]).unwrap();
+    let mut dexel = TriDexel::from_shape(&stock, CELL).unwrap();
+    let opts = SimOptions {
+        check_collisions: false,
+        merge_blocks: merge,
+        ..SimOptions::default()
+    };
+    let out = cut(&mut dexel, None, &[(cutter, path)], &opts).unwrap();
+    let tol = out.stats.sweep_tol_mm;
+    let grid = dexel.grid(2);
+    let (nu, nv) = grid.size();
+    let mut checked = 0;
+    for i in 0..nu {
+        for j in 0..nv {
+            let (x, y) = grid.ray_uv(i, j);
+            if !(-9.0..=9.0).contains(&x) {
+                continue;
+            }
+            let d = pts
+                .windows(2)
+                .map(|w| {
+                    let (a, b) = (w[0], w[1]);
+                    let (ex, ey) = (b.0 - a.0, b.1 - a.1);
+                    let t =
+                        (((x - a.0) * ex + (y - a.1) * ey) / (ex * ex + ey * ey)).clamp(0.0, 1.0);
+                    ((x - a.0 - t * ex).powi(2) + (y - a.1 - t * ey).powi(2)).sqrt()
+                })
+                .fold(f64::INFINITY, f64::min);
+            if d > 0.5 * r {
+                continue;
+            }
+            let exact = z_tip + r - (r * r - d * d).sqrt();
+            let segs = grid.ray(i, j).as_slice();
+            let top = segs.last().map_or(f64::NEG_INFINITY, |s| f64::from(s[1]));
+            assert!(
+                top >= exact - 1e-5,
+                "({x:.2}, {y:.2}): floor {top:.5} below the swept {exact:.5} (merge {merge})"
+            );
+            assert!(
+                top <= exact + tol / 30f64.to_radians().cos() + 1e-5,
+                "({x:.2}, {y:.2}): floor {top:.5} more than the tolerance above {exact:.5} \
+                 (merge {merge})"
+            );
+            checked += 1;
+        }
+    }
+    (checked, out.stats.positions)
+}
+
+#[test]
+fn merged_runs_stay_between_the_exact_floor_and_the_tolerance() {
+    // A zigzag within the merge budget (cell/16 = 0.00625 mm: the polyline leaves its chords
+    // by up to twice the amplitude), one beyond it.
+    for wiggle in [0.002, 0.05] {
+        let (checked, merged) = floor_against_exact(wiggle, true);
+        let (_, blocks) = floor_against_exact(wiggle, false);
+        assert!(checked > 3_000);
+        if wiggle < 0.003 {
+            assert!(
+                merged * 3 < blocks,
+                "{merged} positions merged, {blocks} block by block"
+            );
+        } else {
+            assert!(merged <= blocks);
+        }
+    }
 }
