@@ -747,8 +747,11 @@ impl FlankFinishing {
                         minimax_measured(&mut second_side, cutter.shape, how, &run)
                     })
                 };
-                let ((job, study), (cylinder, second)) =
-                    rayon::join(|| rayon::join(job, study), || rayon::join(cylinder, second));
+                // The cylinder comparison is the longest chain (its minimax runs after a
+                // probe per catalogue radius): this thread starts it, the others are left
+                // for idle threads to take.
+                let ((cylinder, second), (job, study)) =
+                    rayon::join(|| rayon::join(cylinder, second), || rayon::join(job, study));
                 Ok(SideRuns {
                     fresh,
                     job,

@@ -3,8 +3,9 @@
 //! functions), with evaluation and a monotone projection of the control points.
 //!
 //! Basis by the Cox–de Boor recursion (NURBS Book A2.2); the normal equations are replaced by
-//! a QR-based least-squares solve of the `m × n` collocation matrix (nalgebra, `n` small).
-//! Cost: O(m·n²).
+//! an SVD-based least-squares solve of the `m × n` collocation matrix (nalgebra, `n` small),
+//! cost O(m·n²). Reverse-motion smoothing, which refits many long runs, factors the banded
+//! collocation matrix by Givens rotations instead ([`crate::banded_lsq`]).
 
 use nalgebra::{DMatrix, DVector};
 

@@ -388,7 +388,8 @@ pub const WINDOW_PADDING_BLOCKS: usize = 3;
 /// B-spline, and this repeats until no reverse motion is left; after `max_iterations` the
 /// control values are projected onto a monotone sequence, which makes the spline monotone.
 /// Returns the new angles, the iterations and whether the projection ran; `None` for fewer
-/// than 3 angles or a rank-deficient fit. Cost O(m·n²) plus O(m·n) per iteration.
+/// than 3 angles or a rank-deficient fit. Cost O(m + n³) for the factorisation (banded
+/// Givens QR and the rank test on its triangle) plus O(m + n) per iteration.
 pub fn smooth_monotone(
     t: &[f64],
     angles: &[f64],
@@ -566,7 +567,8 @@ impl SplineProjector {
 /// Shift-and-smooth with `n_ctrl` control values in direction `dir` and optional pinned ends.
 /// The fit uses the given parameters `t` (normalised path length) when they determine the
 /// coefficients, otherwise the normalised block index (a knot span without samples, e.g.
-/// across a long plunge). Cost O(m·n²) for the factorisation plus O(m·n) per iteration.
+/// across a long plunge). Cost O(m + n³) for the factorisation (banded Givens QR and the
+/// rank test on its triangle) plus O(m + n) per iteration.
 fn shift_and_smooth(
     t: &[f64],
     angles: &[f64],
@@ -659,8 +661,9 @@ pub fn adaptive_control_cap(m: usize, n0: usize) -> usize {
 /// those tried that meets the tolerance.
 ///
 /// `None` for fewer than 3 angles or when no control-value count gives a full-rank fit.
-/// Cost: at most `⌈log₂(cap / n0)⌉ + 1` fits, each O(m·n²) (one SVD of the collocation
-/// matrix) plus O(m·n) per shift-and-smooth iteration.
+/// Cost: at most `⌈log₂(cap / n0)⌉ + 1` fits, each O(m + n³) (a banded Givens QR of the
+/// collocation matrix and the singular values of its triangle) plus O(m + n) per
+/// shift-and-smooth iteration.
 pub fn smooth_monotone_adaptive(
     t: &[f64],
     angles: &[f64],
@@ -891,7 +894,7 @@ type SmoothingStrategy = fn(&[f64], &[f64], &ReverseMotionOptions) -> Option<Smo
 /// location.
 ///
 /// Cost: per run and reversing axis at most `⌈log₂(cap / n0)⌉ + 1` fits of
-/// O(m·n² + max_iterations·m·n) each (see [`smooth_monotone_adaptive`]), plus
+/// O(m + n³ + max_iterations·(m + n)) each (see [`smooth_monotone_adaptive`]), plus
 /// `c_max / c_step` checker passes per run whose smoothed postures fail; runs in parallel
 /// (rayon), reports added in run order.
 pub fn remove_reverse_motions(
