@@ -9,7 +9,7 @@
 //! visited, and a ray whose material lies outside the part's extent along the ray is skipped
 //! before any geometry; the same extent test runs first on whole tiles of rays (shrinking
 //! the placement's ray range before it is bucketed into rows) and on chunks of a row, against
-//! the material bounds of [`crate::cull`] ([`apply_batch`] proves each cull exact; [`apply_batch_reference`] is
+//! the material bounds of the private `cull` module ([`apply_batch`] proves each cull exact; [`apply_batch_reference`] is
 //! the plain sequential definition, and `tests/removal_equivalence.rs` checks both agree bit
 //! for bit). Per ray the cutter's interval is the closed-form ray–solid-of-revolution
 //! intersection of [`crate::tool_solid`], subtracted from the ray's material list.
@@ -586,10 +586,10 @@ fn ray_work(
 ///   rest of the tool lies outside the stock box, where no ray holds material.
 /// * the same test runs on groups of rays first: the extent over a group's column (and row)
 ///   range contains every member's extent, and the group's material bound
-///   ([`crate::cull`]) contains every member's material, also later in the batch since
+///   (the private `cull` module) contains every member's material, also later in the batch since
 ///   removal only shrinks material. A placement's ray range is shrunk to the
-///   [`crate::cull::TILE`]² tiles it can meet (from bounds taken at the batch's start)
-///   before it is bucketed into rows, and on a row whole [`crate::cull::CHUNK`]s of rays
+///   `cull::TILE`² tiles it can meet (from bounds taken at the batch's start)
+///   before it is bucketed into rows, and on a row whole `cull::CHUNK`s of rays
 ///   are skipped. On the default job at 0.1 mm this skips 94 % of the rays the band visits
 ///   (26.6·10⁹ → 1.6·10⁹ ray visits; removal 102 s → 31 s on two cores).
 ///
