@@ -1,10 +1,11 @@
 //! Sampling runs of short feed blocks together for the removal.
 //!
-//! A post-processor splits a cutter-location move into many short blocks to keep the
-//! joint-interpolated motion within its linearisation tolerance (on the default job about
-//! eight blocks per move), so a program read back block by block holds far more moves than
-//! the sweep tolerance needs positions: every block costs at least one position, however
-//! short it is. This module lets the positions of a run of consecutive feed blocks be spaced
+//! A program read back for verification holds many short moves: the post-processor splits
+//! a cutter-location move into blocks to keep the joint-interpolated motion within its
+//! linearisation tolerance, and the read-back cuts each block into chords within 1 µm of the
+//! controller's motion (on the default job, 50k cutter locations become 162k blocks and 383k
+//! read-back moves). Every move costs at least one position, however short it is, far more
+//! than the sweep tolerance needs. This module lets the positions of a run of consecutive feed blocks be spaced
 //! along the run as a whole, when the actual motion through the run stays within a
 //! deviation budget `e` of the straight tool-centre-point motion (the *chord*) from the run's
 //! start to its end. The positions stay on the actual motion (block ends in between are
