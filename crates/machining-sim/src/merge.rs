@@ -37,39 +37,44 @@
 //! with a flat face (whose step also depends on the direction of motion), nor blocks that do
 //! not move the tip (a pure reorientation has no chord).
 
-use cam_core::{Cutter, CutterLocation, UnitVector3, Vector3};
+use crate::motion::tcp_at;
+use cam_core::{Cutter, CutterLocation};
 
 /// Most blocks merged into one chord.
 pub const MAX_BLOCKS: usize = 32;
 
-/// Largest displacement `δ(a, b)` of a cutting point of `cutter` between the cutter
-/// locations `a` and `b` (module docs).
-pub fn cutting_displacement(cutter: &Cutter, a: &CutterLocation, b: &CutterLocation) -> f64 {
+/// What [`cutting_displacement`] needs of a cutter: its flute length `H` and the largest
+/// radius `ρ` of its flutes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CuttingReach {
+    /// Flute length (mm).
+    pub flute_mm: f64,
+    /// Largest radius of the fluted part (mm).
+    pub radius_mm: f64,
+}
+
+impl CuttingReach {
+    /// The reach of `cutter`.
+    pub fn of(cutter: &Cutter) -> Self {
+        let h = cutter.flute_length;
+        let profile = cutter.shape.profile();
+        Self {
+            flute_mm: h,
+            radius_mm: profile.radius_at(h).max(profile.radius_at(0.0)),
+        }
+    }
+}
+
+/// Largest displacement `δ(a, b)` of a cutting point of a cutter of reach `reach` between
+/// the cutter locations `a` and `b` (module docs). O(1).
+pub fn cutting_displacement(reach: &CuttingReach, a: &CutterLocation, b: &CutterLocation) -> f64 {
     let dt = b.tip - a.tip;
     let da = b.axis.into_inner() - a.axis.into_inner();
-    let h = cutter.flute_length;
-    let rho = cutter.shape.radius_at(h).max(cutter.shape.radius_at(0.0));
-    dt.norm().max((dt + da * h).norm()) + rho * da.norm()
+    dt.norm().max((dt + da * reach.flute_mm).norm()) + reach.radius_mm * da.norm()
 }
 
-/// The straight tool-centre-point motion from `from` to `to` at fraction `s` (tip linear,
-/// axis linear then normalised, as [`crate::motion::Interpolation::Tcp`]).
-pub fn chord_at(from: &CutterLocation, to: &CutterLocation, s: f64) -> CutterLocation {
-    let tip = from.tip + (to.tip - from.tip) * s;
-    let a: Vector3 = from.axis.into_inner() * (1.0 - s) + to.axis.into_inner() * s;
-    let n = a.norm();
-    let axis = if n > 1e-12 {
-        UnitVector3::new_unchecked(a / n)
-    } else if s < 0.5 {
-        from.axis
-    } else {
-        to.axis
-    };
-    CutterLocation { tip, axis }
-}
-
-/// A run of feed blocks being merged: its start, the samples of its blocks and the block
-/// ends' positions along the chord.
+/// A run of feed blocks being merged: its start, the samples of its blocks, the blocks with
+/// their cumulative cutting displacement, and the samples' largest deviation from the chord.
 #[derive(Debug, Clone, Default)]
 pub struct Run {
     /// Start of the run (end of the block before it).
@@ -97,11 +102,16 @@ impl Run {
         self.deviation_mm = 0.0;
     }
 
+    /// The samples of the run's blocks, in order.
+    pub fn samples(&self) -> &[CutterLocation] {
+        &self.samples
+    }
+
     /// Starts a run at `start` with one block `(index, end)` sampled at `samples` (the last
     /// sample is the block's end).
     pub fn begin(
         &mut self,
-        cutter: &Cutter,
+        reach: &CuttingReach,
         start: CutterLocation,
         index: usize,
         end: CutterLocation,
@@ -109,7 +119,7 @@ impl Run {
     ) {
         self.clear();
         self.start = Some(start);
-        let d = path_displacement(cutter, &start, samples);
+        let d = path_displacement(reach, &start, samples);
         self.blocks.push((index, start, end, d));
         self.samples.extend_from_slice(samples);
     }
@@ -125,7 +135,7 @@ impl Run {
     /// is not extended.
     pub fn try_extend(
         &mut self,
-        cutter: &Cutter,
+        reach: &CuttingReach,
         index: usize,
         end: CutterLocation,
         samples: &[CutterLocation],
@@ -144,7 +154,7 @@ impl Run {
         }
         let deviation = |q: &CutterLocation| {
             let s = ((q.tip - start.tip).dot(&d) / len2).clamp(0.0, 1.0);
-            cutting_displacement(cutter, &chord_at(&start, &end, s), q)
+            cutting_displacement(reach, &tcp_at(&start, &end, s), q)
         };
         let mut worst = 0.0f64;
         for q in self.samples.iter().chain(samples) {
@@ -154,7 +164,7 @@ impl Run {
             }
             worst = worst.max(e);
         }
-        let d = path_displacement(cutter, &last_end, samples);
+        let d = path_displacement(reach, &last_end, samples);
         self.blocks.push((index, last_end, end, cum + d));
         self.samples.extend_from_slice(samples);
         self.deviation_mm = worst;
@@ -188,11 +198,15 @@ impl Run {
 }
 
 /// Cumulative cutting displacement ([`cutting_displacement`]) along `samples` from `from`.
-fn path_displacement(cutter: &Cutter, from: &CutterLocation, samples: &[CutterLocation]) -> f64 {
+fn path_displacement(
+    reach: &CuttingReach,
+    from: &CutterLocation,
+    samples: &[CutterLocation],
+) -> f64 {
     let mut prev = from;
     let mut d = 0.0;
     for s in samples {
-        d += cutting_displacement(cutter, prev, s);
+        d += cutting_displacement(reach, prev, s);
         prev = s;
     }
     d
@@ -212,7 +226,7 @@ pub fn run_step(rho_min: f64, tol: f64, e: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cam_core::{CutterShape, Point3};
+    use cam_core::{CutterShape, Point3, UnitVector3, Vector3};
 
     fn ball() -> Cutter {
         Cutter::new("b", CutterShape::BallEnd { radius: 1.0 }, 10.0, 2.0, 30.0).unwrap()
@@ -230,7 +244,7 @@ mod tests {
             tip: Point3::new(0.1, 0.0, 0.0),
             axis: UnitVector3::new_normalize(Vector3::new(0.02, 0.01, 1.0)),
         };
-        let bound = cutting_displacement(&c, &a, &b);
+        let bound = cutting_displacement(&CuttingReach::of(&c), &a, &b);
         // Every point of the flutes' surface moves by no more than the bound.
         let ra = nalgebra::Rotation3::rotation_between(&a.axis, &b.axis).unwrap();
         for i in 0..=20 {
@@ -248,17 +262,17 @@ mod tests {
 
     #[test]
     fn collinear_blocks_merge_and_a_corner_does_not() {
-        let c = ball();
+        let r = CuttingReach::of(&ball());
         let mut run = Run::default();
         let s = |x: f64| [at(x - 0.05, 0.0), at(x, 0.0)];
-        run.begin(&c, at(0.0, 0.0), 1, at(0.1, 0.0), &s(0.1));
-        assert!(run.try_extend(&c, 2, at(0.2, 0.0), &s(0.2), 0.01));
-        assert!(run.try_extend(&c, 3, at(0.3, 0.0), &s(0.3), 0.01));
+        run.begin(&r, at(0.0, 0.0), 1, at(0.1, 0.0), &s(0.1));
+        assert!(run.try_extend(&r, 2, at(0.2, 0.0), &s(0.2), 0.01));
+        assert!(run.try_extend(&r, 3, at(0.3, 0.0), &s(0.3), 0.01));
         assert!(run.deviation_mm < 1e-12);
         // A block that turns by 90°: its end is 0.1 mm off the line of the run, and the
         // run's own samples leave the new chord by more than the budget.
         let turn = [at(0.3, 0.05), at(0.3, 0.1)];
-        assert!(!run.try_extend(&c, 4, at(0.3, 0.1), &turn, 0.01));
+        assert!(!run.try_extend(&r, 4, at(0.3, 0.1), &turn, 0.01));
         assert_eq!(run.blocks.len(), 3);
         assert!((run.displacement_mm() - 0.3).abs() < 1e-12);
         // Six positions spaced 0.05 mm along the actual motion: two per block, at its
@@ -290,10 +304,10 @@ mod tests {
 
     #[test]
     fn a_bulging_block_is_measured_at_its_samples() {
-        let c = ball();
+        let r = CuttingReach::of(&ball());
         let mut run = Run::default();
         run.begin(
-            &c,
+            &r,
             at(0.0, 0.0),
             1,
             at(0.1, 0.0),
@@ -301,8 +315,8 @@ mod tests {
         );
         // The next block ends on the line but bulges 0.02 mm sideways in its middle.
         let bulge = [at(0.15, 0.02), at(0.2, 0.0)];
-        assert!(!run.try_extend(&c, 2, at(0.2, 0.0), &bulge, 0.01));
-        assert!(run.try_extend(&c, 2, at(0.2, 0.0), &bulge, 0.03));
+        assert!(!run.try_extend(&r, 2, at(0.2, 0.0), &bulge, 0.01));
+        assert!(run.try_extend(&r, 2, at(0.2, 0.0), &bulge, 0.03));
         assert!((run.deviation_mm - 0.02).abs() < 1e-12);
     }
 }

@@ -51,26 +51,27 @@ impl Interpolation {
         s: f64,
     ) -> CutterLocation {
         match self {
-            Interpolation::Tcp => {
-                let tip = from.tip + (to.tip - from.tip) * s;
-                let a = from.axis.into_inner() * (1.0 - s) + to.axis.into_inner() * s;
-                let n = a.norm();
-                let axis = if n > 1e-12 {
-                    UnitVector3::new_unchecked(a / n)
-                } else {
-                    // Antiparallel axes: no meaningful linear blend; keep the start axis
-                    // for the first half.
-                    if s < 0.5 {
-                        from.axis
-                    } else {
-                        to.axis
-                    }
-                };
-                CutterLocation { tip, axis }
-            }
+            Interpolation::Tcp => tcp_at(from, to, s),
             Interpolation::Custom(f) => f(op, index, from, to, s),
         }
     }
+}
+
+/// The tool-centre-point motion from `from` to `to` at fraction `s`
+/// ([`Interpolation::Tcp`]): tip linear, tool-axis vector linear then normalised (the start
+/// axis for the first half of an antiparallel pair, where the blend has no direction).
+pub fn tcp_at(from: &CutterLocation, to: &CutterLocation, s: f64) -> CutterLocation {
+    let tip = from.tip + (to.tip - from.tip) * s;
+    let a = from.axis.into_inner() * (1.0 - s) + to.axis.into_inner() * s;
+    let n = a.norm();
+    let axis = if n > 1e-12 {
+        UnitVector3::new_unchecked(a / n)
+    } else if s < 0.5 {
+        from.axis
+    } else {
+        to.axis
+    };
+    CutterLocation { tip, axis }
 }
 
 /// Smallest principal radius (mm) of the cutter's cutting surface (scallop radius).
@@ -95,6 +96,16 @@ pub fn has_flat_face(shape: &CutterShape) -> bool {
     }
 }
 
+/// Points per move at which [`positions_for_move`] measures the move's displacement, at
+/// fractions `k/n`, `k = 1..=n`: the end of a straight tool-centre-point move, eight points of
+/// any other motion (summed as sub-chords).
+pub fn sub_positions(interp: &Interpolation) -> usize {
+    match interp {
+        Interpolation::Tcp => 1,
+        Interpolation::Custom(_) => 8,
+    }
+}
+
 /// Number of positions `n >= 1` to sample the move `from → to` so the swept-volume error
 /// stays below `tol` (see module docs).
 pub fn positions_for_move(
@@ -106,19 +117,57 @@ pub fn positions_for_move(
     to: &CutterLocation,
     tol: f64,
 ) -> usize {
+    let sub = sub_positions(interp);
+    let points = (1..=sub).map(|k| interp.at(op, index, from, to, k as f64 / sub as f64));
+    positions_for_displacement(
+        cutter,
+        from,
+        to,
+        sub_chord_displacement(cutter, from, points),
+        tol,
+    )
+}
+
+/// [`positions_for_move`] from the move's points already sampled at the fractions of
+/// [`sub_positions`] (`points[k − 1]` at `k/n`): the same count without evaluating the
+/// motion again.
+pub fn positions_for_samples(
+    cutter: &Cutter,
+    from: &CutterLocation,
+    to: &CutterLocation,
+    points: &[CutterLocation],
+    tol: f64,
+) -> usize {
+    let disp = sub_chord_displacement(cutter, from, points.iter().copied());
+    positions_for_displacement(cutter, from, to, disp, tol)
+}
+
+/// Displacement bound `Σ |Δtip| + H |Δaxis|` (`H` the flute length) along the sub-chords
+/// from `from` through `points` (module docs).
+fn sub_chord_displacement(
+    cutter: &Cutter,
+    from: &CutterLocation,
+    points: impl Iterator<Item = CutterLocation>,
+) -> f64 {
     let h = cutter.flute_length;
-    let sub = match interp {
-        Interpolation::Tcp => 1,
-        Interpolation::Custom(_) => 8,
-    };
     let mut disp = 0.0;
     let mut prev = *from;
-    for k in 1..=sub {
-        let cur = interp.at(op, index, from, to, k as f64 / sub as f64);
+    for cur in points {
         disp += (cur.tip - prev.tip).norm()
             + h * (cur.axis.into_inner() - prev.axis.into_inner()).norm();
         prev = cur;
     }
+    disp
+}
+
+/// The number of positions for a move of displacement bound `disp` (module docs).
+fn positions_for_displacement(
+    cutter: &Cutter,
+    from: &CutterLocation,
+    to: &CutterLocation,
+    disp: f64,
+    tol: f64,
+) -> usize {
     if !(disp.is_finite()) || disp <= 0.0 {
         return 1;
     }

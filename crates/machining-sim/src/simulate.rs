@@ -20,8 +20,11 @@ use crate::dexel::TriDexel;
 use crate::endpoints::overcut_error_bound;
 use crate::error::SimError;
 use crate::measure::{extremum, measure, Extremum, SurfaceMap};
-use crate::merge::{run_step, Run};
-use crate::motion::{has_flat_face, positions_for_move, scallop_radius, Interpolation};
+use crate::merge::{run_step, CuttingReach, Run};
+use crate::motion::{
+    has_flat_face, positions_for_move, positions_for_samples, scallop_radius, sub_positions,
+    Interpolation,
+};
 use crate::removal::{apply_batch, PartKind, Placement, ToolBody};
 use cam_core::{Cutter, MoveKind, ToolPath};
 use rayon::prelude::*;
@@ -333,39 +336,37 @@ pub fn cut(
     } else {
         -1.0
     };
-    let sub = match options.interpolation {
-        Interpolation::Tcp => 2,
-        Interpolation::Custom(_) => 8,
-    };
+    // The points of a block the run measures: those `positions_for_move` measures too (so
+    // a one-block run reuses them), at least the middle and the end.
+    let sub = sub_positions(&options.interpolation).max(2);
     let mut run = Run::default();
     let mut samples: Vec<cam_core::CutterLocation> = Vec::with_capacity(sub);
     for (oi, (cutter, path)) in ops.iter().enumerate() {
+        let reach = CuttingReach::of(cutter);
+        let budget = if has_flat_face(&cutter.shape) {
+            -1.0
+        } else {
+            budget
+        };
         // Positions of the pending run of blocks (one block: its own positions, as the
-        // controller moves; several: along their chord).
+        // controller moves; several: spaced along the run, on the motion).
         let emit = |run: &mut Run, batch: &mut Vec<Placement>, meta: &mut Vec<(usize, usize)>| {
-            let mut push = |c: &cam_core::CutterLocation, mi: usize| {
-                batch.push(Placement {
-                    tip: [c.tip.x, c.tip.y, c.tip.z],
-                    axis: [c.axis.x, c.axis.y, c.axis.z],
-                    tool: oi,
-                    rapid: false,
-                });
-                meta.push((oi, mi));
-            };
             match (run.start, run.blocks.as_slice()) {
                 (Some(from), &[(mi, _, cl, _)]) => {
-                    let n =
-                        positions_for_move(cutter, &options.interpolation, oi, mi, &from, &cl, tol);
-                    for k in 1..=n {
-                        let c = if k == n {
-                            cl
-                        } else {
-                            options
-                                .interpolation
-                                .at(oi, mi, &from, &cl, k as f64 / n as f64)
-                        };
-                        push(&c, mi);
-                    }
+                    let n = if run.samples().len() == sub_positions(&options.interpolation) {
+                        positions_for_samples(cutter, &from, &cl, run.samples(), tol)
+                    } else {
+                        positions_for_move(cutter, &options.interpolation, oi, mi, &from, &cl, tol)
+                    };
+                    push_move(
+                        batch,
+                        meta,
+                        &options.interpolation,
+                        (oi, mi),
+                        (&from, &cl),
+                        n,
+                        false,
+                    );
                 }
                 (Some(_), [.., (_, _, end, _)]) => {
                     let step = run_step(scallop_radius(&cutter.shape), tol, run.deviation_mm)
@@ -379,7 +380,8 @@ pub fn cut(
                         } else {
                             options.interpolation.at(oi, mi, &a, &b, f)
                         };
-                        push(&c, mi);
+                        batch.push(placement(&c, oi, false));
+                        meta.push((oi, mi));
                     }
                     debug_assert!(batch
                         .last()
@@ -402,12 +404,7 @@ pub fn cut(
             let rapid = mv.kind == MoveKind::Rapid;
             if mi == 0 {
                 emit(&mut run, &mut batch, &mut meta);
-                batch.push(Placement {
-                    tip: [cl.tip.x, cl.tip.y, cl.tip.z],
-                    axis: [cl.axis.x, cl.axis.y, cl.axis.z],
-                    tool: oi,
-                    rapid,
-                });
+                batch.push(placement(&cl, oi, rapid));
                 meta.push((oi, mi));
             } else {
                 let from = path.moves[mi - 1].cl;
@@ -415,22 +412,15 @@ pub fn cut(
                     emit(&mut run, &mut batch, &mut meta);
                     let n =
                         positions_for_move(cutter, &options.interpolation, oi, mi, &from, &cl, tol);
-                    for k in 1..=n {
-                        let c = if k == n {
-                            cl
-                        } else {
-                            options
-                                .interpolation
-                                .at(oi, mi, &from, &cl, k as f64 / n as f64)
-                        };
-                        batch.push(Placement {
-                            tip: [c.tip.x, c.tip.y, c.tip.z],
-                            axis: [c.axis.x, c.axis.y, c.axis.z],
-                            tool: oi,
-                            rapid,
-                        });
-                        meta.push((oi, mi));
-                    }
+                    push_move(
+                        &mut batch,
+                        &mut meta,
+                        &options.interpolation,
+                        (oi, mi),
+                        (&from, &cl),
+                        n,
+                        true,
+                    );
                 } else {
                     samples.clear();
                     samples.extend((1..=sub).map(|k| {
@@ -438,14 +428,9 @@ pub fn cut(
                             .interpolation
                             .at(oi, mi, &from, &cl, k as f64 / sub as f64)
                     }));
-                    let budget = if has_flat_face(&cutter.shape) {
-                        -1.0
-                    } else {
-                        budget
-                    };
-                    if !run.try_extend(cutter, mi, cl, &samples, budget) {
+                    if !run.try_extend(&reach, mi, cl, &samples, budget) {
                         emit(&mut run, &mut batch, &mut meta);
-                        run.begin(cutter, from, mi, cl, &samples);
+                        run.begin(&reach, from, mi, cl, &samples);
                     }
                 }
             }
@@ -512,6 +497,38 @@ pub fn cut(
         })
         .collect();
     Ok(CutOutcome { collisions, stats })
+}
+
+/// The placement of tool `tool` at `c`.
+fn placement(c: &cam_core::CutterLocation, tool: usize, rapid: bool) -> Placement {
+    Placement {
+        tip: [c.tip.x, c.tip.y, c.tip.z],
+        axis: [c.axis.x, c.axis.y, c.axis.z],
+        tool,
+        rapid,
+    }
+}
+
+/// The `n` positions of move `mi` of operation `oi` from `from` to `to` as the controller
+/// moves (fractions `k/n`, the last exactly `to`), with their (operation, move) labels.
+fn push_move(
+    batch: &mut Vec<Placement>,
+    meta: &mut Vec<(usize, usize)>,
+    interp: &Interpolation,
+    (oi, mi): (usize, usize),
+    (from, to): (&cam_core::CutterLocation, &cam_core::CutterLocation),
+    n: usize,
+    rapid: bool,
+) {
+    for k in 1..=n {
+        let c = if k == n {
+            *to
+        } else {
+            interp.at(oi, mi, from, to, k as f64 / n as f64)
+        };
+        batch.push(placement(&c, oi, rapid));
+        meta.push((oi, mi));
+    }
 }
 
 /// Number of distinct (operation, move) pairs with a collision.

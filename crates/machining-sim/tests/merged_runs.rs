@@ -4,8 +4,9 @@
 //! tolerance left, and a planted dip of one block still cut.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+use cam_core::path::point_segment_distance;
 use cam_core::{Cutter, CutterLocation, CutterShape, Move, MoveKind, Point3, ToolPath, Vector3};
-use machining_sim::{cut, BoxStock, SimOptions, TriDexel};
+use machining_sim::{cut, BoxStock, CutOutcome, SimOptions, TriDexel};
 
 const CELL: f64 = 0.1;
 
@@ -28,17 +29,27 @@ fn pass(dip: f64) -> ToolPath {
     path
 }
 
-fn run(path: ToolPath, merge: bool) -> (f64, usize) {
+/// `path` of a ball end of radius 2 mm through the box `lo`–`hi` at `CELL`: the stock after
+/// it and the simulation's outcome.
+fn simulate(path: ToolPath, (lo, hi): ([f64; 3], [f64; 3]), merge: bool) -> (TriDexel, CutOutcome) {
     let cutter = Cutter::new("b2", CutterShape::BallEnd { radius: 2.0 }, 8.0, 2.0, 30.0).unwrap();
-    let stock = BoxStock::new([-20.0, -8.0, -6.0], [20.0, 10.0, 0.0]).unwrap();
-    let mut dexel = TriDexel::from_shape(&stock, CELL).unwrap();
-    let before = dexel.volume();
+    let mut dexel = TriDexel::from_shape(&BoxStock::new(lo, hi).unwrap(), CELL).unwrap();
     let opts = SimOptions {
         check_collisions: false,
         merge_blocks: merge,
         ..SimOptions::default()
     };
     let out = cut(&mut dexel, None, &[(cutter, path)], &opts).unwrap();
+    (dexel, out)
+}
+
+/// Removed volume and positions of `path` through a 40 × 18 × 6 mm box.
+fn run(path: ToolPath, merge: bool) -> (f64, usize) {
+    let stock = ([-20.0, -8.0, -6.0], [20.0, 10.0, 0.0]);
+    let before = TriDexel::from_shape(&BoxStock::new(stock.0, stock.1).unwrap(), CELL)
+        .unwrap()
+        .volume();
+    let (dexel, out) = simulate(path, stock, merge);
     (before - dexel.volume(), out.stats.positions)
 }
 
@@ -81,7 +92,7 @@ fn a_dipping_block_is_not_merged_away() {
 /// `f32`) and the exact floor plus the sweep tolerance read along the ray
 /// (`tol / cos 30°`).
 fn floor_against_exact(wiggle: f64, merge: bool) -> (usize, usize) {
-    let r = 2.0;
+    let r = 2.0; // the ball of `simulate`
     let z_tip = -0.5;
     let pts: Vec<(f64, f64)> = (0..=400)
         .map(|k| {
@@ -97,15 +108,7 @@ fn floor_against_exact(wiggle: f64, merge: bool) -> (usize, usize) {
             feed_mm_per_min: None,
         });
     }
-    let cutter = Cutter::new("b2", CutterShape::BallEnd { radius: r }, 8.0, 2.0, 30.0).unwrap();
-    let stock = BoxStock::new([-12.0, -4.0, -6.0], [12.0, 4.0, 0.0]).unwrap();
-    let mut dexel = TriDexel::from_shape(&stock, CELL).unwrap();
-    let opts = SimOptions {
-        check_collisions: false,
-        merge_blocks: merge,
-        ..SimOptions::default()
-    };
-    let out = cut(&mut dexel, None, &[(cutter, path)], &opts).unwrap();
+    let (dexel, out) = simulate(path, ([-12.0, -4.0, -6.0], [12.0, 4.0, 0.0]), merge);
     let tol = out.stats.sweep_tol_mm;
     let grid = dexel.grid(2);
     let (nu, nv) = grid.size();
@@ -116,14 +119,12 @@ fn floor_against_exact(wiggle: f64, merge: bool) -> (usize, usize) {
             if !(-9.0..=9.0).contains(&x) {
                 continue;
             }
+            let q = Point3::new(x, y, 0.0);
             let d = pts
                 .windows(2)
                 .map(|w| {
-                    let (a, b) = (w[0], w[1]);
-                    let (ex, ey) = (b.0 - a.0, b.1 - a.1);
-                    let t =
-                        (((x - a.0) * ex + (y - a.1) * ey) / (ex * ex + ey * ey)).clamp(0.0, 1.0);
-                    ((x - a.0 - t * ex).powi(2) + (y - a.1 - t * ey).powi(2)).sqrt()
+                    let a = Point3::new(w[0].0, w[0].1, 0.0);
+                    point_segment_distance(&q, &a, &Point3::new(w[1].0, w[1].1, 0.0))
                 })
                 .fold(f64::INFINITY, f64::min);
             if d > 0.5 * r {

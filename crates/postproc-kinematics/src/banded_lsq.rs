@@ -20,6 +20,10 @@ use nalgebra::DMatrix;
 /// Widest band handled (cubic B-splines have 4 non-zeros per row).
 pub const MAX_BAND: usize = 4;
 
+/// A row of a banded matrix: its first non-zero column and the values from there (entries
+/// past the band are zero).
+pub type BandRow = (usize, [f64; MAX_BAND]);
+
 /// One step of the reduction of a right-hand-side entry (see [`BandedQr::reduce`]).
 #[derive(Debug, Clone, Copy)]
 enum Step {
@@ -47,11 +51,7 @@ impl BandedQr {
     /// Factors the matrix whose row `i` has the values `rows[i].1[..w]` in columns
     /// `rows[i].0 …` (entries at columns `≥ k` must be zero and are ignored). `w` must be
     /// at most [`MAX_BAND`]. O(m·w²).
-    pub fn new(
-        k: usize,
-        w: usize,
-        rows: impl IntoIterator<Item = (usize, [f64; MAX_BAND])>,
-    ) -> Self {
+    pub fn new(k: usize, w: usize, rows: impl IntoIterator<Item = BandRow>) -> Self {
         let w = w.clamp(1, MAX_BAND);
         let mut qr = Self {
             k,
@@ -166,7 +166,7 @@ mod tests {
     use nalgebra::DVector;
 
     /// A banded test matrix: row `i` has `w` values from column `first(i)`.
-    fn banded(m: usize, k: usize, w: usize) -> Vec<(usize, [f64; MAX_BAND])> {
+    fn banded(m: usize, k: usize, w: usize) -> Vec<BandRow> {
         (0..m)
             .map(|i| {
                 let first = (i * (k - w + 1)) / m;
@@ -179,7 +179,7 @@ mod tests {
             .collect()
     }
 
-    fn dense(rows: &[(usize, [f64; MAX_BAND])], k: usize, w: usize) -> DMatrix<f64> {
+    fn dense(rows: &[BandRow], k: usize, w: usize) -> DMatrix<f64> {
         let mut a = DMatrix::zeros(rows.len(), k);
         for (i, (first, v)) in rows.iter().enumerate() {
             for d in 0..w {
@@ -223,7 +223,7 @@ mod tests {
     #[test]
     fn a_column_without_entries_is_rank_deficient() {
         // Column 3 of 6 is never touched.
-        let rows: Vec<(usize, [f64; MAX_BAND])> = (0..12)
+        let rows: Vec<BandRow> = (0..12)
             .map(|i| {
                 (
                     if i < 6 { 0 } else { 4 },

@@ -7,6 +7,7 @@
 //! cost O(m·n²). Reverse-motion smoothing, which refits many long runs, factors the banded
 //! collocation matrix by Givens rotations instead ([`crate::banded_lsq`]).
 
+use crate::banded_lsq::BandRow;
 use nalgebra::{DMatrix, DVector};
 
 /// A scalar clamped uniform B-spline on `[0, 1]`.
@@ -119,9 +120,6 @@ pub(crate) fn collocation(t: &[f64], n_ctrl: usize) -> Option<(ScalarBSpline, DM
     }
     Some((spline, a))
 }
-
-/// A row of a banded matrix: its first non-zero column and the values from there.
-pub(crate) type BandRow = (usize, [f64; 4]);
 
 /// [`collocation`] by rows: for each parameter, the first column of its `p + 1` non-zeros
 /// and their values (the rest of the row is zero). O(m·p²).

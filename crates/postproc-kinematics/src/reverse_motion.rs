@@ -2,7 +2,7 @@
 //! displacement of an axis changes direction (paper 004: such reversals leave tool marks,
 //! because the feed drive stops and backlash acts).
 
-use crate::banded_lsq::{BandedQr, MAX_BAND};
+use crate::banded_lsq::{BandRow, BandedQr, MAX_BAND};
 use crate::bspline_fit::{collocation_rows, ScalarBSpline};
 use crate::error::PostError;
 use crate::joints::{AxisId, Joints};
@@ -437,7 +437,7 @@ struct Pins {
 struct SplineProjector {
     template: ScalarBSpline,
     /// Row `i` of `A`: its first non-zero column and the `p + 1` values from there.
-    rows: Vec<(usize, [f64; MAX_BAND])>,
+    rows: Vec<BandRow>,
     /// Number of columns (control values).
     k: usize,
     qr: BandedQr,
