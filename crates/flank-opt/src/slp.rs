@@ -191,7 +191,7 @@ pub fn solve<M: Model>(
             model.record(iterations, &x, &eval, radius);
             break;
         }
-        let trial: Vec<f64> = x.iter().zip(&step).map(|(a, b)| a + b).collect();
+        let trial = take_step(&x, &step, opts);
         let trial_eval = model.evaluate(&trial, true)?;
         let trial_phi = merit(&trial_eval, opts.penalty);
         let mut ratio = (phi - trial_phi) / pred_red;
@@ -205,7 +205,7 @@ pub fn solve<M: Model>(
             // predicted decrease, so the merit still never rises.
             iterations += 1;
             let (corr, _) = lp_step(&cand.1, &cand.0, radius, opts)?;
-            let x2: Vec<f64> = cand.0.iter().zip(&corr).map(|(a, b)| a + b).collect();
+            let x2 = take_step(&cand.0, &corr, opts);
             let e2 = model.evaluate(&x2, true)?;
             let phi2 = merit(&e2, opts.penalty);
             let r2 = (phi - phi2) / pred_red;
@@ -239,6 +239,24 @@ pub fn solve<M: Model>(
         merit_history: history,
         termination,
     })
+}
+
+/// `x + step` kept exactly inside the variable bounds, with the variables of zero trust
+/// scale left where they are. The LP meets its bounds only to the interior-point tolerance
+/// (about 1e-10): without this projection a variable at its bound (a half angle of 0, say)
+/// could step to −1e-10 and leave the model's domain.
+fn take_step(x: &[f64], step: &[f64], opts: &SlpOptions) -> Vec<f64> {
+    x.iter()
+        .zip(step)
+        .enumerate()
+        .map(|(k, (a, d))| {
+            if opts.scale[k] == 0.0 {
+                *a
+            } else {
+                (a + d).max(opts.lower[k]).min(opts.upper[k])
+            }
+        })
+        .collect()
 }
 
 /// Sparse matrix assembly by columns (CSC) from (row, col, value) triplets.
@@ -497,5 +515,52 @@ mod tests {
         let r = solve(&mut Clash, vec![3.0], &opts).unwrap();
         assert_eq!(r.termination, Termination::Infeasible);
         assert!(r.merit_history.windows(2).all(|w| w[1] <= w[0]));
+    }
+
+    /// Minimise `x0 + (x1 − 0.3)²` over `x0 >= 0` (the bound) with `x2` fixed (trust scale
+    /// 0): the optimum sits on the bound, where the LP lands only within its tolerance. The
+    /// model refuses to evaluate outside its domain, as a cutter model refuses a negative
+    /// half angle (issue found on an imported 12+12 impeller: θ = −1.1e-10).
+    struct OnBound;
+    impl Model for OnBound {
+        fn dimension(&self) -> usize {
+            3
+        }
+        fn evaluate(&mut self, x: &[f64], _: bool) -> Result<Evaluation, FlankError> {
+            if x[0] < 0.0 || x[2] != 0.25 {
+                return Err(FlankError::Param(format!("outside the domain: {x:?}")));
+            }
+            Ok(Evaluation {
+                objective: Row {
+                    value: x[0] + (x[1] - 0.3) * (x[1] - 0.3),
+                    grad: vec![(0, 1.0), (1, 2.0 * (x[1] - 0.3)), (2, 1.0)],
+                },
+                minimax: Vec::new(),
+                constraints: Vec::new(),
+                info: Vec::new(),
+            })
+        }
+    }
+
+    #[test]
+    fn steps_stay_inside_the_bounds_and_keep_fixed_variables() {
+        let opts = SlpOptions {
+            max_iterations: 40,
+            radius: 0.5,
+            min_radius: 1e-12,
+            tol: 1e-14,
+            penalty: 10.0,
+            feas_tol: 1e-6,
+            scale: vec![1.0, 1.0, 0.0],
+            lower: vec![0.0, -1.0, -1.0],
+            upper: vec![1.0, 1.0, 1.0],
+        };
+        // Every start walks onto the bound x0 = 0; none may step past it.
+        for start in [0.7, 0.31, 0.05, 1e-9] {
+            let r = solve(&mut OnBound, vec![start, -0.4, 0.25], &opts).unwrap();
+            assert!(r.x[0] >= 0.0 && r.x[0] < 1e-9, "{start}: {:?}", r.x);
+            assert_eq!(r.x[2], 0.25, "{start}: the fixed variable moved");
+            assert!((r.x[1] - 0.3).abs() < 1e-3, "{start}: {:?}", r.x);
+        }
     }
 }
