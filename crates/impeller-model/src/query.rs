@@ -369,7 +369,10 @@ mod tests {
 /// edges; there `max` over-reads (0.21 mm measured beside impeller-8+8's splitter leading
 /// edge, where a cutter gouged unseen) and the bound is `max(d_sh, min(d_p, d_s) − half_edge)`:
 /// the edge region of the boundary lies on the two patches or on an edge face spanning the
-/// gap between them, whose points are within `half_edge` of a patch. O(1).
+/// gap between them, whose points are within `half_edge` of a patch.
+///
+/// Near a blunt edge, where both closest points lie on the edge, [`blunt_edge_distance`] is
+/// the better answer. O(1).
 pub fn blade_solid_distance(
     d_pressure: f64,
     d_suction: f64,
@@ -381,6 +384,67 @@ pub fn blade_solid_distance(
     } else {
         d_pressure.max(d_suction).max(d_shroud)
     }
+}
+
+/// A side's edge at a closest point: which u-end, the outward normal, the outward u-tangent
+/// and the tangent along the edge.
+type EdgeFrame = (usize, Vector3<f64>, Vector3<f64>, Vector3<f64>);
+
+/// Edges thinner than this (mm) count as closed (the sides meet, as at a rounded edge).
+const CLOSED_EDGE_MM: f64 = 1e-3;
+
+/// Signed distance (negative inside) to a blade near a **blunt** edge, where the closest
+/// points `pressure` and `suction` of `p` on the two sides both lie on the same u-edge of
+/// their patches and that edge is open (the sides end `> 1 µm` apart); `None` elsewhere.
+///
+/// Locally the blade there is the wedge bounded by the two sides' tangent planes at the
+/// edge points and the edge face spanning them (the plane through both edge points along the
+/// edge, facing outward along the sides' u-tangents). Its signed distance is taken as the
+/// largest of the three planes' signed distances: exact inside a convex wedge, a lower bound
+/// outside. The side-distance sign alone fails there: behind a trailing-edge face whose sides
+/// splay apart both signs are negative, and an imported 12 + 12 impeller's verification read
+/// a point 0.2 mm behind its 3 mm trailing-edge face as 3.4 mm inside the blade (hub
+/// finishing had rightly cut past the blade). O(p²) for degree p.
+pub fn blunt_edge_distance(
+    blade: &Blade,
+    p: &Vector3<f64>,
+    pressure: &SurfacePoint,
+    suction: &SurfacePoint,
+) -> Option<f64> {
+    let edge = |side: Side, foot: &SurfacePoint| -> Option<EdgeFrame> {
+        let s = blade.side(side);
+        let ((u0, u1), _) = s.domain();
+        let tol = 1e-9 * (u1 - u0).abs().max(1.0);
+        let (end, sign) = if (foot.u - u1).abs() <= tol {
+            (1, 1.0)
+        } else if (foot.u - u0).abs() <= tol {
+            (0, -1.0)
+        } else {
+            return None;
+        };
+        let d = s.derivs2(foot.u, foot.v);
+        let n = blade.outward_normal(side, foot.u, foot.v)?;
+        Some((end, n, sign * d.su, d.sv))
+    };
+    let (ep, np, tp, vp) = edge(Side::Pressure, pressure)?;
+    let (es, ns, ts, _) = edge(Side::Suction, suction)?;
+    let gap = suction.point - pressure.point;
+    if ep != es || gap.norm() <= CLOSED_EDGE_MM {
+        return None;
+    }
+    let mut face = gap.cross(&vp);
+    let out = tp.normalize() + ts.normalize();
+    if face.dot(&out) < 0.0 {
+        face = -face;
+    }
+    let face = face.try_normalize(1e-12)?;
+    let mid = 0.5 * (pressure.point + suction.point);
+    Some(
+        (p - pressure.point)
+            .dot(&np)
+            .max((p - suction.point).dot(&ns))
+            .max((p - mid).dot(&face)),
+    )
 }
 
 /// Half the gap between a blade's two sides at its edges, `[at the pressure side's u-min

@@ -10,13 +10,17 @@
 //! is evaluated: it is found, with a starting parameter for the Newton iteration, by
 //! projecting `p` on a triangle mesh of all blade sides (parry BVH, O(log T)). The max/min
 //! combination is exact where one surface is nearest and a (slight) under-estimate of |sd|
-//! near edges; it is accurate near the surfaces, which is where the probes need it.
+//! near edges; it is accurate near the surfaces, which is where the probes need it. Where the
+//! closest points of both sides lie on the same blunt leading or trailing edge, the blade is
+//! the wedge of the two sides' tangent planes and the edge face between them
+//! (`impeller_model::query::blunt_edge_distance`): behind a face whose sides splay apart both
+//! side signs are negative, and the sign rule alone would put such points inside the blade.
 
 use crate::design::{DesignModel, SurfaceGrid, TriangleMesh};
 use crate::error::SimError;
 use crate::stock_shape::RevolvedStock;
 use cam_core::{Point3, Vector3};
-use impeller_model::query::closest_point;
+use impeller_model::query::{blunt_edge_distance, closest_point, SurfacePoint};
 use impeller_model::{Blade, Impeller, Side};
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::PointQueryWithLocation;
@@ -259,14 +263,22 @@ impl ImpellerDesign {
         let (d1, u1, f1) = side_foot(blade, side, p, (u, v));
         let (d2, u2, f2) = side_foot(blade, side.other(), p, (u, v));
         let (ds, zr) = self.shroud_sd.foot(p);
-        let u_pressure = if side == Side::Pressure { u1 } else { u2 };
+        let u_pressure = if side == Side::Pressure { u1.0 } else { u2.0 };
         let ((ua, ub), _) = blade.side(Side::Pressure).domain();
         let end = usize::from(u_pressure > 0.5 * (ua + ub));
         let half_gap = self
             .edge_half_gaps
             .get(bi as usize)
             .map_or(self.far_mm, |g| g[end]);
-        let d = impeller_model::query::blade_solid_distance(d1, d2, ds, half_gap);
+        let (fp, fs) = if side == Side::Pressure {
+            (foot_point(u1, &f1, d1), foot_point(u2, &f2, d2))
+        } else {
+            (foot_point(u2, &f2, d2), foot_point(u1, &f1, d1))
+        };
+        let d = match blunt_edge_distance(blade, &p.coords, &fp, &fs) {
+            Some(e) => e.max(ds),
+            None => impeller_model::query::blade_solid_distance(d1, d2, ds, half_gap),
+        };
         // The face whose term decides `blade_solid_distance`.
         let foot = if d == ds {
             Foot::Meridian(zr)
@@ -465,18 +477,28 @@ impl Foot {
 /// `closest_point`, NURBS Book §6.1; allocation-free), positive on the outward side.
 /// Signed distance of `p` to one side of `blade` and the u parameter of the closest point.
 fn side_distance(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> (f64, f64) {
-    let (d, u, _) = side_foot(blade, side, p, hint);
+    let (d, (u, _), _) = side_foot(blade, side, p, hint);
     (d, u)
 }
 
 /// [`side_distance`] with the closest point found on the side.
-fn side_foot(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> (f64, f64, Point3) {
+fn side_foot(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> (f64, (f64, f64), Point3) {
     let sp = closest_point(blade.side(side), &p.coords, Some(hint));
     let d = match blade.outward_normal(side, sp.u, sp.v) {
         Some(n) if (p.coords - sp.point).dot(&n) < 0.0 => -sp.distance,
         _ => sp.distance,
     };
-    (d, sp.u, Point3::from(sp.point))
+    (d, (sp.u, sp.v), Point3::from(sp.point))
+}
+
+/// The closest-point record of a side foot.
+fn foot_point((u, v): (f64, f64), foot: &Point3, d: f64) -> SurfacePoint {
+    SurfacePoint {
+        u,
+        v,
+        point: foot.coords,
+        distance: d.abs(),
+    }
 }
 
 fn side_name(side: Side) -> &'static str {
@@ -567,7 +589,16 @@ impl DesignModel for ImpellerDesign {
         });
         match side {
             Some((d, blade, s, hint)) if d <= hub && d <= shroud => {
-                -side_distance(blade, s, p, hint).0
+                // Near a blunt edge one side's signed distance can read a point behind
+                // the edge face as deep inside; the edge wedge decides there.
+                let (d1, uv1, f1) = side_foot(blade, s, p, hint);
+                let (d2, uv2, f2) = side_foot(blade, s.other(), p, hint);
+                let (a, b) = (foot_point(uv1, &f1, d1), foot_point(uv2, &f2, d2));
+                let (fp, fs) = if s == Side::Pressure { (a, b) } else { (b, a) };
+                match blunt_edge_distance(blade, &p.coords, &fp, &fs) {
+                    Some(e) => -e,
+                    None => -d1,
+                }
             }
             _ if hub <= shroud => -self.hub_signed_distance(p),
             _ => -self.shroud_sd.signed_distance(p),
