@@ -393,6 +393,20 @@ type EdgeFrame = (usize, Vector3<f64>, Vector3<f64>, Vector3<f64>);
 /// Edges thinner than this (mm) count as closed (the sides meet, as at a rounded edge).
 const CLOSED_EDGE_MM: f64 = 1e-3;
 
+/// Which u-edge of a blade side the parameter `u` lies on (`0` at u-min, `1` at u-max, within
+/// 1e-9 of the parameter range), `None` inside: a closest point on an edge of the patch.
+pub fn side_u_edge(blade: &Blade, side: Side, u: f64) -> Option<usize> {
+    let ((u0, u1), _) = blade.side(side).domain();
+    let tol = 1e-9 * (u1 - u0).abs().max(1.0);
+    if (u - u1).abs() <= tol {
+        Some(1)
+    } else if (u - u0).abs() <= tol {
+        Some(0)
+    } else {
+        None
+    }
+}
+
 /// Signed distance (negative inside) to a blade near a **blunt** edge, where the closest
 /// points `pressure` and `suction` of `p` on the two sides both lie on the same u-edge of
 /// their patches and that edge is open (the sides end `> 1 µm` apart); `None` elsewhere.
@@ -412,17 +426,9 @@ pub fn blunt_edge_distance(
     suction: &SurfacePoint,
 ) -> Option<f64> {
     let edge = |side: Side, foot: &SurfacePoint| -> Option<EdgeFrame> {
-        let s = blade.side(side);
-        let ((u0, u1), _) = s.domain();
-        let tol = 1e-9 * (u1 - u0).abs().max(1.0);
-        let (end, sign) = if (foot.u - u1).abs() <= tol {
-            (1, 1.0)
-        } else if (foot.u - u0).abs() <= tol {
-            (0, -1.0)
-        } else {
-            return None;
-        };
-        let d = s.derivs2(foot.u, foot.v);
+        let end = side_u_edge(blade, side, foot.u)?;
+        let sign = if end == 1 { 1.0 } else { -1.0 };
+        let d = blade.side(side).derivs2(foot.u, foot.v);
         let n = blade.outward_normal(side, foot.u, foot.v)?;
         Some((end, n, sign * d.su, d.sv))
     };

@@ -20,7 +20,7 @@ use crate::design::{DesignModel, SurfaceGrid, TriangleMesh};
 use crate::error::SimError;
 use crate::stock_shape::RevolvedStock;
 use cam_core::{Point3, Vector3};
-use impeller_model::query::{blunt_edge_distance, closest_point, SurfacePoint};
+use impeller_model::query::{blunt_edge_distance, closest_point, side_u_edge, SurfacePoint};
 use impeller_model::{Blade, Impeller, Side};
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::PointQueryWithLocation;
@@ -260,22 +260,17 @@ impl ImpellerDesign {
             return (bound.max(ds).max(1e-9), foot);
         }
         let blade = &self.blades[bi as usize].1;
-        let (d1, u1, f1) = side_foot(blade, side, p, (u, v));
-        let (d2, u2, f2) = side_foot(blade, side.other(), p, (u, v));
+        let (d1, f1) = side_foot(blade, side, p, (u, v));
+        let (d2, f2) = side_foot(blade, side.other(), p, (u, v));
         let (ds, zr) = self.shroud_sd.foot(p);
-        let u_pressure = if side == Side::Pressure { u1.0 } else { u2.0 };
+        let u_pressure = if side == Side::Pressure { f1.u } else { f2.u };
         let ((ua, ub), _) = blade.side(Side::Pressure).domain();
         let end = usize::from(u_pressure > 0.5 * (ua + ub));
         let half_gap = self
             .edge_half_gaps
             .get(bi as usize)
             .map_or(self.far_mm, |g| g[end]);
-        let (fp, fs) = if side == Side::Pressure {
-            (foot_point(u1, &f1, d1), foot_point(u2, &f2, d2))
-        } else {
-            (foot_point(u2, &f2, d2), foot_point(u1, &f1, d1))
-        };
-        let d = match blunt_edge_distance(blade, &p.coords, &fp, &fs) {
+        let d = match edge_wedge(blade, side, p, &f1, &f2) {
             Some(e) => e.max(ds),
             None => impeller_model::query::blade_solid_distance(d1, d2, ds, half_gap),
         };
@@ -283,9 +278,9 @@ impl ImpellerDesign {
         let foot = if d == ds {
             Foot::Meridian(zr)
         } else if (d1 > 0.0 && d2 > 0.0) == (d1 <= d2) {
-            Foot::At(f1)
+            Foot::At(Point3::from(f1.point))
         } else {
-            Foot::At(f2)
+            Foot::At(Point3::from(f2.point))
         };
         (d, foot)
     }
@@ -477,28 +472,33 @@ impl Foot {
 /// `closest_point`, NURBS Book §6.1; allocation-free), positive on the outward side.
 /// Signed distance of `p` to one side of `blade` and the u parameter of the closest point.
 fn side_distance(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> (f64, f64) {
-    let (d, (u, _), _) = side_foot(blade, side, p, hint);
-    (d, u)
+    let (d, foot) = side_foot(blade, side, p, hint);
+    (d, foot.u)
 }
 
 /// [`side_distance`] with the closest point found on the side.
-fn side_foot(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> (f64, (f64, f64), Point3) {
+fn side_foot(blade: &Blade, side: Side, p: &Point3, hint: (f64, f64)) -> (f64, SurfacePoint) {
     let sp = closest_point(blade.side(side), &p.coords, Some(hint));
     let d = match blade.outward_normal(side, sp.u, sp.v) {
         Some(n) if (p.coords - sp.point).dot(&n) < 0.0 => -sp.distance,
         _ => sp.distance,
     };
-    (d, (sp.u, sp.v), Point3::from(sp.point))
+    (d, sp)
 }
 
-/// The closest-point record of a side foot.
-fn foot_point((u, v): (f64, f64), foot: &Point3, d: f64) -> SurfacePoint {
-    SurfacePoint {
-        u,
-        v,
-        point: foot.coords,
-        distance: d.abs(),
-    }
+/// [`blunt_edge_distance`] from the closest points on `side` (`first`) and on the other side.
+fn edge_wedge(
+    blade: &Blade,
+    side: Side,
+    p: &Point3,
+    first: &SurfacePoint,
+    other: &SurfacePoint,
+) -> Option<f64> {
+    let (pressure, suction) = match side {
+        Side::Pressure => (first, other),
+        Side::Suction => (other, first),
+    };
+    blunt_edge_distance(blade, &p.coords, pressure, suction)
 }
 
 fn side_name(side: Side) -> &'static str {
@@ -590,15 +590,14 @@ impl DesignModel for ImpellerDesign {
         match side {
             Some((d, blade, s, hint)) if d <= hub && d <= shroud => {
                 // Near a blunt edge one side's signed distance can read a point behind
-                // the edge face as deep inside; the edge wedge decides there.
-                let (d1, uv1, f1) = side_foot(blade, s, p, hint);
-                let (d2, uv2, f2) = side_foot(blade, s.other(), p, hint);
-                let (a, b) = (foot_point(uv1, &f1, d1), foot_point(uv2, &f2, d2));
-                let (fp, fs) = if s == Side::Pressure { (a, b) } else { (b, a) };
-                match blunt_edge_distance(blade, &p.coords, &fp, &fs) {
-                    Some(e) => -e,
-                    None => -d1,
-                }
+                // the edge face as deep inside; the edge wedge decides there (the other
+                // side is needed only when this side's foot lies on an edge).
+                let (d1, f1) = side_foot(blade, s, p, hint);
+                let wedge = side_u_edge(blade, s, f1.u).and_then(|_| {
+                    let (_, f2) = side_foot(blade, s.other(), p, hint);
+                    edge_wedge(blade, s, p, &f1, &f2)
+                });
+                -wedge.unwrap_or(d1)
             }
             _ if hub <= shroud => -self.hub_signed_distance(p),
             _ => -self.shroud_sd.signed_distance(p),
