@@ -26,6 +26,7 @@
 pub mod catalogue;
 pub mod finishing;
 pub mod geometry;
+pub mod lp;
 pub mod measure;
 pub mod problem;
 pub mod semi;
