@@ -7,7 +7,7 @@
 //!   tangency with the ball lowered onto the hub; then the cutter shape (ball radius, half
 //!   taper angle) and the path (the control points of the two guide curves of the tool-axis
 //!   trajectory surface) optimised together for the Rayleigh–Ritz stiffness under accuracy,
-//!   hub-tangency and clearance constraints by SLP ([`slp`], LPs by clarabel); the catalogue
+//!   hub-tangency and clearance constraints by SLP ([`slp`], LPs by [`lp`]); the catalogue
 //!   cutter just below the optimum ([`catalogue`]); the path of the job's tool optimised as a
 //!   minimax problem; the written pass measured densely against the design side and refined
 //!   until it holds the tolerance ([`measure`], issue 13); the best cylindrical ball end for
@@ -16,9 +16,10 @@
 //!   sub-ruled strips within the semi-finish tolerance, one flank pass per strip from the
 //!   shroud down; compared with isoparametric point milling at the same scallop height.
 //!
-//! Why clarabel: it is the workspace's LP/QP/SOCP solver (DESIGN §2), a maintained pure-Rust
-//! interior-point code with sparse KKT factorisation, which fits LPs of a few hundred
-//! variables and a thousand rows per SLP iteration.
+//! The LPs: a primal–dual interior point specialised to the SLP subproblem ([`lp`]: the
+//! elastic slacks eliminated, a dense normal system of the few hundred path variables),
+//! several times faster there than clarabel, the workspace's general conic solver (DESIGN §2),
+//! which remains the fallback should the specialised solve not converge.
 //!
 //! Dependency direction: `nurbs`, `cam-core`, `impeller-model`, `cutter-stiffness`,
 //! `cam-plan` only.
