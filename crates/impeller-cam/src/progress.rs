@@ -44,8 +44,18 @@ impl Progress {
         }
     }
 
-    /// A spinner for one operation being planned; finish it with [`Task::done`].
+    /// A spinner for one operation being planned; finish it with [`Task::done`]. Without a
+    /// terminal (a log file, CI) there is no spinner: the start and the summary are printed
+    /// as stage lines instead, so a long planning run still shows which operations are under
+    /// way and which are done.
     pub fn task(&self, what: String) -> Task {
+        if self.multi.is_hidden() {
+            self.stage(&what);
+            return Task {
+                bar: ProgressBar::hidden(),
+                lines: !self.quiet,
+            };
+        }
         let bar = self.multi.add(ProgressBar::new_spinner());
         bar.set_style(
             ProgressStyle::with_template("{spinner} {msg} {elapsed:>4}")
@@ -53,7 +63,7 @@ impl Progress {
         );
         bar.set_message(what);
         bar.enable_steady_tick(Duration::from_millis(120));
-        Task { bar }
+        Task { bar, lines: false }
     }
 
     /// A bar over `total` units (moves) with a message.
@@ -75,11 +85,16 @@ impl Progress {
 #[derive(Debug)]
 pub struct Task {
     bar: ProgressBar,
+    /// Print the summary as a line (no terminal, not quiet).
+    lines: bool,
 }
 
 impl Task {
-    /// Ends the spinner, leaving `summary` in its place.
+    /// Ends the spinner, leaving `summary` in its place (or prints it as a line).
     pub fn done(self, summary: String) {
+        if self.lines {
+            eprintln!("[impeller-cam] {summary}");
+        }
         self.bar.finish_with_message(summary);
     }
 }

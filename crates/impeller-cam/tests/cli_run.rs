@@ -61,6 +61,19 @@ fn default_job_is_the_impeller_8_8_fixture_job() {
         assert!(o["plan_ms"].as_f64().unwrap() > 0.0, "{o}");
         assert_eq!(o["uncertified_links"], 0.0, "{o}");
     }
+    // Without a terminal (stderr is a pipe here) each operation's start and end are stage
+    // lines: a long planning run shows which operations are under way.
+    let stderr = String::from_utf8_lossy(&st.stderr);
+    for (name, kind) in &kinds {
+        assert!(
+            stderr.contains(&format!("[impeller-cam] planning {name} ({kind}) …")),
+            "{stderr}"
+        );
+        assert!(
+            stderr.contains(&format!("[impeller-cam] planned {name} ({kind}): ")),
+            "{stderr}"
+        );
+    }
     // The turned blank: the shroud's outlet radius, not the file's Ø79 cylinder.
     let sr = r["impeller"]["stock_radius_mm"].as_f64().unwrap();
     assert!((sr - 38.5).abs() < 0.02, "{sr}");
