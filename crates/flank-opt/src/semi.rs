@@ -10,9 +10,11 @@
 //! 2. one flank pass per strip, the strip nearest the shroud first: at `passes_along`
 //!    rulings the cutter axis is tangent, at the strip's two edge points, to the ruled
 //!    surface offset by the blade allowance (two-point tangency with the cutter's own radius
-//!    at each contact height), the strip's lower edge at the ball-centre height; more
-//!    rulings wherever the straight moves of the written pass would leave that solution by
-//!    more than the job's `chord_tol` ([`pass_stations`]: around a rounded leading edge);
+//!    at each contact height), the strip's lower edge at the ball-centre height, the axis
+//!    then moved away from any interior point of the ruling that comes nearer than the
+//!    allowance (a twisted ruling turns away from the cutter's line; [`tangency_station`]);
+//!    more rulings wherever the straight moves of the written pass would leave that solution
+//!    by more than the job's `chord_tol` ([`pass_stations`]: around a rounded leading edge);
 //! 3. interference check: the design side below the strip (the lower strips, still carrying
 //!    their allowance) and the hub must stay at least `allowance − strip_tol` from the pass's
 //!    swept envelope ([`cam_core::SweptEnvelope`], certified distances); a pass that comes
@@ -88,6 +90,15 @@ pub fn build_flank_semi_finishing(spec: &OperationSpec) -> Result<Box<dyn Operat
 /// Bisection steps of the interference lift (the bracket is the strip height; 30 halvings
 /// leave < 1e-7 of it).
 const LIFT_BISECTIONS: usize = 30;
+/// Fixed-point rounds of [`tangency_station`] (contact heights and offsets across the axis).
+const TANGENCY_ROUNDS: usize = 6;
+/// Interior points of a ruling checked against the cutter by [`tangency_station`] (the
+/// ruling split into this many parts).
+const RULING_CHECKS: usize = 8;
+/// Rounds of the interior-point correction of [`tangency_station`].
+const GOUGE_ROUNDS: usize = 4;
+/// Missing clearance below which an interior point counts as kept (mm).
+const CLEARANCE_SLACK_MM: f64 = 1e-6;
 /// Most stations of one pass (the chord refinement of [`pass_stations`] stops there).
 pub const MAX_STATIONS: usize = 4000;
 /// Smallest station interval, as a fraction of the side's u range (the chord refinement
@@ -130,8 +141,9 @@ pub struct Station {
 
 /// The [`Station`] at `u` of the strip `v ∈ [a, b]` of `side`: the cutter axis through the
 /// offset points `p(u, a) + n·(ρ(h_a) + allowance)` and `p(u, b) + n·(ρ(h_b) + allowance)`
-/// (ρ the cutter's radius at the contact height), the lower contact at the ball-centre
-/// height; four fixed-point rounds for the contact heights of a tapered cutter. O(1).
+/// (ρ the cutter's radius at the contact height; `n` the side normal's part across the
+/// axis), the lower contact at the ball-centre height; [`TANGENCY_ROUNDS`] fixed-point
+/// rounds for the contact heights and the axis. O(1).
 pub fn tangency_station(
     blade: &Blade,
     side: Side,
@@ -152,13 +164,54 @@ pub fn tangency_station(
     let (mut ha, mut hb) = (r, r + (pb - pa).norm());
     let mut axis = (pb - pa).normalize();
     let mut tip = pa;
-    for _ in 0..4 {
-        let qa = pa + na * (member_radius(shape, ha) + allowance);
-        let qb = pb + nb * (member_radius(shape, hb) + allowance);
+    // Each contact point is offset across the axis: along the part of its normal normal to
+    // the axis, so the axis passes at ρ + allowance from it. (Along the normal itself the
+    // distance would be only (ρ + allowance)·cos β where the normal leans by β along the
+    // axis, as it does around a swept leading edge: with ρ = 6 mm and β = 20° the cutter
+    // would reach 0.17 mm into the allowance.)
+    let across = |n: &Vector3, axis: &Vector3| {
+        let m = n - axis * n.dot(axis);
+        let len = m.norm();
+        if len > 1e-9 {
+            m / len
+        } else {
+            *n
+        }
+    };
+    for _ in 0..TANGENCY_ROUNDS {
+        let qa = pa + across(&na, &axis) * (member_radius(shape, ha) + allowance);
+        let qb = pb + across(&nb, &axis) * (member_radius(shape, hb) + allowance);
         axis = (qb - qa).normalize();
         tip = qa - axis * r;
         ha = r;
         hb = (qb - tip).dot(&axis);
+    }
+    // Between the two contacts a twisted ruling turns away from the cutter's line (the
+    // normal of a non-developable side rotates along the ruling): around a swept leading
+    // edge the cutter tangent at both ends reached 0.3 mm into the allowance halfway along.
+    // The ruling's interior points are measured against the cutter and the axis is moved
+    // away from the deepest by the missing clearance until each keeps the allowance.
+    for _ in 0..GOUGE_ROUNDS {
+        let mut worst: Option<(f64, Vector3)> = None;
+        for k in 1..RULING_CHECKS {
+            let v = a + (b - a) * k as f64 / RULING_CHECKS as f64;
+            let p = s.point(u, v);
+            let d = p - tip;
+            let h = d.dot(&axis);
+            let radial = d - axis * h;
+            let w = radial.norm();
+            if w <= 1e-9 {
+                continue;
+            }
+            let missing = member_radius(shape, h.max(r)) + allowance - w;
+            if missing > worst.map_or(CLEARANCE_SLACK_MM, |x| x.0) {
+                worst = Some((missing, -radial / w));
+            }
+        }
+        match worst {
+            Some((missing, away)) => tip += away * missing,
+            None => break,
+        }
     }
     Ok(Station {
         u,
