@@ -50,7 +50,7 @@ const STEP_FRACTION: f64 = 0.99;
 /// summed). Rows with the same variables form a group, whose contribution to the normal
 /// matrix is accumulated densely before it is scattered once (the rows of the SLP share few
 /// patterns: the two rows of a minimax sample, all samples in one knot span of the path).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct SparseRows {
     ptr: Vec<usize>,
     idx: Vec<usize>,
@@ -59,6 +59,12 @@ pub struct SparseRows {
     groups: Vec<Vec<usize>>,
     /// Group of each variable pattern.
     pattern: std::collections::HashMap<Vec<usize>, usize>,
+}
+
+impl Default for SparseRows {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 impl SparseRows {
@@ -104,14 +110,16 @@ impl SparseRows {
         self.val.truncate(w);
         self.ptr.push(w);
         let r = self.ptr.len() - 2;
-        let next = self.groups.len();
-        let g = *self
-            .pattern
-            .entry(self.idx[start..w].to_vec())
-            .or_insert(next);
-        if g == next {
-            self.groups.push(Vec::new());
-        }
+        // A pattern seen before is looked up without copying it.
+        let g = match self.pattern.get(&self.idx[start..w]) {
+            Some(&g) => g,
+            None => {
+                let g = self.groups.len();
+                self.pattern.insert(self.idx[start..w].to_vec(), g);
+                self.groups.push(Vec::new());
+                g
+            }
+        };
         self.groups[g].push(r);
     }
     /// Number of rows.
@@ -739,7 +747,8 @@ mod tests {
 
     #[test]
     fn rows_are_sorted_merged_and_grouped_by_pattern() {
-        let mut r = SparseRows::new();
+        assert!(SparseRows::default().is_empty());
+        let mut r = SparseRows::default();
         r.push([(3, 1.0), (1, 2.0), (3, 4.0)]);
         r.push([(1, -1.0), (3, 0.5)]);
         r.push([(0, 1.0)]);
