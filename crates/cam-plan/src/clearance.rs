@@ -97,14 +97,15 @@
 //!
 //! Dependency: parry3d-f64 (the workspace's chosen BVH and convex-shape queries).
 
+use crate::mesh_distance::MeshDistance;
 use crate::{PlanError, Point3, Tool, Vector3};
 use cam_core::{CutterLocation, CutterShape};
 use impeller_model::export::stl::tessellate;
 use impeller_model::query::blade_side_distance;
 use impeller_model::{BladeSet, Impeller, Side};
 use parry3d_f64::math::{Pose, Rotation, Vector as PVec};
-use parry3d_f64::query::{self, PointQueryWithLocation};
-use parry3d_f64::shape::{CompositeShapeRef, TriMesh};
+use parry3d_f64::query;
+use parry3d_f64::shape::TriMesh;
 use std::sync::Arc;
 
 /// Default sampling tolerance of the swept balls (mm): the largest rim band between two
@@ -288,14 +289,16 @@ pub struct DesignMesh {
     blade_of: Vec<(Row, usize)>,
     /// The blade sides whole, including where they reach past the shroud contour (the exact
     /// side distances measure to them there).
-    blade_sides: TriMesh,
+    blade_sides: MeshDistance,
     /// (row, instance) of each triangle of `blade_sides`.
     side_of: Vec<(Row, usize)>,
     /// The chord of `blade_sides`.
     side_chord_mm: f64,
     /// Each row's reference blade (instance 0), both sides whole, in its own frame: the
     /// blade distance of one instance is bounded by turning the point into that frame.
-    reference_sides: Vec<(Row, TriMesh)>,
+    reference_sides: Vec<(Row, MeshDistance)>,
+    /// `blades` for point distances.
+    blades_distance: MeshDistance,
     chord_mm: f64,
     thickest_blade_mm: f64,
 }
@@ -425,13 +428,16 @@ impl DesignMesh {
         };
         let (blades, blade_of) = blade_mesh(clipped)?;
         let (blade_sides, side_of) = blade_mesh(whole)?;
+        let blade_sides = MeshDistance::new(&blade_sides);
         let reference_sides = reference
             .into_iter()
-            .map(|(row, t)| blade_mesh(t).map(|(m, _)| (row, m)))
+            .map(|(row, t)| blade_mesh(t).map(|(m, _)| (row, MeshDistance::new(&m))))
             .collect::<Result<Vec<_>, _>>()?;
+        let blades_distance = MeshDistance::new(&blades);
         Ok(Self {
             hub,
             blades,
+            blades_distance,
             blade_of,
             blade_sides,
             side_of,
@@ -456,9 +462,7 @@ impl DesignMesh {
     /// blade it belongs to when it is below `max_dist`, else `None` (the search prunes every
     /// BVH node beyond `max_dist`: cheap far from the blades). O(log T).
     fn side_mesh_distance_within(&self, p: &Point3, max_dist: f64) -> Option<(f64, DesignPart)> {
-        let q = pv(p);
-        let (tri, proj, _) = CompositeShapeRef(&self.blade_sides)
-            .project_local_point_and_get_location(q, max_dist, false)?;
+        let (tri, d) = self.blade_sides.nearest_within(pv(p), max_dist)?;
         let part = self
             .side_of
             .get(tri as usize)
@@ -466,14 +470,15 @@ impl DesignMesh {
                 row,
                 index,
             });
-        Some(((proj.point - q).length(), part))
+        Some((d, part))
     }
 
     /// Unsigned distance from `p` to the nearest blade side triangle and the blade it
     /// belongs to. O(log T).
     fn blade_mesh_distance(&self, p: &Point3) -> (f64, DesignPart) {
-        let q = pv(p);
-        let (proj, (tri, _)) = self.blades.project_local_point_and_get_location(q, false);
+        let Some((tri, d)) = self.blades_distance.nearest_within(pv(p), f64::INFINITY) else {
+            return (f64::INFINITY, DesignPart::Hub);
+        };
         let part = self
             .blade_of
             .get(tri as usize)
@@ -481,7 +486,7 @@ impl DesignMesh {
                 row,
                 index,
             });
-        ((proj.point - q).length(), part)
+        (d, part)
     }
 }
 
@@ -1053,9 +1058,7 @@ impl<'a> DesignClearance<'a> {
             let mesh = self.mesh.reference_sides.iter().find(|(r, _)| *r == row);
             if let Some((_, mesh)) = mesh.filter(|_| prune && cap.is_finite()) {
                 let q = PVec::new(local.x, local.y, local.z);
-                let near =
-                    CompositeShapeRef(mesh).project_local_point_and_get_location(q, cap, false);
-                if near.is_none() {
+                if mesh.nearest_within(q, cap).is_none() {
                     skipped |= floor < best.0;
                     continue;
                 }

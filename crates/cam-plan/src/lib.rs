@@ -30,6 +30,7 @@
 pub mod clearance;
 pub mod error;
 pub mod linking;
+mod mesh_distance;
 pub mod metrics;
 pub mod operation;
 pub mod order;
