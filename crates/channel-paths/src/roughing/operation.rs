@@ -1490,15 +1490,9 @@ impl ChannelRoughing {
         }
         // The scallop of every lane (its machinable region), against every cutter position
         // of the level.
+        let probe = ScallopProbe::new(&shape, ctx.tool.cutter.flute_length, &level_runs, doc);
         for area in &lp.areas {
-            out.max_scallop = out.max_scallop.max(measure_scallop(
-                &shape,
-                ctx.tool.cutter.flute_length,
-                &level_runs,
-                &area.region,
-                lv,
-                doc,
-            ));
+            out.max_scallop = out.max_scallop.max(probe.measure(&area.region, lv));
         }
         Ok(out)
     }
@@ -1643,108 +1637,166 @@ fn inside(
     (d - a * h).norm() <= profile.radius_at(h)
 }
 
-/// Largest scallop over a grid of the lane `region` (its machinable region): from each grid
-/// point of the level, the distance along the level normal to the first cutter position of
-/// `runs` (module docs), at most `cap`: the ray is marched at a quarter of the ball radius
-/// and the first entry bisected (40 steps); a cutter crossed by the ray over less than a
-/// march step may be missed, which only reads more. Each run is a sequence of consecutive
-/// locations joined by cutting motions, densified to `reach / SCALLOP_DENSIFY`.
-/// O(grid · (cap / step) · dense locations near the point).
-fn measure_scallop(
-    shape: &CutterShape,
+/// The cutter locations of one level, densified along their runs and bucketed in space,
+/// for [`ScallopProbe::measure`].
+struct ScallopProbe {
+    shape: CutterShape,
     flute: f64,
-    runs: &[Vec<CutterLocation>],
-    region: &Region,
-    lv: &DepthLevel,
     cap: f64,
-) -> f64 {
-    if runs.is_empty() {
-        return 0.0;
-    }
-    let reach = match *shape {
-        CutterShape::BallEnd { radius }
-        | CutterShape::BullNose { radius, .. }
-        | CutterShape::TaperedBallEnd {
-            ball_radius: radius,
-            ..
-        } => radius,
-        _ => 0.0,
-    };
-    // Densify consecutive locations to `reach / SCALLOP_DENSIFY`: the union of discrete
-    // cutters under-reads the swept one between them, so that a point at lateral distance `d`
-    // from the path is reached only as if `√(d² + (a/2)²)` away for spacing `a`. At a quarter
-    // radius this read up to 0.018 mm above a 0.5 mm scallop of a ball R1.5 (the cusps of the
-    // discrete balls); at a sixteenth it is below 0.002 mm.
-    let mut dense: Vec<CutterLocation> = Vec::new();
-    for cls in runs {
-        for w in cls.windows(2) {
-            let d = (w[1].tip - w[0].tip).norm();
-            let k = ((d * SCALLOP_DENSIFY / reach).ceil() as usize).clamp(1, 256);
-            for i in 0..k {
-                let t = i as f64 / k as f64;
-                let axis = w[0].axis.into_inner() * (1.0 - t) + w[1].axis.into_inner() * t;
-                dense.push(CutterLocation {
-                    tip: w[0].tip + (w[1].tip - w[0].tip) * t,
-                    axis: Unit::new_normalize(axis),
-                });
-            }
-        }
-        if let Some(l) = cls.last() {
-            dense.push(*l);
-        }
-    }
-    let (ns, ny) = SCALLOP_GRID;
-    let (s0, s1) = (region.s[0], region.s[region.s.len() - 1]);
-    let profile = shape.profile();
-    let mut near: Vec<&CutterLocation> = Vec::new();
-    let mut worst: f64 = 0.0;
-    for i in 0..=ns {
-        let s = s0 + (s1 - s0) * i as f64 / ns as f64;
-        let (l, r) = region.bounds(s);
-        for j in 0..=ny {
-            let y = l + (r - l) * j as f64 / ny as f64;
-            let (p, n) = lv.at_developed(s, y / lv.radius_at(s));
-            near.clear();
-            near.extend(
-                dense
-                    .iter()
-                    .filter(|c| (c.tip.coords - p).norm() <= 2.0 * reach + cap),
-            );
-            let hit = |t: f64| {
-                let x = p + n * t;
-                near.iter().any(|c| inside(&profile, flute, c, &x))
-            };
-            if hit(0.0) {
-                continue;
-            }
-            // March up the ray at a quarter radius to the first position inside a cutter
-            // (a ray may pass above or beside the cutters: the cap alone does not tell),
-            // then bisect between the last miss and the first hit.
-            let step = (0.25 * reach).max(1e-3).min(cap);
-            let mut lo = 0.0;
-            let mut first_hit = None;
-            while lo < cap {
-                let t = (lo + step).min(cap);
-                if hit(t) {
-                    first_hit = Some(t);
-                    break;
-                }
-                lo = t;
-            }
-            let Some(mut hi) = first_hit else {
-                worst = worst.max(cap);
-                continue;
-            };
-            for _ in 0..40 {
-                let m = 0.5 * (lo + hi);
-                if hit(m) {
-                    hi = m;
-                } else {
-                    lo = m;
+    /// The ball radius (0 for a flat end).
+    reach: f64,
+    /// The distance within which a location can hold a point of a probe ray: `2·reach + cap`.
+    radius: f64,
+    dense: Vec<CutterLocation>,
+    /// Indices into `dense` by cubic cell of side `radius` (the 27 cells around a point's
+    /// cell hold every location within `radius` of it).
+    cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl ScallopProbe {
+    /// The locations of `runs` (each a sequence of consecutive locations joined by cutting
+    /// motions), densified to `reach / SCALLOP_DENSIFY`, for rays of length `cap`. O(dense).
+    fn new(shape: &CutterShape, flute: f64, runs: &[Vec<CutterLocation>], cap: f64) -> Self {
+        let reach = match *shape {
+            CutterShape::BallEnd { radius }
+            | CutterShape::BullNose { radius, .. }
+            | CutterShape::TaperedBallEnd {
+                ball_radius: radius,
+                ..
+            } => radius,
+            _ => 0.0,
+        };
+        // Densify consecutive locations to `reach / SCALLOP_DENSIFY`: the union of discrete
+        // cutters under-reads the swept one between them, so that a point at lateral distance
+        // `d` from the path is reached only as if `√(d² + (a/2)²)` away for spacing `a`. At a
+        // quarter radius this read up to 0.018 mm above a 0.5 mm scallop of a ball R1.5 (the
+        // cusps of the discrete balls); at a sixteenth it is below 0.002 mm.
+        let mut dense: Vec<CutterLocation> = Vec::new();
+        for cls in runs {
+            for w in cls.windows(2) {
+                let d = (w[1].tip - w[0].tip).norm();
+                let k = ((d * SCALLOP_DENSIFY / reach).ceil() as usize).clamp(1, 256);
+                for i in 0..k {
+                    let t = i as f64 / k as f64;
+                    let axis = w[0].axis.into_inner() * (1.0 - t) + w[1].axis.into_inner() * t;
+                    dense.push(CutterLocation {
+                        tip: w[0].tip + (w[1].tip - w[0].tip) * t,
+                        axis: Unit::new_normalize(axis),
+                    });
                 }
             }
-            worst = worst.max(hi);
+            if let Some(l) = cls.last() {
+                dense.push(*l);
+            }
+        }
+        let radius = 2.0 * reach + cap;
+        let mut cells: std::collections::HashMap<[i64; 3], Vec<u32>> =
+            std::collections::HashMap::new();
+        if radius > 0.0 && radius.is_finite() {
+            for (i, c) in dense.iter().enumerate() {
+                if let Some(key) = Self::cell(&c.tip.coords, radius) {
+                    cells.entry(key).or_default().push(i as u32);
+                }
+            }
+        }
+        Self {
+            shape: *shape,
+            flute,
+            cap,
+            reach,
+            radius,
+            dense,
+            cells,
         }
     }
-    worst
+
+    /// The cell of `p` (`None` for a point too far out to bucket).
+    fn cell(p: &Vector3<f64>, side: f64) -> Option<[i64; 3]> {
+        let k = |x: f64| {
+            let c = (x / side).floor();
+            (c.abs() < 1e15).then_some(c as i64)
+        };
+        Some([k(p.x)?, k(p.y)?, k(p.z)?])
+    }
+
+    /// Largest scallop over a grid of the lane `region` (its machinable region) of level
+    /// `lv`: from each grid point, the distance along the level normal to the first cutter
+    /// position, at most `cap`: the ray is marched at a quarter of the ball radius and the
+    /// first entry bisected (40 steps); a cutter crossed by the ray over less than a march
+    /// step may be missed, which only reads more. O(grid · (cap / step) · dense locations
+    /// near the point).
+    fn measure(&self, region: &Region, lv: &DepthLevel) -> f64 {
+        if self.dense.is_empty() {
+            return 0.0;
+        }
+        let (reach, cap) = (self.reach, self.cap);
+        let (ns, ny) = SCALLOP_GRID;
+        let (s0, s1) = (region.s[0], region.s[region.s.len() - 1]);
+        let profile = self.shape.profile();
+        let mut near: Vec<&CutterLocation> = Vec::new();
+        let mut worst: f64 = 0.0;
+        for i in 0..=ns {
+            let s = s0 + (s1 - s0) * i as f64 / ns as f64;
+            let (l, r) = region.bounds(s);
+            for j in 0..=ny {
+                let y = l + (r - l) * j as f64 / ny as f64;
+                let (p, n) = lv.at_developed(s, y / lv.radius_at(s));
+                near.clear();
+                let within = |c: &&CutterLocation| (c.tip.coords - p).norm() <= self.radius;
+                match Self::cell(&p, self.radius).filter(|_| !self.cells.is_empty()) {
+                    Some([x, y, z]) => {
+                        for dx in -1..=1 {
+                            for dy in -1..=1 {
+                                for dz in -1..=1 {
+                                    if let Some(ids) = self.cells.get(&[x + dx, y + dy, z + dz]) {
+                                        near.extend(
+                                            ids.iter()
+                                                .filter_map(|&k| self.dense.get(k as usize))
+                                                .filter(within),
+                                        );
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    None => near.extend(self.dense.iter().filter(within)),
+                }
+                let hit = |t: f64| {
+                    let x = p + n * t;
+                    near.iter().any(|c| inside(&profile, self.flute, c, &x))
+                };
+                if hit(0.0) {
+                    continue;
+                }
+                // March up the ray at a quarter radius to the first position inside a cutter
+                // (a ray may pass above or beside the cutters: the cap alone does not tell),
+                // then bisect between the last miss and the first hit.
+                let step = (0.25 * reach).max(1e-3).min(cap);
+                let mut lo = 0.0;
+                let mut first_hit = None;
+                while lo < cap {
+                    let t = (lo + step).min(cap);
+                    if hit(t) {
+                        first_hit = Some(t);
+                        break;
+                    }
+                    lo = t;
+                }
+                let Some(mut hi) = first_hit else {
+                    worst = worst.max(cap);
+                    continue;
+                };
+                for _ in 0..40 {
+                    let m = 0.5 * (lo + hi);
+                    if hit(m) {
+                        hi = m;
+                    } else {
+                        lo = m;
+                    }
+                }
+                worst = worst.max(hi);
+            }
+        }
+        worst
+    }
 }
