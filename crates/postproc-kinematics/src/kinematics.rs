@@ -253,16 +253,40 @@ impl Machine {
         prev: Option<&Joints>,
     ) -> Result<(Joints, Option<KinematicsError>), KinematicsError> {
         let reference = prev.copied().unwrap_or(self.home);
-        let (best, fallback) =
-            self.choose_solution(cl, tool_length, &reference, |j| reference.rotary_travel(j))?;
+        check_finite(cl, tool_length)?;
+        // The choice of `choose_solution` with the rotary travel as cost, which needs the
+        // angles only: the two solutions are taken cheapest first (the first of equal ones)
+        // and the linear axes computed only until one lies within the limits.
+        let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
+        let tilt_spec = self.axis(AxisId::Tilt);
+        let rot_spec = self.axis(AxisId::Rotate);
+        let angles = sols.map(|(t, c)| {
+            let (t, t_ok) = equivalent_angle(t, tilt_spec, reference.tilt);
+            let (c, c_ok) = equivalent_angle(c, rot_spec, reference.rotate);
+            let cost = (t - reference.tilt).abs() + (c - reference.rotate).abs();
+            (t, c, t_ok && c_ok, cost)
+        });
+        let order = if angles[1].3 < angles[0].3 {
+            [1, 0]
+        } else {
+            [0, 1]
+        };
+        let mut cheapest: Option<Joints> = None;
+        for k in order {
+            let (t, c, ok, _) = angles[k];
+            let j = self.joints_for_angles(&cl.tip, tool_length, t, c);
+            if ok && self.check_limits(&j, LIMIT_SLACK).is_ok() {
+                return Ok((j, None));
+            }
+            cheapest.get_or_insert(j);
+        }
         let a = cl.axis.into_inner();
-        match (best, fallback) {
-            (Some((_, j)), _) => Ok((j, None)),
-            (None, Some((_, j))) => match self.check_limits(&j, LIMIT_SLACK) {
+        match cheapest {
+            Some(j) => match self.check_limits(&j, LIMIT_SLACK) {
                 Err(e) => Ok((j, Some(e))),
                 Ok(()) => Err(KinematicsError::UnreachableOrientation(a.x, a.y, a.z)),
             },
-            (None, None) => Err(KinematicsError::UnreachableOrientation(a.x, a.y, a.z)),
+            None => Err(KinematicsError::UnreachableOrientation(a.x, a.y, a.z)),
         }
     }
 
@@ -277,16 +301,7 @@ impl Machine {
         reference: &Joints,
         cost: impl Fn(&Joints) -> f64,
     ) -> Result<(Scored, Scored), KinematicsError> {
-        if !(cl.tip.x.is_finite() && cl.tip.y.is_finite() && cl.tip.z.is_finite()) {
-            return Err(KinematicsError::NonFinite("tool tip"));
-        }
-        let a = cl.axis.into_inner();
-        if !(a.x.is_finite() && a.y.is_finite() && a.z.is_finite()) {
-            return Err(KinematicsError::NonFinite("tool axis"));
-        }
-        if !tool_length.is_finite() {
-            return Err(KinematicsError::NonFinite("tool length"));
-        }
+        check_finite(cl, tool_length)?;
         let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
         let tilt_spec = self.axis(AxisId::Tilt);
         let rot_spec = self.axis(AxisId::Rotate);
@@ -381,6 +396,69 @@ impl Machine {
         Ok(out)
     }
 
+    /// The posture nearest `reference` (least rotary travel `|ΔT| + |ΔC|`, the first of equal
+    /// ones) among [`Self::inverse_candidates`] whose tilt passes `keep`; `None` when no
+    /// candidate does. The candidates' angles decide the order, so the linear axes are
+    /// computed (and checked against their limits) only for a candidate that improves on the
+    /// best so far: a continuation along a sweep asks this at every step.
+    pub fn nearest_candidate(
+        &self,
+        cl: &CutterLocation,
+        tool_length: f64,
+        reference: &Joints,
+        keep: impl Fn(f64) -> bool,
+    ) -> Result<Option<Joints>, KinematicsError> {
+        let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
+        let tilt_spec = self.axis(AxisId::Tilt);
+        let rot_spec = self.axis(AxisId::Rotate);
+        let mut best: Option<(f64, Joints)> = None;
+        // Angles of the candidates within the limits so far (the list's duplicates are
+        // dropped as in `inverse_candidates`).
+        let mut seen = [(0.0f64, 0.0f64); 18];
+        let mut n_seen = 0;
+        for (t, c) in sols {
+            let (t0, _) = equivalent_angle(t, tilt_spec, reference.tilt);
+            let (c0, _) = equivalent_angle(c, rot_spec, reference.rotate);
+            for dt in [-TAU, 0.0, TAU] {
+                for dc in [-TAU, 0.0, TAU] {
+                    let (tt, cc) = (t0 + dt, c0 + dc);
+                    if !tilt_spec.contains(tt, LIMIT_SLACK) || !rot_spec.contains(cc, LIMIT_SLACK) {
+                        continue;
+                    }
+                    if matches!(tilt_spec.mode, RotaryMode::Continuous) && dt != 0.0 {
+                        continue;
+                    }
+                    if matches!(rot_spec.mode, RotaryMode::Continuous) && dc != 0.0 {
+                        continue;
+                    }
+                    if seen[..n_seen]
+                        .iter()
+                        .any(|&(st, sc)| (st - tt).abs() < 1e-12 && (sc - cc).abs() < 1e-12)
+                    {
+                        continue;
+                    }
+                    let travel = (tt - reference.tilt).abs() + (cc - reference.rotate).abs();
+                    let improves = best.is_none_or(|(b, _)| travel < b);
+                    if !(keep(tt) && improves) {
+                        // Not chosen; whether it lies within the linear limits (and so
+                        // shadows a later duplicate) only matters for an equal angle pair,
+                        // which would not improve either.
+                        continue;
+                    }
+                    let j = self.joints_for_angles(&cl.tip, tool_length, tt, cc);
+                    if self.check_limits(&j, LIMIT_SLACK).is_ok() {
+                        if n_seen < seen.len() {
+                            seen[n_seen] = (tt, cc);
+                            n_seen += 1;
+                        }
+                        best = Some((travel, j));
+                    }
+                }
+            }
+        }
+        Ok(best.map(|(_, j)| j))
+    }
+
     /// Reduces continuous rotary axes to the equivalent angle in (−π, π] and recomputes the
     /// linear axes (unchanged for a pure 2π shift). Returns `true` when a value changed.
     pub fn unwind(&self, j: &mut Joints) -> bool {
@@ -397,6 +475,21 @@ impl Machine {
         }
         changed
     }
+}
+
+/// Errors: a non-finite tool tip, tool axis or tool length.
+fn check_finite(cl: &CutterLocation, tool_length: f64) -> Result<(), KinematicsError> {
+    if !(cl.tip.x.is_finite() && cl.tip.y.is_finite() && cl.tip.z.is_finite()) {
+        return Err(KinematicsError::NonFinite("tool tip"));
+    }
+    let a = cl.axis.into_inner();
+    if !(a.x.is_finite() && a.y.is_finite() && a.z.is_finite()) {
+        return Err(KinematicsError::NonFinite("tool axis"));
+    }
+    if !tool_length.is_finite() {
+        return Err(KinematicsError::NonFinite("tool length"));
+    }
+    Ok(())
 }
 
 /// Angle in (−π, π].
@@ -429,5 +522,106 @@ fn equivalent_angle(angle: f64, spec: &AxisSpec, reference: f64) -> (f64, bool) 
                 (angle + TAU * k, false)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod lazy_choice_tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+    use cam_core::{Point3, Vector3};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn machines() -> Vec<Machine> {
+        ["xyzac-trt", "xyzbc-trt", "turnmill-bc", "headhead-ac"]
+            .iter()
+            .map(|n| {
+                Machine::from_file(format!(
+                    "{}/../../fixtures/machines/{n}.toml",
+                    env!("CARGO_MANIFEST_DIR")
+                ))
+                .unwrap()
+            })
+            .collect()
+    }
+
+    /// Random postures across the four fixture machines, a third of them within 0.1° of the
+    /// rotary axis' singular direction (where the continuation along a sweep asks most):
+    /// [`Machine::nearest_candidate`] returns exactly the first least-travel posture of the
+    /// filtered [`Machine::inverse_candidates`], and the lazy [`Machine::inverse_best_effort`]
+    /// exactly the choice of `choose_solution` with the rotary travel as cost (the rule it
+    /// replaced), limit errors included.
+    #[test]
+    fn lazy_choices_equal_the_full_ones() {
+        let mut rng = ChaCha8Rng::seed_from_u64(17);
+        let mut compared = 0;
+        for m in machines() {
+            for k in 0..3000 {
+                let pole = k % 3 == 0;
+                let (tilt, rot) = if pole {
+                    (
+                        rng.random_range(-0.1f64..0.1).to_radians(),
+                        rng.random_range(-3.2..3.2),
+                    )
+                } else {
+                    (rng.random_range(-1.6f64..1.6), rng.random_range(-7.0..7.0))
+                };
+                let axis = m.tool_axis(tilt, rot).into_inner()
+                    + Vector3::new(
+                        rng.random_range(-1e-3..1e-3),
+                        rng.random_range(-1e-3..1e-3),
+                        rng.random_range(-1e-3..1e-3),
+                    ) * f64::from(u8::from(!pole));
+                let tip = Point3::new(
+                    rng.random_range(-80.0..80.0),
+                    rng.random_range(-80.0..80.0),
+                    rng.random_range(-20.0..80.0),
+                );
+                let Ok(cl) = CutterLocation::new(tip, axis) else {
+                    continue;
+                };
+                let reference = Joints {
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                    tilt: rng.random_range(-1.6..1.6),
+                    rotate: rng.random_range(-7.0..7.0),
+                };
+                let tl = rng.random_range(50.0..150.0);
+                let sign = rng.random_bool(0.5);
+                let keep = |t: f64| (t < 0.0) == sign && t != 0.0;
+                let lazy = m.nearest_candidate(&cl, tl, &reference, keep);
+                let full = m.inverse_candidates(&cl, tl, &reference).map(|c| {
+                    c.into_iter().filter(|j| keep(j.tilt)).min_by(|p, q| {
+                        reference
+                            .rotary_travel(p)
+                            .total_cmp(&reference.rotary_travel(q))
+                    })
+                });
+                match (lazy, full) {
+                    (Ok(a), Ok(b)) => assert_eq!(a, b, "{} {cl:?}", m.name()),
+                    (Err(_), Err(_)) => {}
+                    (a, b) => panic!("{}: {a:?} vs {b:?}", m.name()),
+                }
+                let lazy = m.inverse_best_effort(&cl, tl, Some(&reference));
+                let full = m
+                    .choose_solution(&cl, tl, &reference, |j| reference.rotary_travel(j))
+                    .map(|(best, fallback)| match (best, fallback) {
+                        (Some((_, j)), _) => Some((j, None)),
+                        (None, Some((_, j))) => {
+                            m.check_limits(&j, LIMIT_SLACK).err().map(|e| (j, Some(e)))
+                        }
+                        (None, None) => None,
+                    });
+                match (lazy, full) {
+                    (Ok(a), Ok(Some(b))) => assert_eq!(a, b, "{} {cl:?}", m.name()),
+                    (Err(_), Ok(None)) | (Err(_), Err(_)) => {}
+                    (a, b) => panic!("{}: {a:?} vs {b:?}", m.name()),
+                }
+                compared += 1;
+            }
+        }
+        assert!(compared > 10_000, "{compared}");
     }
 }

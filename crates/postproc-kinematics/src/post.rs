@@ -831,11 +831,10 @@ fn continue_sweep(
         let cl = crate::linearise::interpolate_cl(cla, clb, t);
         let j = if on_branch {
             machine
-                .inverse_candidates(&cl, tool_length, &cur)
-                .ok()?
-                .into_iter()
-                .filter(|j| (j.tilt < 0.0) == (a.tilt < 0.0) && j.tilt != 0.0)
-                .min_by(|p, q| cur.rotary_travel(p).total_cmp(&cur.rotary_travel(q)))?
+                .nearest_candidate(&cl, tool_length, &cur, |tilt| {
+                    (tilt < 0.0) == (a.tilt < 0.0) && tilt != 0.0
+                })
+                .ok()??
         } else {
             machine
                 .inverse_best_effort(&cl, tool_length, Some(&cur))
@@ -948,8 +947,13 @@ fn solve_group_optimal(
                     .map(|c| {
                         let mut best = (usize::MAX, usize::MAX, f64::INFINITY, 0usize);
                         for (k, (b, p, l, t, _)) in before.iter().enumerate() {
-                            let p =
-                                p + usize::from(c.1.is_some()) + usize::from(reconf(k, &b.0, &c.0));
+                            // A reconfiguration only adds a problem: a pair already worse
+                            // without it needs no sweep continuation.
+                            let p = p + usize::from(c.1.is_some());
+                            if p > best.0 || (p == best.0 && *l > best.1) {
+                                continue;
+                            }
+                            let p = p + usize::from(reconf(k, &b.0, &c.0));
                             let t = t + b.0.rotary_travel(&c.0);
                             if p > best.0 || (p == best.0 && *l > best.1) {
                                 continue;
