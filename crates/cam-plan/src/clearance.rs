@@ -100,7 +100,7 @@
 use crate::mesh_distance::MeshDistance;
 use crate::{PlanError, Point3, Tool, Vector3};
 use cam_core::{CutterLocation, CutterShape};
-use impeller_model::export::stl::tessellate;
+use impeller_model::export::stl::{tessellate, tessellate_compact};
 use impeller_model::query::blade_side_distance;
 use impeller_model::{BladeSet, Impeller, Side};
 use parry3d_f64::math::{Pose, Rotation, Vector as PVec};
@@ -126,6 +126,10 @@ pub const MAX_MESH_CHORD_MM: f64 = 0.05;
 /// distances of the cutter samples from below (a finer design chord is kept): a coarser mesh
 /// is cheaper to query and loosens the bounds by its chord, leaving more exact projections.
 pub const BOUND_CHORD_MM: f64 = 0.05;
+
+/// Longest grid edge (mm) of the blade-side meshes that bound the exact distances.
+pub const BOUND_MAX_EDGE_MM: f64 = MAX_EDGE_DBG;
+const MAX_EDGE_DBG: f64 = 3.0;
 
 /// Blade thickness grid (u × v samples per pressure side) for the thickest blade `t`.
 const THICKNESS_GRID: (usize, usize) = (24, 8);
@@ -401,7 +405,9 @@ impl DesignMesh {
                 let name = format!("{row:?} blade {side:?} side");
                 let sm = tessellate(blade.side(side), chord, &name).map_err(mesh_err)?;
                 clipped.add_instances(&clip_at_shroud(impeller, &sm), row, set);
-                let coarse = tessellate(blade.side(side), side_chord, &name).map_err(mesh_err)?;
+                let coarse =
+                    tessellate_compact(blade.side(side), side_chord, BOUND_MAX_EDGE_MM, &name)
+                        .map_err(mesh_err)?;
                 whole.add_instances(&coarse, row, set);
                 own.add(&coarse, row, 0, &nalgebra::Rotation3::identity());
             }

@@ -4,7 +4,9 @@
 
 mod import_common;
 
-use impeller_model::export::{mesh_parts, stl_bytes, tessellate, write_stl, ExportError, Part};
+use impeller_model::export::{
+    mesh_parts, stl_bytes, tessellate, tessellate_compact, write_stl, ExportError, Part,
+};
 use impeller_model::fixtures::default_impeller;
 use impeller_model::meridional::MeridionalCurve;
 use nalgebra::Vector3;
@@ -38,6 +40,62 @@ fn hub_triangles_within_chord_tolerance() {
     );
     // Not needlessly fine either: the deviation uses a good part of the tolerance.
     assert!(worst > 0.2 * tol, "{worst}");
+}
+
+/// With a longest edge, a blade side (ruled: its rulings are straight, so the chord alone
+/// leaves slivers as long as them) is cut into triangles whose edges keep the limit (grid
+/// edges within it, diagonals within √2 of it), on the same surface (vertices on it) and
+/// still within the chord tolerance at edge midpoints and centroids (distance to the side
+/// measured by the exact closest point); a limit that is not a positive length is an error.
+#[test]
+fn compact_tessellation_keeps_edges_and_chord() {
+    let imp = default_impeller().unwrap();
+    let side = imp.main().blade().side(impeller_model::Side::Pressure);
+    let (tol, edge) = (0.05, 2.0);
+    let plain = tessellate(side, tol, "side").unwrap();
+    let longest = |m: &impeller_model::export::TriMesh| {
+        m.triangles
+            .iter()
+            .flat_map(|t| {
+                let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+                [(a - b).norm(), (b - c).norm(), (c - a).norm()]
+            })
+            .fold(0.0f64, f64::max)
+    };
+    assert!(longest(&plain) > 2.0 * edge, "{}", longest(&plain));
+    let mesh = tessellate_compact(side, tol, edge, "side").unwrap();
+    assert!(
+        longest(&mesh) <= edge * 2f64.sqrt() + 1e-9,
+        "{}",
+        longest(&mesh)
+    );
+    let projector = nurbs::closest::SurfaceProjector::new(side);
+    let dist = |q: &Vector3<f64>| (projector.closest_point(q).point - q).norm();
+    let mut worst: f64 = 0.0;
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+        for q in [
+            (a + b + c) / 3.0,
+            (a + b) / 2.0,
+            (b + c) / 2.0,
+            (a + c) / 2.0,
+        ] {
+            worst = worst.max(dist(&q));
+        }
+    }
+    assert!(
+        worst <= tol,
+        "largest chord deviation {worst} mm > {tol} mm"
+    );
+    for v in mesh.vertices.iter().step_by(7) {
+        assert!(dist(v) < 1e-7, "{}", dist(v));
+    }
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            tessellate_compact(side, tol, bad, "side"),
+            Err(ExportError::Invalid { .. })
+        ));
+    }
 }
 
 #[test]

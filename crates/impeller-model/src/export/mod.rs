@@ -9,4 +9,6 @@ pub mod stl;
 pub use atomic::write_atomic;
 pub use curves::{write_curves, CurveFiles, CurveSampling};
 pub use error::ExportError;
-pub use stl::{mesh_parts, stl_bytes, tessellate, write_stl, Part, StlStats, TriMesh};
+pub use stl::{
+    mesh_parts, stl_bytes, tessellate, tessellate_compact, write_stl, Part, StlStats, TriMesh,
+};

@@ -97,12 +97,45 @@ fn refine(breaks: &mut Vec<f64>, fails: impl Fn(f64, f64) -> bool) -> bool {
 
 /// Triangulates a surface within `chord_tol` (see the module docs).
 pub fn tessellate(s: &NurbsSurface, chord_tol: f64, name: &str) -> Result<TriMesh, ExportError> {
+    tessellate_grid(s, chord_tol, f64::INFINITY, name)
+}
+
+/// [`tessellate`] with every grid edge also at most `max_edge` mm long (intervals are
+/// halved until the 3-D distance between neighbouring grid points along every grid line is
+/// within it; a triangle's diagonal is then at most `√2·max_edge`). A surface nearly straight
+/// in one direction (a ruled blade side along its rulings) otherwise gives slivers as long as
+/// the rulings, whose bounding boxes make nearest-point searches in a bounding volume
+/// hierarchy test many of them; compact triangles keep those searches short.
+pub fn tessellate_compact(
+    s: &NurbsSurface,
+    chord_tol: f64,
+    max_edge: f64,
+    name: &str,
+) -> Result<TriMesh, ExportError> {
+    if !(max_edge.is_finite() && max_edge > 0.0) {
+        return Err(ExportError::Invalid {
+            field: "max_edge_mm",
+            reason: format!("{max_edge} is not a positive length"),
+        });
+    }
+    tessellate_grid(s, chord_tol, max_edge, name)
+}
+
+fn tessellate_grid(
+    s: &NurbsSurface,
+    chord_tol: f64,
+    max_edge: f64,
+    name: &str,
+) -> Result<TriMesh, ExportError> {
     if !(chord_tol.is_finite() && chord_tol > 0.0) {
         return Err(ExportError::Invalid {
             field: "chord_tol_mm",
             reason: format!("{chord_tol} is not a positive length"),
         });
     }
+    let long = |a: (f64, f64), b: (f64, f64)| {
+        max_edge.is_finite() && (s.point(a.0, a.1) - s.point(b.0, b.1)).norm() > max_edge
+    };
     let ((u0, u1), (v0, v1)) = s.domain();
     // Start from the knot breaks so every polynomial piece is sampled.
     let start = |knots: &[f64], a: f64, b: f64| {
@@ -131,12 +164,12 @@ pub fn tessellate(s: &NurbsSurface, chord_tol: f64, name: &str) -> Result<TriMes
         let a = refine(&mut us, |lo, hi| {
             vs_now
                 .iter()
-                .any(|&v| mid_dev(s, (lo, v), (hi, v)) > chord_tol)
+                .any(|&v| mid_dev(s, (lo, v), (hi, v)) > chord_tol || long((lo, v), (hi, v)))
         });
         let b = refine(&mut vs, |lo, hi| {
             us_now
                 .iter()
-                .any(|&u| mid_dev(s, (u, lo), (u, hi)) > chord_tol)
+                .any(|&u| mid_dev(s, (u, lo), (u, hi)) > chord_tol || long((u, lo), (u, hi)))
         });
         if a || b {
             continue;
