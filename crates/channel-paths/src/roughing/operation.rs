@@ -80,7 +80,12 @@
 //! blades' offset sides from inlet to outlet, as many as the channel's widest section needs,
 //! kept where they run inside a planned lane, [`plan2d::clip_to_regions`]; with a splitter
 //! it differs from the per-lane baseline both ways: denser upstream of the splitter, none
-//! where a path runs into the splitter or an unmachinable strip),
+//! where a path runs into the splitter or an unmachinable strip), `saving_ratio_width_bound`
+//! (what the lanes' shape allows: paths at a constant interval `d` are as many at a section as
+//! its width `w(s)` needs, `∫ w ds / d` in length, while the baseline runs `w_max / d` paths
+//! the whole length `L` of the lane, so no such path set saves more than
+//! `1 − Σ ∫ w ds / Σ w_max·L` over the lanes, up to the rounding of path counts and the
+//! paths' slant; a lane that narrows little toward the inlet leaves little to save),
 //! `max_scallop_mm` (measured over the machinable region: rays along the level normal from a
 //! grid of points of every lane to the first cutter position of the level, the cutters taken
 //! at the emitted locations of every lane of the level densified to a sixteenth of the ball
@@ -687,6 +692,17 @@ impl ChannelRoughing {
         let mut bridged = 0usize;
         let area_mm2: f64 = levels.iter().map(|l| l.area_mm2).sum();
         let planned_mm2: f64 = levels.iter().map(|l| l.planned_mm2).sum();
+        // The most any paths spaced like the triangle paths can save against the lanes'
+        // isoparametric baseline (module docs): Σ ∫w ds over Σ w_max·L of every lane.
+        let (width_area, box_area) = levels
+            .iter()
+            .flat_map(|l| &l.areas)
+            .map(|a| {
+                let r = &a.region;
+                let len = r.s.last().zip(r.s.first()).map_or(0.0, |(b, a)| b - a);
+                (r.width_integral(), r.max_width().max(0.0) * len)
+            })
+            .fold((0.0, 0.0), |(x, y), (a, b)| (x + a, y + b));
         for lc in &per_level {
             tri_len += lc.tri_len;
             iso_len += lc.iso_len;
@@ -724,6 +740,7 @@ impl ChannelRoughing {
                 "saving_ratio_whole_channel",
                 saving(tri_len, channel_iso_len),
             )
+            .number("saving_ratio_width_bound", saving(width_area, box_area))
             .number("max_scallop_mm", max_scallop)
             .number("scallop_target_mm", self.params.scallop_mm)
             .count("scallop_replanned_levels", replanned_levels)
