@@ -363,37 +363,52 @@ impl Machine {
         tool_length: f64,
         reference: &Joints,
     ) -> Result<Vec<Joints>, KinematicsError> {
-        let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
-        let tilt_spec = self.axis(AxisId::Tilt);
-        let rot_spec = self.axis(AxisId::Rotate);
         let mut out = Vec::new();
-        for (t, c) in sols {
-            let (t0, _) = equivalent_angle(t, tilt_spec, reference.tilt);
-            let (c0, _) = equivalent_angle(c, rot_spec, reference.rotate);
-            for dt in [-TAU, 0.0, TAU] {
-                for dc in [-TAU, 0.0, TAU] {
-                    let (tt, cc) = (t0 + dt, c0 + dc);
-                    if !tilt_spec.contains(tt, LIMIT_SLACK) || !rot_spec.contains(cc, LIMIT_SLACK) {
-                        continue;
-                    }
-                    if matches!(tilt_spec.mode, RotaryMode::Continuous) && dt != 0.0 {
-                        continue;
-                    }
-                    if matches!(rot_spec.mode, RotaryMode::Continuous) && dc != 0.0 {
-                        continue;
-                    }
-                    let j = self.joints_for_angles(&cl.tip, tool_length, tt, cc);
-                    if self.check_limits(&j, LIMIT_SLACK).is_ok()
-                        && !out.iter().any(|o: &Joints| {
-                            (o.tilt - tt).abs() < 1e-12 && (o.rotate - cc).abs() < 1e-12
-                        })
-                    {
-                        out.push(j);
-                    }
-                }
+        for (tt, cc) in self.candidate_angles(cl, reference)? {
+            let j = self.joints_for_angles(&cl.tip, tool_length, tt, cc);
+            if self.check_limits(&j, LIMIT_SLACK).is_ok()
+                && !out
+                    .iter()
+                    .any(|o: &Joints| (o.tilt - tt).abs() < 1e-12 && (o.rotate - cc).abs() < 1e-12)
+            {
+                out.push(j);
             }
         }
         Ok(out)
+    }
+
+    /// The rotary angles `(tilt, rotate)` of [`Self::inverse_candidates`], in its order,
+    /// before the linear axes are computed: for both tilt signs, the 2π-equivalents next to
+    /// the ones nearest `reference` that lie within the rotary limits (a continuous axis keeps
+    /// the nearest one only).
+    fn candidate_angles(
+        &self,
+        cl: &CutterLocation,
+        reference: &Joints,
+    ) -> Result<impl Iterator<Item = (f64, f64)> + '_, KinematicsError> {
+        let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
+        let tilt_spec = self.axis(AxisId::Tilt);
+        let rot_spec = self.axis(AxisId::Rotate);
+        let shifts = |spec: &AxisSpec| -> &'static [f64] {
+            if matches!(spec.mode, RotaryMode::Continuous) {
+                &[0.0]
+            } else {
+                &[-TAU, 0.0, TAU]
+            }
+        };
+        let (t_shifts, c_shifts) = (shifts(tilt_spec), shifts(rot_spec));
+        let (ref_t, ref_c) = (reference.tilt, reference.rotate);
+        Ok(sols.into_iter().flat_map(move |(t, c)| {
+            let (t0, _) = equivalent_angle(t, tilt_spec, ref_t);
+            let (c0, _) = equivalent_angle(c, rot_spec, ref_c);
+            t_shifts.iter().flat_map(move |&dt| {
+                c_shifts.iter().filter_map(move |&dc| {
+                    let (tt, cc) = (t0 + dt, c0 + dc);
+                    (tilt_spec.contains(tt, LIMIT_SLACK) && rot_spec.contains(cc, LIMIT_SLACK))
+                        .then_some((tt, cc))
+                })
+            })
+        }))
     }
 
     /// The posture nearest `reference` (least rotary travel `|ΔT| + |ΔC|`, the first of equal
@@ -408,52 +423,33 @@ impl Machine {
         reference: &Joints,
         keep: impl Fn(f64) -> bool,
     ) -> Result<Option<Joints>, KinematicsError> {
-        let sols = self.rotary_solutions(&cl.axis, reference.rotate)?;
-        let tilt_spec = self.axis(AxisId::Tilt);
-        let rot_spec = self.axis(AxisId::Rotate);
         let mut best: Option<(f64, Joints)> = None;
         // Angles of the candidates within the limits so far (the list's duplicates are
         // dropped as in `inverse_candidates`).
         let mut seen = [(0.0f64, 0.0f64); 18];
         let mut n_seen = 0;
-        for (t, c) in sols {
-            let (t0, _) = equivalent_angle(t, tilt_spec, reference.tilt);
-            let (c0, _) = equivalent_angle(c, rot_spec, reference.rotate);
-            for dt in [-TAU, 0.0, TAU] {
-                for dc in [-TAU, 0.0, TAU] {
-                    let (tt, cc) = (t0 + dt, c0 + dc);
-                    if !tilt_spec.contains(tt, LIMIT_SLACK) || !rot_spec.contains(cc, LIMIT_SLACK) {
-                        continue;
-                    }
-                    if matches!(tilt_spec.mode, RotaryMode::Continuous) && dt != 0.0 {
-                        continue;
-                    }
-                    if matches!(rot_spec.mode, RotaryMode::Continuous) && dc != 0.0 {
-                        continue;
-                    }
-                    if seen[..n_seen]
-                        .iter()
-                        .any(|&(st, sc)| (st - tt).abs() < 1e-12 && (sc - cc).abs() < 1e-12)
-                    {
-                        continue;
-                    }
-                    let travel = (tt - reference.tilt).abs() + (cc - reference.rotate).abs();
-                    let improves = best.is_none_or(|(b, _)| travel < b);
-                    if !(keep(tt) && improves) {
-                        // Not chosen; whether it lies within the linear limits (and so
-                        // shadows a later duplicate) only matters for an equal angle pair,
-                        // which would not improve either.
-                        continue;
-                    }
-                    let j = self.joints_for_angles(&cl.tip, tool_length, tt, cc);
-                    if self.check_limits(&j, LIMIT_SLACK).is_ok() {
-                        if n_seen < seen.len() {
-                            seen[n_seen] = (tt, cc);
-                            n_seen += 1;
-                        }
-                        best = Some((travel, j));
-                    }
+        for (tt, cc) in self.candidate_angles(cl, reference)? {
+            if seen[..n_seen]
+                .iter()
+                .any(|&(st, sc)| (st - tt).abs() < 1e-12 && (sc - cc).abs() < 1e-12)
+            {
+                continue;
+            }
+            let travel = (tt - reference.tilt).abs() + (cc - reference.rotate).abs();
+            let improves = best.is_none_or(|(b, _)| travel < b);
+            if !(keep(tt) && improves) {
+                // Not chosen; whether it lies within the linear limits (and so shadows a
+                // later duplicate) only matters for an equal angle pair, which would not
+                // improve either.
+                continue;
+            }
+            let j = self.joints_for_angles(&cl.tip, tool_length, tt, cc);
+            if self.check_limits(&j, LIMIT_SLACK).is_ok() {
+                if n_seen < seen.len() {
+                    seen[n_seen] = (tt, cc);
+                    n_seen += 1;
                 }
+                best = Some((travel, j));
             }
         }
         Ok(best.map(|(_, j)| j))
