@@ -11,14 +11,12 @@ use impeller_model::fixtures::default_impeller;
 use impeller_model::meridional::MeridionalCurve;
 use nalgebra::Vector3;
 
-/// Every triangle's centroid and edge midpoints lie within the chord tolerance of the hub, a
-/// surface of revolution whose distance is known exactly through its meridional contour.
-#[test]
-fn hub_triangles_within_chord_tolerance() {
-    let imp = default_impeller().unwrap();
-    let tol = 0.02;
-    let mesh = tessellate(imp.hub().surface(), tol, "hub").unwrap();
-    let m = imp.hub().meridional();
+/// The largest distance `dist` of a triangle's centroid or edge midpoint from the surface:
+/// where the chord check of the tessellation samples.
+fn largest_chord_deviation(
+    mesh: &impeller_model::export::TriMesh,
+    dist: impl Fn(&Vector3<f64>) -> f64,
+) -> f64 {
     let mut worst: f64 = 0.0;
     for t in &mesh.triangles {
         let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
@@ -28,9 +26,21 @@ fn hub_triangles_within_chord_tolerance() {
             (b + c) / 2.0,
             (a + c) / 2.0,
         ] {
-            worst = worst.max(m.closest(MeridionalCurve::zr_of(&q)).1.abs());
+            worst = worst.max(dist(&q));
         }
     }
+    worst
+}
+
+/// Every triangle's centroid and edge midpoints lie within the chord tolerance of the hub, a
+/// surface of revolution whose distance is known exactly through its meridional contour.
+#[test]
+fn hub_triangles_within_chord_tolerance() {
+    let imp = default_impeller().unwrap();
+    let tol = 0.02;
+    let mesh = tessellate(imp.hub().surface(), tol, "hub").unwrap();
+    let m = imp.hub().meridional();
+    let worst = largest_chord_deviation(&mesh, |q| m.closest(MeridionalCurve::zr_of(q)).1.abs());
     for v in &mesh.vertices {
         assert!(m.closest(MeridionalCurve::zr_of(v)).1.abs() < 1e-9);
     }
@@ -71,18 +81,7 @@ fn compact_tessellation_keeps_edges_and_chord() {
     );
     let projector = nurbs::closest::SurfaceProjector::new(side);
     let dist = |q: &Vector3<f64>| (projector.closest_point(q).point - q).norm();
-    let mut worst: f64 = 0.0;
-    for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
-        for q in [
-            (a + b + c) / 3.0,
-            (a + b) / 2.0,
-            (b + c) / 2.0,
-            (a + c) / 2.0,
-        ] {
-            worst = worst.max(dist(&q));
-        }
-    }
+    let worst = largest_chord_deviation(&mesh, dist);
     assert!(
         worst <= tol,
         "largest chord deviation {worst} mm > {tol} mm"
