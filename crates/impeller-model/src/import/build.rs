@@ -11,6 +11,7 @@ use super::geomturbo::read_geomturbo;
 use super::prepare::prepare;
 use super::raw::{BladeRole, LengthUnit, RawImpeller};
 use super::rtzt::read_rtzt;
+use super::tables::{read_tables, TableOptions};
 use super::turbogrid::read_turbogrid;
 use crate::blade::{Blade, BladeKind, BladeSet};
 use crate::impeller::Impeller;
@@ -37,6 +38,9 @@ pub struct ImportOptions {
     pub name: Option<String>,
     /// Length unit of `rtzt` files (the format has none).
     pub rtzt_unit: LengthUnit,
+    /// Unit, blade counts and contour files of a folder of section tables (the tables state
+    /// none of them).
+    pub tables: TableOptions,
 }
 
 impl Default for ImportOptions {
@@ -49,6 +53,7 @@ impl Default for ImportOptions {
             stock_margin_mm: 2.0,
             name: None,
             rtzt_unit: LengthUnit::Millimetre,
+            tables: TableOptions::default(),
         }
     }
 }
@@ -73,6 +78,15 @@ pub fn is_import_extension(path: &Path) -> bool {
             .as_deref(),
         Some("inf" | "geomturbo" | "rtzt")
     )
+}
+
+/// Reads an export into raw point data: a folder is read as section tables with
+/// `opts.tables`, a file by its extension (see [`is_import_extension`]).
+pub fn read_raw_with(path: &Path, opts: &ImportOptions) -> Result<RawImpeller, ImportError> {
+    if path.is_dir() {
+        return read_tables(path, &opts.tables);
+    }
+    read_raw(path, opts.rtzt_unit)
 }
 
 /// Reads an export into raw point data, choosing the reader by extension (see
@@ -256,7 +270,8 @@ pub fn import_raw(raw: &RawImpeller, opts: &ImportOptions) -> Result<Imported, I
     Ok(Imported { impeller, fitted })
 }
 
-/// Reads an export file (by extension) and turns it into an impeller.
+/// Reads an export file (by extension) or a folder of section tables and turns it into an
+/// impeller.
 pub fn import_file(path: &Path, opts: &ImportOptions) -> Result<Imported, ImportError> {
-    import_raw(&read_raw(path, opts.rtzt_unit)?, opts)
+    import_raw(&read_raw_with(path, opts)?, opts)
 }

@@ -1,9 +1,10 @@
 //! Importers of blade-design exports: TurboGrid curve sets, NUMECA AutoGrid `.geomTurbo`, and
-//! BladeGen `rtzt` meanline files, turned into an exact [`crate::Impeller`].
+//! BladeGen `rtzt` meanline files, and folders of section tables (the NASA HECC archive),
+//! turned into an exact [`crate::Impeller`].
 //!
 //! The pipeline, one module per step:
 //!
-//! 1. **Parse** ([`turbogrid`], [`geomturbo`], [`rtzt`]) into a [`RawImpeller`]: point data
+//! 1. **Parse** ([`turbogrid`], [`geomturbo`], [`rtzt`], [`tables`]) into a [`RawImpeller`]: point data
 //!    in millimetres with the rotation axis along +Z, in the file's axial sense. Every
 //!    malformed file is an [`ImportError`] naming the file, the line and what was expected
 //!    there (CRLF and LF files alike; non-finite numbers rejected).
@@ -21,8 +22,8 @@
 //! [`import_file`] runs all four by file extension; [`spec`] reads TOML files that point at an
 //! export (`[import] file = ...`), which [`crate::load`] dispatches to. Achieved on the real
 //! exports in `../shared/data`: Rotor 37 (36 blades, cm), the 12 + 12 centrifugal impeller
-//! (metres) and the NASA HECC 15 + 15 impeller (inches, written as a `.geomTurbo` by the
-//! test `import_all_real`) all import at the default tolerance; Rotor 37 and the 12 + 12
+//! (metres) and the NASA HECC 15 + 15 impeller (inches, its archive tables read in place by
+//! [`tables`]) all import at the default tolerance; Rotor 37 and the 12 + 12
 //! impeller also within 0.001 mm.
 //!
 //! No new dependency: parsing is hand-written over lines (the formats are line-oriented and
@@ -36,12 +37,13 @@ pub mod prepare;
 pub mod raw;
 pub mod rtzt;
 pub mod spec;
+pub mod tables;
 mod text;
 pub mod turbogrid;
 
 pub use build::{
     assemble, check_tolerance, import_file, import_raw, is_import_extension, read_raw,
-    ImportOptions, Imported,
+    read_raw_with, ImportOptions, Imported,
 };
 pub use error::ImportError;
 pub use fit::{fit, DataMiss, FittedBlade, FittedImpeller, DEFAULT_FIT_TOL_MM};
@@ -53,4 +55,5 @@ pub use raw::{
 };
 pub use rtzt::{parse_rtzt, read_rtzt};
 pub use spec::{from_import_toml, from_import_toml_with, is_import_toml, ImportSpec};
+pub use tables::{read_tables, TableOptions, ThetaSense};
 pub use turbogrid::{read_turbogrid, turbogrid_from_bytes, TurboGridInf};

@@ -68,6 +68,8 @@ pub enum SourceFormat {
     GeomTurbo,
     /// BladeGen meanline `rtzt` file.
     Rtzt,
+    /// A folder of section tables (hub and shroud `x r`, blade sections `X R·θ R`).
+    SectionTables,
 }
 
 /// Main blade or splitter.

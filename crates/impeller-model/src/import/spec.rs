@@ -13,6 +13,20 @@
 //! rtzt_unit = "mm"         # length unit of .rtzt files (MM, CM, M, IN, FT, UM)
 //! ```
 //!
+//! A folder of section tables ([`super::tables`]) is imported when `file` names a folder; the
+//! tables state neither unit nor blade counts, so the file gives them:
+//!
+//! ```toml
+//! [import]
+//! file = "../shared/data/nasa-hecc"
+//! table_unit = "IN"        # required for a folder
+//! blade_count = 15         # required for a folder: main blades
+//! splitter_count = 15      # default: blade_count, when splitter sections are present
+//! hub_file = "…"           # optional: the hub `x r` table (default: the folder's *hub* file)
+//! shroud_file = "…"        # optional, likewise (resolved like `file`)
+//! theta_sense = "counter_clockwise_looking_aft"   # or "clockwise_looking_aft"
+//! ```
+//!
 //! `file` is resolved against this file's folder and then against each folder above it, so a
 //! path written relative to the repository root (`../shared/data/...`) also works from a
 //! fixture folder, in the main checkout and in nested worktrees alike. The reader is chosen
@@ -21,6 +35,7 @@
 use super::build::{import_file, ImportOptions, Imported};
 use super::error::ImportError;
 use super::raw::LengthUnit;
+use super::tables::{TableOptions, ThetaSense};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -51,6 +66,24 @@ pub struct ImportSection {
     /// Length unit of `.rtzt` files.
     #[serde(default)]
     pub rtzt_unit: Option<String>,
+    /// Length unit of a folder of section tables.
+    #[serde(default)]
+    pub table_unit: Option<String>,
+    /// Main blade count of a folder of section tables.
+    #[serde(default)]
+    pub blade_count: Option<usize>,
+    /// Splitter count of a folder of section tables.
+    #[serde(default)]
+    pub splitter_count: Option<usize>,
+    /// Hub contour table of a folder of section tables.
+    #[serde(default)]
+    pub hub_file: Option<PathBuf>,
+    /// Shroud contour table of a folder of section tables.
+    #[serde(default)]
+    pub shroud_file: Option<PathBuf>,
+    /// Sense of θ of a folder of section tables.
+    #[serde(default)]
+    pub theta_sense: Option<String>,
 }
 
 /// A whole import file.
@@ -107,14 +140,60 @@ impl ImportSpec {
     pub fn options(&self, text: &str, path: &Path) -> Result<ImportOptions, ImportError> {
         let d = ImportOptions::default();
         let s = &self.import;
+        let bad = |key: &str, reason: String| ImportError::Invalid {
+            file: path.to_path_buf(),
+            line: super::super::params::field_line(text, &format!("import.{key}")),
+            field: format!("import.{key}"),
+            reason,
+        };
+        let unit = |key: &str, u: &str| {
+            LengthUnit::from_name(u)
+                .ok_or_else(|| bad(key, format!("{u:?} is not one of MM, CM, M, IN, FT, UM")))
+        };
         let rtzt_unit = match &s.rtzt_unit {
             None => d.rtzt_unit,
-            Some(u) => LengthUnit::from_name(u).ok_or_else(|| ImportError::Invalid {
-                file: path.to_path_buf(),
-                line: super::super::params::field_line(text, "import.rtzt_unit"),
-                field: "import.rtzt_unit".into(),
-                reason: format!("{u:?} is not one of MM, CM, M, IN, FT, UM"),
-            })?,
+            Some(u) => unit("rtzt_unit", u)?,
+        };
+        let base = path.parent().unwrap_or(Path::new("."));
+        let table_file = |key: &str, f: &Option<PathBuf>| -> Result<Option<PathBuf>, ImportError> {
+            match f {
+                None => Ok(None),
+                Some(f) => resolve(base, f).map(Some).ok_or_else(|| {
+                    bad(
+                        key,
+                        format!(
+                            "{} not found relative to {} or any folder above it",
+                            f.display(),
+                            base.display()
+                        ),
+                    )
+                }),
+            }
+        };
+        let theta_sense = match s.theta_sense.as_deref() {
+            None | Some("counter_clockwise_looking_aft") => ThetaSense::CounterClockwiseLookingAft,
+            Some("clockwise_looking_aft") => ThetaSense::ClockwiseLookingAft,
+            Some(other) => {
+                return Err(bad(
+                    "theta_sense",
+                    format!(
+                        "{other:?} is not \"counter_clockwise_looking_aft\" or \
+                         \"clockwise_looking_aft\""
+                    ),
+                ))
+            }
+        };
+        let tables = TableOptions {
+            unit: s
+                .table_unit
+                .as_deref()
+                .map(|u| unit("table_unit", u))
+                .transpose()?,
+            blade_count: s.blade_count,
+            splitter_count: s.splitter_count,
+            hub_file: table_file("hub_file", &s.hub_file)?,
+            shroud_file: table_file("shroud_file", &s.shroud_file)?,
+            theta_sense,
         };
         Ok(ImportOptions {
             fit_tol_mm: s.fit_tol_mm.unwrap_or(d.fit_tol_mm),
@@ -128,6 +207,7 @@ impl ImportSpec {
             stock_margin_mm: s.stock_margin_mm.unwrap_or(d.stock_margin_mm),
             name: self.name.clone(),
             rtzt_unit,
+            tables,
         })
     }
 }
@@ -161,5 +241,28 @@ pub fn from_import_toml_with(
             base.display()
         ),
     })?;
+    if !file.is_dir() {
+        let s = &spec.import;
+        let table_keys = [
+            ("table_unit", s.table_unit.is_some()),
+            ("blade_count", s.blade_count.is_some()),
+            ("splitter_count", s.splitter_count.is_some()),
+            ("hub_file", s.hub_file.is_some()),
+            ("shroud_file", s.shroud_file.is_some()),
+            ("theta_sense", s.theta_sense.is_some()),
+        ];
+        if let Some((key, _)) = table_keys.iter().find(|(_, set)| *set) {
+            return Err(ImportError::Invalid {
+                file: path.to_path_buf(),
+                line: super::super::params::field_line(text, &format!("import.{key}")),
+                field: format!("import.{key}"),
+                reason: format!(
+                    "only a folder of section tables takes it; {} is a file whose format \
+                     states it",
+                    file.display()
+                ),
+            });
+        }
+    }
     import_file(&file, &opts)
 }
