@@ -45,7 +45,9 @@ pub use clearance::{
 pub use error::PlanError;
 pub use linking::{LinkCheck, LinkStats, Linker, SafetySurface};
 pub use metrics::{MetricValue, Metrics, Plot, PlotKind, PlotSeries};
-pub use operation::{Builder, Operation, OperationSpec, PlanContext, PlannedOperation};
+pub use operation::{
+    Builder, Operation, OperationSpec, PlanContext, PlannedOperation, PlannedStep, StepTool,
+};
 pub use process::Process;
 pub use tool::Tool;
 

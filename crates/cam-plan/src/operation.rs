@@ -105,6 +105,52 @@ pub trait Operation: std::fmt::Debug + Send + Sync {
     fn tool(&self) -> &str;
     /// Plans the operation.
     fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError>;
+
+    /// Further tools of the job the operation plans steps of its own with (a pilot drill
+    /// before plunge roughing), with the keys that name them. Default: none.
+    fn step_tools(&self) -> Vec<StepTool> {
+        Vec::new()
+    }
+
+    /// Plans the operation and the steps it machines with the further tools `tools` (the
+    /// job's tools named by [`Operation::step_tools`], in that order). The pipeline posts
+    /// every step as its own operation (own tool change, feeds, report row), before or after
+    /// the operation as [`PlannedStep::before`] says. Default: [`Operation::plan`], no step.
+    fn plan_with_steps(
+        &self,
+        ctx: &PlanContext<'_>,
+        tools: &[&Tool],
+    ) -> Result<(PlannedOperation, Vec<PlannedStep>), PlanError> {
+        let _ = tools;
+        Ok((self.plan(ctx)?, Vec::new()))
+    }
+}
+
+/// A further tool of the job an operation plans a step with ([`Operation::step_tools`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StepTool {
+    /// The operation's (dotted) key that names the tool, for error locations.
+    pub key: String,
+    /// The tool's name in the job.
+    pub tool: String,
+}
+
+/// A step an operation plans with a further tool of the job ([`Operation::plan_with_steps`]):
+/// posted as its own operation.
+#[derive(Debug, Clone)]
+pub struct PlannedStep {
+    /// Its name in the job's report (unique: usually the operation's name with a suffix).
+    pub name: String,
+    /// Its kind name in the report (e.g. `pilot_drilling`).
+    pub kind: String,
+    /// The tool it runs with (one of the operation's [`StepTool`]s).
+    pub tool: String,
+    /// Its process row (spindle speed, feeds; allowances as the operation's).
+    pub process: Process,
+    /// Machined before the operation (`true`) or after it.
+    pub before: bool,
+    /// Its paths (each from and back to the safety surface), metrics, plots and notes.
+    pub planned: PlannedOperation,
 }
 
 /// One `[[operations]]` table of a job: the common keys, the process row and the kind's own

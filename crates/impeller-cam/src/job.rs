@@ -916,7 +916,26 @@ impl Job {
                 _ => at(path, here("name"), &key("name"), &e),
             };
             spec.process.validate(&spec.name).map_err(located)?;
-            registry::build(registry, &spec).map_err(located)?;
+            let built = registry::build(registry, &spec).map_err(located)?;
+            // Further tools the operation plans steps with (a pilot drill) are job tools.
+            for st in built.step_tools() {
+                if !tools.iter().any(|t| t.name() == st.tool) {
+                    let names: Vec<&str> = tools.iter().map(Tool::name).collect();
+                    return Err(located(PlanError::param(
+                        &spec.name,
+                        &st.key,
+                        format!(
+                            "unknown tool \"{}\" (tools: {})",
+                            st.tool,
+                            if names.is_empty() {
+                                "none".into()
+                            } else {
+                                names.join(", ")
+                            }
+                        ),
+                    )));
+                }
+            }
             operations.push(spec);
         }
 

@@ -345,7 +345,7 @@ pub fn plan(
         Some(design_mesh(job, impeller)?)
     };
     let progress = Progress::new(job.quiet);
-    let planned: Vec<Result<JobOperation, CliError>> = job
+    let planned: Vec<Result<Vec<JobOperation>, CliError>> = job
         .operations
         .par_iter()
         .enumerate()
@@ -359,13 +359,27 @@ pub fn plan(
                 ))
             })?;
             let op = registry::build(registry, spec).map_err(fail)?;
+            // Further tools the operation plans steps with (a pilot drill).
+            let step_tools: Vec<&Tool> = op
+                .step_tools()
+                .iter()
+                .map(|st| {
+                    job.tool(&st.tool).ok_or_else(|| {
+                        fail(PlanError::param(
+                            &spec.name,
+                            &st.key,
+                            format!("\"{}\" is not a tool of the job", st.tool),
+                        ))
+                    })
+                })
+                .collect::<Result<_, _>>()?;
             let t = Instant::now();
             let task = progress.task(format!("planning {} ({})", spec.name, spec.kind));
             let mesh = mesh
                 .clone()
                 .ok_or_else(|| fail(PlanError::geometry(&spec.name, "design mesh", "not built")))?;
             let clearance =
-                DesignClearance::with_mesh(impeller, mesh, tool, clearance_options(job))
+                DesignClearance::with_mesh(impeller, mesh.clone(), tool, clearance_options(job))
                     .map_err(|e| fail(rename(e, &spec.name)))?;
             let links = LinkStats::default();
             let ctx = PlanContext {
@@ -378,59 +392,64 @@ pub fn plan(
                 linker: &linker,
                 links: &links,
             };
-            let mut planned = op.plan(&ctx).map_err(fail)?;
-            let mut path = linker
-                .join_checked(
-                    &spec.name,
-                    tool.name(),
-                    &planned.paths,
-                    LINK_APPROACH_MM,
-                    &ctx.link_check(),
-                )
-                .map_err(|e| fail(rename(e, &spec.name)))?;
-            let (uncertified, turned) = (links.uncertified(), links.turned());
-            planned
-                .metrics
-                .number("uncertified_links", uncertified as f64)
-                .number("links_off_axis", turned as f64);
-            if uncertified > 0 {
-                planned.notes.push(format!(
-                    "{uncertified} retract(s)/approach(es) could not be certified clear of the \
-                     design in any direction tried; they follow the tool axis (see the \
-                     verification)"
-                ));
-            }
-            let rates = ctx.rates();
-            set_feeds(&mut path, &rates);
+            let (planned, steps) = op.plan_with_steps(&ctx, &step_tools).map_err(fail)?;
+            let mut main =
+                job_operation(&ctx, spec.name.as_str(), &spec.kind, planned).map_err(fail)?;
             let plan_ms = ms(t);
+            main.plan_ms = plan_ms;
             task.done(format!(
                 "planned {} ({}): {} moves in {:.1} s",
                 spec.name,
                 spec.kind,
-                path.moves.len(),
+                main.cl.path.moves.len(),
                 plan_ms / 1e3
             ));
-            let mut cl = ClOperation::new(path);
-            cl.tool_number = Some(tool.number);
-            cl.cutter = Some(tool.cutter.clone());
-            cl.tool_length_mm = Some(tool.tool_length_mm);
-            cl.spindle = Some(Spindle {
-                rpm: spec.process.spindle_rpm,
-                clockwise: true,
-            });
-            cl.comments = planned.notes.clone();
-            Ok(JobOperation {
-                cl,
-                kind: spec.kind.clone(),
-                tool: Some(tool.clone()),
-                rates,
-                plan_ms,
-                metrics: planned.metrics,
-                plots: planned.plots,
-            })
+            // Each step is its own operation with its own tool: linked, checked and fed
+            // with that tool, machined before or after the operation.
+            let (mut before, mut after) = (Vec::new(), Vec::new());
+            for step in steps {
+                let step_tool = job.tool(&step.tool).ok_or_else(|| {
+                    fail(PlanError::tool(
+                        &step.name,
+                        &step.tool,
+                        "a step's tool must be one of the job's tools",
+                    ))
+                })?;
+                let clearance = DesignClearance::with_mesh(
+                    impeller,
+                    mesh.clone(),
+                    step_tool,
+                    clearance_options(job),
+                )
+                .map_err(|e| fail(rename(e, &step.name)))?;
+                let links = LinkStats::default();
+                let step_ctx = PlanContext {
+                    tool: step_tool,
+                    process: &step.process,
+                    clearance: &clearance,
+                    links: &links,
+                    ..ctx
+                };
+                // Planned with the operation: its planning time is the operation's.
+                let op =
+                    job_operation(&step_ctx, &step.name, &step.kind, step.planned).map_err(fail)?;
+                if step.before {
+                    before.push(op);
+                } else {
+                    after.push(op);
+                }
+            }
+            before.push(main);
+            before.extend(after);
+            Ok(before)
         })
         .collect();
-    let mut operations = planned.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let mut operations: Vec<JobOperation> = planned
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .flatten()
+        .collect();
     for op in &operations {
         for n in &op.cl.comments {
             notes.push(format!("{}: {n}", op.cl.path.name));
@@ -467,6 +486,61 @@ pub fn plan(
         }
     }
     Ok(operations)
+}
+
+/// The CL operation of `planned` (an operation or one of its steps) in `ctx`: its paths
+/// linked over the safety surface with the checked retracts and approaches of `ctx`'s tool,
+/// the link counts as metrics, the process row's feeds, tool and spindle (`plan_ms` 0, for
+/// the caller to set).
+fn job_operation(
+    ctx: &PlanContext<'_>,
+    name: &str,
+    kind: &str,
+    mut planned: cam_plan::PlannedOperation,
+) -> Result<JobOperation, PlanError> {
+    let tool = ctx.tool;
+    let mut path = ctx
+        .linker
+        .join_checked(
+            name,
+            tool.name(),
+            &planned.paths,
+            LINK_APPROACH_MM,
+            &ctx.link_check(),
+        )
+        .map_err(|e| rename(e, name))?;
+    let (uncertified, turned) = (ctx.links.uncertified(), ctx.links.turned());
+    planned
+        .metrics
+        .number("uncertified_links", uncertified as f64)
+        .number("links_off_axis", turned as f64);
+    if uncertified > 0 {
+        planned.notes.push(format!(
+            "{uncertified} retract(s)/approach(es) could not be certified clear of the \
+             design in any direction tried; they follow the tool axis (see the \
+             verification)"
+        ));
+    }
+    let rates = ctx.rates();
+    set_feeds(&mut path, &rates);
+    let mut cl = ClOperation::new(path);
+    cl.tool_number = Some(tool.number);
+    cl.cutter = Some(tool.cutter.clone());
+    cl.tool_length_mm = Some(tool.tool_length_mm);
+    cl.spindle = Some(Spindle {
+        rpm: ctx.process.spindle_rpm,
+        clockwise: true,
+    });
+    cl.comments = planned.notes.clone();
+    Ok(JobOperation {
+        cl,
+        kind: kind.to_string(),
+        tool: Some(tool.clone()),
+        rates,
+        plan_ms: 0.0,
+        metrics: planned.metrics,
+        plots: planned.plots,
+    })
 }
 
 /// A planning error of the framework (clearance, linking) named after `operation`.

@@ -2,14 +2,15 @@
 //! binary, never in a fixture job): a ring of arcs above the blade tips, one arc per main
 //! channel made by rotational copy, planned through the registry passed to
 //! `impeller_cam::run_job_with`, linked over the safety surface, written to the CL file and
-//! the program, verified, and reported with its kind's metrics and plots. Also: job-file
-//! errors of the kind's own keys name the file, line and key.
+//! the program, verified, and reported with its kind's metrics and plots; a step it plans with
+//! a further tool of the job is posted as its own operation before it. Also: job-file errors
+//! of the kind's own keys name the file, line and key.
 #![allow(clippy::unwrap_used, clippy::panic)] // test code
 
 use cam_core::{CutterLocation, Move, Point3, ToolPath, Vector3};
 use cam_plan::{
     order, params, pattern, Builder, Metrics, Operation, OperationSpec, PlanContext, PlanError,
-    PlannedOperation, Plot, PlotKind, PlotSeries,
+    PlannedOperation, PlannedStep, Plot, PlotKind, PlotSeries, StepTool, Tool,
 };
 use impeller_cam::{run_job_with, Job};
 use serde::Deserialize;
@@ -26,6 +27,10 @@ struct RingParams {
     /// Chords per channel.
     #[serde(default = "default_chords")]
     chords: usize,
+    /// A further tool of the job: a step with it runs the same ring 2 mm further in, before
+    /// the operation.
+    #[serde(default)]
+    pre_tool: Option<String>,
 }
 
 fn default_chords() -> usize {
@@ -50,18 +55,64 @@ impl Operation for Ring {
         &self.tool
     }
     fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
+        self.ring(ctx, self.params.radius_mm, &self.tool)
+    }
+    fn step_tools(&self) -> Vec<StepTool> {
+        self.params
+            .pre_tool
+            .iter()
+            .map(|t| StepTool {
+                key: "pre_tool".into(),
+                tool: t.clone(),
+            })
+            .collect()
+    }
+    fn plan_with_steps(
+        &self,
+        ctx: &PlanContext<'_>,
+        tools: &[&Tool],
+    ) -> Result<(PlannedOperation, Vec<PlannedStep>), PlanError> {
+        let main = self.plan(ctx)?;
+        let steps = tools
+            .iter()
+            .map(|t| {
+                Ok(PlannedStep {
+                    name: format!("{}-pre", self.name),
+                    kind: "test_pre".into(),
+                    tool: t.name().into(),
+                    process: cam_plan::Process {
+                        spindle_rpm: 8000.0,
+                        ..*ctx.process
+                    },
+                    before: true,
+                    planned: self.ring(ctx, self.params.radius_mm - 2.0, t.name())?,
+                })
+            })
+            .collect::<Result<_, PlanError>>()?;
+        Ok((main, steps))
+    }
+}
+
+impl Ring {
+    /// The ring of arcs at `radius` with `tool`.
+    fn ring(
+        &self,
+        ctx: &PlanContext<'_>,
+        radius: f64,
+        tool: &str,
+    ) -> Result<PlannedOperation, PlanError> {
         let p = &self.params;
         let set = ctx.impeller.main();
         let pitch = set.pitch_rad();
         let z = ctx.stock.z_range().1 - p.depth_mm;
         let tilt = 10f64.to_radians();
         // Channel 0's arc: one pitch of the ring, axis tilted 10° outward.
-        let mut arc = ToolPath::new(format!("{} arc", self.name), &self.tool);
+        let mut arc = ToolPath::new(format!("{} arc", self.name), tool);
         for k in 0..=p.chords {
             let phi = pitch * k as f64 / p.chords as f64;
             let (s, c) = phi.sin_cos();
             let cl = CutterLocation::new(
-                Point3::new(p.radius_mm * c, p.radius_mm * s, z),
+                Point3::new(radius * c, radius * s, z),
                 Vector3::new(tilt.sin() * c, tilt.sin() * s, tilt.cos()),
             )
             .map_err(|e| PlanError::cam(&self.name, e))?;
@@ -231,6 +282,56 @@ fn line_of(text: &str, needle: &str) -> usize {
         .position(|l| l.trim_start().starts_with(needle))
         .unwrap()
         + 1
+}
+
+#[test]
+fn a_step_with_a_further_tool_is_posted_as_its_own_operation_before_it() {
+    let pre_tool = "[[tools]]\nnumber = 4\nname = \"flat-d4\"\nshape = \"flat_end\"\n\
+        diameter_mm = 4.0\nflute_length_mm = 20.0\nshank_diameter_mm = 4.0\n\
+        stick_out_mm = 40.0\ntool_length_mm = 100.0\nteeth = 2\n\n";
+    let op = RING_OP.replace(
+        "depth_mm = 0.5\n",
+        "depth_mm = 0.5\npre_tool = \"flat-d4\"\n",
+    );
+    let dir = scratch("steps");
+    let job_path = dir.join("job.toml");
+    std::fs::write(&job_path, job_text(&format!("{pre_tool}{op}"))).unwrap();
+    let job = Job::from_file_with(&job_path, TEST_REGISTRY).unwrap();
+    let out = dir.join("out");
+    let report = run_job_with(&job, &out, TEST_REGISTRY).unwrap();
+    // The step first, with its own tool, kind, feeds and metrics; then the operation.
+    let names: Vec<&str> = report.operations.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["ring-pre", "ring"]);
+    let pre = &report.operations[0];
+    assert_eq!(
+        (pre.kind.as_str(), pre.tool.as_str()),
+        ("test_pre", "flat-d4")
+    );
+    assert!(pre.moves > 0);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert!((json["operations"][0]["ring_radius_mm"].as_f64().unwrap() - 28.0).abs() < 1e-9);
+    // Two tool changes in that order; 8000 rpm · 0.04 mm · 2 teeth = 640 mm/min for the step.
+    let program = std::fs::read_to_string(out.join("program.ngc")).unwrap();
+    let t4 = program.find("T4 M6").unwrap();
+    let t3 = program.find("T3 M6").unwrap();
+    assert!(t4 < t3, "the step's tool change comes first");
+    assert!(program[t4..t3].contains("S8000"));
+    let cls = std::fs::read_to_string(out.join("toolpath.cls")).unwrap();
+    assert!(
+        cls.contains("LOADTL/4") && cls.contains("FEDRAT/MMPM,640"),
+        "{cls}"
+    );
+    assert_eq!(json["verification"]["collisions"], 0);
+    // A further tool that is not a job tool is named with the file, line and key.
+    let text =
+        job_text(&RING_OP.replace("depth_mm = 0.5\n", "depth_mm = 0.5\npre_tool = \"nope\"\n"));
+    let err = parse_err(&text);
+    let line = line_of(&text, "pre_tool");
+    assert!(
+        err.contains(&format!("job.toml:{line}: operations[0].pre_tool")) && err.contains("nope"),
+        "{err}"
+    );
 }
 
 #[test]
