@@ -79,12 +79,36 @@ fn channel(c: &mut Criterion) {
         hub_allowance_mm: 0.5,
         rapid_mm_per_min: 10_000.0,
     };
+    // The pilot drill of `fixtures/tools/plunge-cutters.toml` (Ø16 flat-bottom drill).
+    let mut drill_cutter = Cutter::new(
+        "drill-d16",
+        CutterShape::FlatEnd { radius: 8.0 },
+        90.0,
+        8.0,
+        140.0,
+    )
+    .expect("drill");
+    drill_cutter.holder = vec![HolderSegment {
+        bottom_radius: 16.0,
+        top_radius: 16.0,
+        length: 40.0,
+    }];
+    let drill = Tool {
+        number: 34,
+        cutter: drill_cutter,
+        teeth: 2,
+        tool_length_mm: 200.0,
+        plunge_edge_length_mm: None,
+    };
     let spec = OperationSpec {
         name: "plunge-d30".into(),
         kind: plunge_opt::KIND.into(),
         tool: "plunge-d30".into(),
         process,
-        params: toml::Table::new(),
+        params: toml::from_str(
+            "[pilot]\ntool = \"drill-d16\"\nspindle_rpm = 4000.0\nfeed_per_tooth_mm = 0.1",
+        )
+        .expect("params"),
     };
     let op = plunge_opt::PlungeRoughing::from_spec(&spec).expect("op");
     let clearance =
@@ -104,7 +128,10 @@ fn channel(c: &mut Criterion) {
     let mut g = c.benchmark_group("plan");
     g.sample_size(10);
     g.bench_function("channel_section_d30", |b| {
-        b.iter(|| op.plan_section(black_box(&ctx)).expect("plan"))
+        b.iter(|| {
+            op.plan_section(black_box(&ctx), Some(&drill))
+                .expect("plan")
+        })
     });
     g.finish();
 }

@@ -1,33 +1,49 @@
-//! Monotone cutter-axis optimisation (paper 000 §3).
-//!
-//! Along a row, plunges go from the outlet to the inlet. With αᵢ the angle between the hub
-//! normal at the cutter-contact point and the cutter axis of plunge `i`, the paper's rule is
-//! that α must increase strictly from one plunge to the next, and by the smallest possible
-//! amount: then every plunge leans toward the material still to be cut and its non-cutting
-//! centre stays out of the hub layer the previous plunge left (paper Figs. 2–4, 9).
+//! The W walk of paper 000 §3: the smallest move of a plunge's upper axis point along the
+//! row's W curve that removes its centre interference.
 //!
 //! Method (§3 ①–③), per row:
 //! 1. fit a NURBS curve through the shroud points `Wᵢ` of the row's conventional axes
 //!    (cubic global interpolation, chord-length parameters, `nurbs::fit::interpolate_curve`;
-//!    the cutter-centre points `Mᵢ` stay where they are — the curve through them the paper
-//!    also fits would only reproduce them);
-//! 2. discretise the W curve with a parameter step (default 1e-5, the paper's "walking
-//!    distance");
-//! 3. keep the first plunge; for `i = 2, …` keep `Wᵢ` if `αᵢ > αᵢ₋₁`, otherwise walk the
-//!    discrete points from `Wᵢ`'s parameter toward the inlet (increasing parameter) and take
-//!    the first one whose axis `Mᵢ → W` gives `αᵢ > αᵢ₋₁`. Each candidate's α needs the
-//!    contact point of its axis: the depth solve of [`crate::axial_depth`], warm-started from
-//!    the previous candidate (2–3 Newton steps). The walk strides over [`WALK_STRIDE`]
-//!    points and re-walks the last stride point by point, so it costs O(moved steps / 64 +
-//!    64) solves rather than O(moved steps).
+//!    parameter 0 at the outlet end; the cutter-centre points `Mᵢ` stay where they are — the
+//!    curve through them the paper also fits would only reproduce them);
+//! 2. discretise it with a parameter step (default 1e-5, the paper's "walking distance"): the
+//!    candidates of plunge `i` are the parameters `uᵢ ± k·step`, `uᵢ` its own `Wᵢ`'s;
+//! 3. move `Wᵢ` along the discrete points **in the feed direction of the plunge's segment**
+//!    ([`crate::feed`]: toward the inlet for a segment fed toward the inlet, as in the paper,
+//!    toward the outlet otherwise), which leans the axis further toward the material still to
+//!    be cut, and take the first point whose axis `Mᵢ → W` satisfies the criterion; when no
+//!    point in that direction does, the same against the feed (see [`walk`]: on a floor
+//!    convex across the feed the axes must turn less than the normals, not lean further).
 //!
-//! The result is the smallest move in the discrete sense: the discrete point one step toward
-//! the outlet does not satisfy the inequality (tested). When the curve's inlet end is reached
-//! without success the plunge keeps its conventional axis and the row is reported
-//! non-monotone. Cost: O(moved steps) depth solves per plunge; no allocation per step.
+//! # Criterion
+//! The paper's criterion is "αᵢ > αᵢ₋₁". With signed α ([`crate::feed::signed_alpha`]) it is
+//! neither necessary nor sufficient on `impeller-plunge-400`: rows fed inlet → outlet have α
+//! falling by 2–3° over 20 plunges with no interference at all (hub curvature turns the
+//! normals with the rows), and where two segments meet α must fall to zero, which no
+//! increasing rule allows. So the walk is applied only to plunges that still interfere after
+//! the feed direction is chosen ("the W walk then only corrects what is left", issue 33), and
+//! its criterion is what the rule stands for: the centre disk's travel through material left
+//! by everything machined before ([`crate::interference`]) is at most
+//! [`crate::interference::INTERFERENCE_TRAVEL_TOL_MM`]. A candidate must also be admissible
+//! (blade allowance of cutter, shank and holder; shank and holder out of the stock); the walk
+//! stops at the first inadmissible one, since leaning further only moves the tool further
+//! toward the blades.
+//!
+//! # Search and smallest move
+//! The travel is costly (thousands of disk samples), so the walk does not try every discrete
+//! point: it doubles the move (1, 2, 4, … steps) up to a stride of [`WALK_MAX_STRIDE_MM`] of W
+//! travel, then goes on in that stride, until a candidate satisfies the criterion, and
+//! bisects between the last failing and the first satisfying move. The result `k` is the
+//! smallest move in the discrete sense on that bracket: `k` satisfies the criterion and
+//! `k − 1` does not (tested); a clean range narrower than the stride before it can be
+//! missed. A direction ends at the curve's end, at an inadmissible candidate, after the
+//! caller's reach of W travel, or once the travel has grown [`WALK_GIVE_UP_MM`] over the
+//! least seen (the centre has left the earlier holes). When both directions end without a
+//! clean candidate the plunge keeps its axis. Cost per walked plunge: O(log₂ stride + W
+//! travel / stride + log₂ stride) posture and travel evaluations per direction.
 
-use crate::axial_depth::ContactSeed;
 use crate::conventional_axes::{Posture, PostureBuilder};
+use crate::feed::Feed;
 use cam_core::Vector3;
 use cam_plan::PlanError;
 use nurbs::fit::{interpolate_curve, parameters, Parametrisation};
@@ -37,200 +53,202 @@ use nurbs::NurbsCurve;
 /// walking distance as 10⁻⁵").
 pub const DEFAULT_W_STEP: f64 = 1e-5;
 
-/// One row after optimisation.
+/// The W curve of one row: the curve through its conventional shroud points (outlet →
+/// inlet), the parameter of each, and the discretisation step.
 #[derive(Debug, Clone)]
-pub struct OptimisedRow {
-    /// The postures, outlet → inlet.
-    pub postures: Vec<Posture>,
-    /// α of the conventional axes (rad).
-    pub alpha_before: Vec<f64>,
-    /// α after optimisation (rad).
-    pub alpha_after: Vec<f64>,
-    /// Discrete W-curve index each moved plunge took, with the index the walk started at.
-    pub moves: Vec<Option<(usize, usize)>>,
-    /// Whether α increases strictly along the row.
-    pub monotone: bool,
-    /// The fitted W curve (parameter 0 at the outlet end), when the row has ≥ 2 plunges.
-    pub w_curve: Option<NurbsCurve<3>>,
-    /// The discretisation step used.
+pub struct WCurve {
+    /// The fitted curve (parameter 0 at the outlet end).
+    pub curve: NurbsCurve<3>,
+    /// Parameter of each station's `Wᵢ`.
+    pub params: Vec<f64>,
+    /// Discretisation step of the parameter.
     pub step: f64,
-    /// Plunges whose smallest α-raising move was not admissible (it would break the blade
-    /// allowance, or make the centre disk run into more material) and that kept their
-    /// conventional axis.
-    pub kept_for_clearance: usize,
 }
 
-/// Fits the W curve of a row: the curve and the parameter of each `Wᵢ`.
+/// Fits the W curve of a row (postures in station order). `None` for a row of fewer than two
+/// plunges (nothing to walk along).
 pub fn fit_w_curve(
     row: &[Posture],
+    step: f64,
     operation: &str,
-) -> Result<(NurbsCurve<3>, Vec<f64>), PlanError> {
+) -> Result<Option<WCurve>, PlanError> {
+    if row.len() < 2 {
+        return Ok(None);
+    }
     let pts: Vec<Vector3> = row.iter().map(|p| p.w).collect();
-    let degree = 3.min(pts.len().saturating_sub(1)).max(1);
+    let degree = 3.min(pts.len() - 1);
     let err = |e: nurbs::fit::FitError| {
         PlanError::geometry(operation, "W curve of a row", format!("fit: {e}"))
     };
     let curve = interpolate_curve(&pts, degree, Parametrisation::ChordLength, None).map_err(err)?;
     let params = parameters(&pts, Parametrisation::ChordLength).map_err(err)?;
-    Ok((curve, params))
-}
-
-/// Stride of the coarse walk over the discrete W points: 64 steps of 1e-5 move W by ~0.1 mm
-/// on impeller-sized curves; inside a stride every point is tried in order, so the result is
-/// the first satisfying point unless α rises above and falls back below αᵢ₋₁ within one
-/// stride without the stride's end satisfying it (a wiggle of α over 0.1 mm of W travel).
-pub const WALK_STRIDE: usize = 64;
-
-/// The first discrete index in `from..=to` whose axis gives α > `prev` (`to` satisfies it).
-#[allow(clippy::too_many_arguments)]
-fn first_in(
-    builder: &PostureBuilder<'_>,
-    curve: &NurbsCurve<3>,
-    step: f64,
-    centre: &Vector3,
-    from: usize,
-    to: usize,
-    prev: f64,
-    seed: Option<((f64, f64), f64)>,
-) -> Option<(usize, Vector3, ContactSeed)> {
-    let mut seed = seed;
-    for k in from..=to {
-        let w = curve.point(k as f64 * step);
-        if let Some((a, s)) = alpha_of(builder, centre, &w, seed) {
-            seed = Some(s);
-            if a > prev {
-                return Some((k, w, s));
-            }
-        }
-    }
-    None
-}
-
-/// α of the axis through `centre` and `w`, with the contact seed for the next candidate.
-fn alpha_of(
-    builder: &PostureBuilder<'_>,
-    centre: &Vector3,
-    w: &Vector3,
-    seed: Option<((f64, f64), f64)>,
-) -> Option<(f64, ContactSeed)> {
-    let (q, c) = builder.contact(centre, w, seed).ok()?;
-    Some((builder.alpha(&q, &c), (c.uv, c.t)))
-}
-
-/// Optimises one row's axes (outlet → inlet) with W-curve parameter step `step`.
-pub fn optimise_row(
-    builder: &PostureBuilder<'_>,
-    row: &[Posture],
-    step: f64,
-    operation: &str,
-) -> Result<OptimisedRow, PlanError> {
-    optimise_row_within(builder, row, step, operation, &|_, _, _| true)
-}
-
-/// [`optimise_row`] where a moved posture must also pass `admissible(moved, unmoved,
-/// before)` (`unmoved` the plunge as given, `before` the plunges before it as optimised so
-/// far; e.g. the blade allowance of cutter, shank and holder, and that the move does not
-/// make its centre disk run into more material): the smallest move that makes α rise is
-/// taken only when the posture it gives is admissible; otherwise the plunge keeps its
-/// conventional axis (placed clear of the blades by the row planner), the row is not
-/// monotone there, and the position is counted in [`OptimisedRow::kept_for_clearance`].
-/// Checks run once per moved plunge.
-pub fn optimise_row_within(
-    builder: &PostureBuilder<'_>,
-    row: &[Posture],
-    step: f64,
-    operation: &str,
-    admissible: &(dyn Fn(&Posture, &Posture, &[Posture]) -> bool + Sync),
-) -> Result<OptimisedRow, PlanError> {
-    let alpha_before: Vec<f64> = row.iter().map(|p| p.alpha).collect();
-    if row.len() < 2 {
-        return Ok(OptimisedRow {
-            postures: row.to_vec(),
-            alpha_after: alpha_before.clone(),
-            alpha_before,
-            moves: vec![None; row.len()],
-            monotone: true,
-            w_curve: None,
-            step,
-            kept_for_clearance: 0,
-        });
-    }
-    let (curve, params) = fit_w_curve(row, operation)?;
-    let last = (1.0 / step).floor() as usize;
-    let mut postures = row.to_vec();
-    let mut moves = vec![None; row.len()];
-    let mut monotone = true;
-    let mut kept_for_clearance = 0;
-    for i in 1..row.len() {
-        let prev = postures[i - 1].alpha;
-        if postures[i].alpha > prev {
-            continue;
-        }
-        let p = row[i];
-        let k0 = (params[i] / step).ceil() as usize;
-        let mut seed = Some((p.contact.uv, p.contact.t));
-        // Walk in strides of WALK_STRIDE discrete points; when a stride's end satisfies
-        // the inequality, walk the stride again point by point for the first that does.
-        let mut found = None;
-        let mut k = k0;
-        let mut from = k0;
-        while k <= last {
-            let w = curve.point(k as f64 * step);
-            match alpha_of(builder, &p.centre, &w, seed) {
-                Some((a, s)) => {
-                    seed = Some(s);
-                    if a > prev {
-                        found = first_in(builder, &curve, step, &p.centre, from, k, prev, seed);
-                        break;
-                    }
-                }
-                None => seed = None,
-            }
-            from = k + 1;
-            k = if k == last {
-                last + 1
-            } else {
-                (k + WALK_STRIDE).min(last)
-            };
-        }
-        match found {
-            Some((k, w, s)) => {
-                let moved = builder.through(p.m, p.s, p.centre, w, Some(s))?;
-                if admissible(&moved, &row[i], &postures[..i]) {
-                    postures[i] = moved;
-                    moves[i] = Some((k, k0));
-                } else {
-                    kept_for_clearance += 1;
-                    monotone = false;
-                }
-            }
-            None => monotone = false,
-        }
-    }
-    let alpha_after: Vec<f64> = postures.iter().map(|p| p.alpha).collect();
-    monotone &= alpha_after.windows(2).all(|w| w[1] > w[0]);
-    Ok(OptimisedRow {
-        postures,
-        alpha_before,
-        alpha_after,
-        moves,
-        monotone,
-        w_curve: Some(curve),
+    Ok(Some(WCurve {
+        curve,
+        params,
         step,
-        kept_for_clearance,
+    }))
+}
+
+/// Largest stride (mm of W travel) of the walk's scan: a clean range of W narrower than this
+/// can be stepped over (the doubling from one discrete step reaches it first).
+pub const WALK_MAX_STRIDE_MM: f64 = 0.25;
+/// The walk gives a direction up once the travel exceeds the smallest seen by this much (mm):
+/// the centre disk has then left the earlier holes and leaning further only adds material.
+pub const WALK_GIVE_UP_MM: f64 = 0.5;
+
+/// What a candidate axis gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Verdict {
+    /// Breaks the blade allowance or the stock clearance: the walk stops in this direction.
+    Inadmissible,
+    /// Admissible; the centre disk's travel through material (mm).
+    Travel(f64),
+}
+
+/// A plunge after the walk.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Walked {
+    /// The moved posture.
+    pub posture: Posture,
+    /// Discrete steps moved.
+    pub steps: usize,
+    /// Whether `W` moved in the feed direction (the paper's) or against it.
+    pub toward_feed: bool,
+    /// W-curve parameter of the new `W`.
+    pub param: f64,
+}
+
+/// The W-curve parameter `d` steps from station `station`'s `W` toward the inlet
+/// (increasing parameter) or the outlet, `None` beyond the curve.
+pub fn param_at(curve: &WCurve, station: usize, toward: Feed, d: usize) -> Option<f64> {
+    let u0 = *curve.params.get(station)?;
+    let du = d as f64 * curve.step;
+    let u = match toward {
+        Feed::TowardInlet => u0 + du,
+        Feed::TowardOutlet => u0 - du,
+    };
+    (0.0..=1.0).contains(&u).then_some(u)
+}
+
+/// The posture of plunge `p` (station `station` of the row of `curve`) with its upper point
+/// moved `d` discrete steps along the W curve toward the inlet or the outlet; `None` beyond
+/// the curve or where no contact exists.
+pub fn moved(
+    builder: &PostureBuilder<'_>,
+    curve: &WCurve,
+    p: &Posture,
+    station: usize,
+    toward: Feed,
+    d: usize,
+) -> Option<(Posture, f64)> {
+    let u = param_at(curve, station, toward, d)?;
+    let w = curve.curve.point(u);
+    builder
+        .through(p.m, p.s, p.centre, w, Some((p.contact.uv, p.contact.t)))
+        .ok()
+        .map(|q| (q, u))
+}
+
+/// How far a walk may go and what it must reach.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WalkGoal {
+    /// Largest W travel (mm) in either direction.
+    pub reach_mm: f64,
+    /// Largest travel (mm) a clean candidate has.
+    pub tol: f64,
+}
+
+/// The smallest move of `p`'s `W` along `curve` whose posture `judge` finds admissible with
+/// a travel of at most `goal.tol`: first in the feed direction `feed` (the paper's, leaning further
+/// toward the material to be cut), then against it (on a floor convex across the feed, e.g.
+/// around the hub near the inlet, consecutive flat bottoms that follow the turning normals
+/// leave a wedge the next centre meets: the axis must turn less). W moves at most
+/// `goal.reach_mm` (the caller's bound: the cutting-edge length beyond the previous plunge's
+/// W, further the centre leaves the previous hole). `None` when neither direction finds one.
+pub fn walk(
+    builder: &PostureBuilder<'_>,
+    curve: &WCurve,
+    p: &Posture,
+    station: usize,
+    feed: Feed,
+    goal: WalkGoal,
+    judge: &dyn Fn(&Posture) -> Verdict,
+) -> Option<Walked> {
+    [feed, feed.reversed()].into_iter().find_map(|toward| {
+        walk_toward(builder, curve, p, station, toward, goal, judge).map(|mut w| {
+            w.toward_feed = toward == feed;
+            w
+        })
     })
 }
 
-/// α of the axis through plunge `i`'s centre and the W-curve point of discrete index `k`
-/// (for checking the smallest-move property).
-pub fn alpha_at_index(
+/// [`walk`] in one direction: doubling from one discrete step up to a stride of
+/// [`WALK_MAX_STRIDE_MM`] of W travel, then that stride, until a clean candidate; then
+/// bisection between the last failing and the first clean move.
+fn walk_toward(
     builder: &PostureBuilder<'_>,
-    row: &OptimisedRow,
-    i: usize,
-    k: usize,
-) -> Option<f64> {
-    let curve = row.w_curve.as_ref()?;
-    let p = row.postures.get(i)?;
-    let w = curve.point(k as f64 * row.step);
-    alpha_of(builder, &p.centre, &w, Some((p.contact.uv, p.contact.t))).map(|a| a.0)
+    curve: &WCurve,
+    p: &Posture,
+    station: usize,
+    toward: Feed,
+    goal: WalkGoal,
+    judge: &dyn Fn(&Posture) -> Verdict,
+) -> Option<Walked> {
+    let WalkGoal { reach_mm, tol } = goal;
+    let u0 = *curve.params.get(station)?;
+    // W travel per discrete step at this point of the curve (mm).
+    let speed = curve.curve.derivs(u0, 1).get(1)?.norm() * curve.step;
+    if !(speed.is_finite() && speed > 0.0) {
+        return None;
+    }
+    let room = match toward {
+        Feed::TowardInlet => 1.0 - u0,
+        Feed::TowardOutlet => u0,
+    };
+    let max_d = ((room / curve.step).floor() as usize).min((reach_mm / speed).ceil() as usize);
+    let max_stride = ((WALK_MAX_STRIDE_MM / speed).floor() as usize).max(1);
+    let try_d = |d: usize| -> Option<(Verdict, Posture, f64)> {
+        let (q, u) = moved(builder, curve, p, station, toward, d)?;
+        Some((judge(&q), q, u))
+    };
+    let (mut lo, mut d) = (0usize, 1usize);
+    let mut least = f64::INFINITY;
+    let (mut hi, mut best) = loop {
+        if d > max_d {
+            return None;
+        }
+        match try_d(d)? {
+            (Verdict::Inadmissible, ..) => return None,
+            (Verdict::Travel(t), q, u) if t <= tol => break (d, (q, u)),
+            (Verdict::Travel(t), ..) => {
+                if t > least + WALK_GIVE_UP_MM {
+                    return None;
+                }
+                least = least.min(t);
+                lo = d;
+                d = if d == max_d {
+                    max_d + 1
+                } else {
+                    (d + d.min(max_stride)).min(max_d)
+                };
+            }
+        }
+    };
+    // Bisection: `lo` interferes (or is the unmoved plunge), `hi` is clean.
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        match try_d(mid) {
+            Some((Verdict::Travel(t), q, u)) if t <= tol => {
+                hi = mid;
+                best = (q, u);
+            }
+            _ => lo = mid,
+        }
+    }
+    Some(Walked {
+        posture: best.0,
+        steps: hi,
+        toward_feed: true,
+        param: best.1,
+    })
 }

@@ -15,9 +15,8 @@
 //!   the higher of that and the height where the bottom disk leaves the blank, plus the start
 //!   clearance — the plunge starts in air.
 //!
-//! `α`, the angle between the hub normal at the
-//! contact point and the axis, is what the
-//! optimisation of [`crate::axis_optimisation`] makes increase along a row.
+//! `α`, the angle between the hub normal at the contact point and the axis, is reported
+//! signed toward the feed along every row ([`crate::feed`]).
 
 use crate::axial_depth::{solve_contact, Contact, DepthError, RevolvedFloor};
 use crate::rows::ChannelFrame;
@@ -125,9 +124,8 @@ impl<'a> PostureBuilder<'a> {
     }
 
     /// α of a contact: the angle between the hub normal there and the axis `q` (paper 000
-    /// §3, unsigned as the paper defines it). `self` is kept so a signed variant (lean toward
-    /// the inlet) can replace it without changing callers; see the crate docs for why the
-    /// unsigned angle is used.
+    /// §3), in [0, π]. Its sign, toward or against the feed, depends on the row and the feed
+    /// direction: [`crate::feed::signed_alpha`].
     pub fn alpha(&self, q: &Vector3, c: &Contact) -> f64 {
         let _ = &self.hub;
         c.normal.dot(q).clamp(-1.0, 1.0).acos()

@@ -2,10 +2,13 @@
 //! metrics and plots.
 
 use crate::allowance::{hub_allowance, HubAllowance};
-use crate::axis_optimisation::{optimise_row_within, OptimisedRow, DEFAULT_W_STEP};
+use crate::axis_optimisation::DEFAULT_W_STEP;
 use crate::conventional_axes::{Posture, PostureBuilder};
+use crate::entries::{pilot_radius, EntryKind, EntryMode, PilotParams};
+use crate::feed::{is_increasing, signed_alpha, Feed};
+use crate::feed_plan::{plan_feed, stroke, FeedInput, FeedPlan};
 use crate::interference::{
-    core_travel, interfering_count, travel_of, ClearedRegion, Material, Stroke,
+    core_travel, depth_in_stock, interfering_count, travel_of, ClearedRegion, Material, Stroke,
     INTERFERENCE_TRAVEL_TOL_MM,
 };
 use crate::rows::{plan_rows, stations, ChannelFrame, RowSettings};
@@ -15,7 +18,8 @@ use crate::KIND;
 use cam_core::CutterShape;
 use cam_plan::{
     order, pattern, ClearanceOptions, DesignClearance, Metrics, Operation, OperationSpec, PartSet,
-    PlanContext, PlanError, PlannedOperation, Plot, PlotKind, PlotSeries,
+    PlanContext, PlanError, PlannedOperation, PlannedStep, Plot, PlotKind, PlotSeries, StepTool,
+    Tool,
 };
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -43,6 +47,12 @@ fn start_clearance() -> f64 {
 fn table_stations() -> usize {
     DEFAULT_ROW_TABLE_STATIONS
 }
+fn pilot_mode() -> EntryMode {
+    EntryMode::Pilot
+}
+
+/// Kind name of the pilot-drilling step in reports.
+pub const PILOT_KIND: &str = "pilot_drilling";
 
 /// The kind's own keys (see the crate docs and docs/job.md).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -73,6 +83,12 @@ pub struct PlungeParams {
     /// First channel machined (the others follow in +θ order).
     #[serde(default)]
     pub first_channel: usize,
+    /// Which entries the section may use (see [`crate::entries`]; default `pilot`).
+    #[serde(default = "pilot_mode")]
+    pub entry: EntryMode,
+    /// The pilot drill and its cutting data (`entry = "pilot"` only, and required there).
+    #[serde(default)]
+    pub pilot: Option<PilotParams>,
 }
 
 /// A plunge-roughing operation (one section of every channel).
@@ -121,6 +137,29 @@ impl PlungeRoughing {
                 format!("{} must be at least 2", p.row_table_stations),
             );
         }
+        match (&p.pilot, p.entry) {
+            (None, EntryMode::Pilot) => {
+                return bad(
+                    "pilot",
+                    "entry = \"pilot\" (the default) needs a [pilot] table naming the drill \
+                     of the job's tools (tool, spindle_rpm, feed_per_tooth_mm); without one, \
+                     entry = \"lead_in\" or \"cleared\" lets rows enter only off the blank or \
+                     where something already cut"
+                        .into(),
+                )
+            }
+            (Some(_), mode) if mode != EntryMode::Pilot => {
+                return bad(
+                    "pilot",
+                    format!(
+                        "a pilot drill is used only with entry = \"pilot\", not \"{}\"",
+                        mode.name()
+                    ),
+                )
+            }
+            (Some(pilot), _) => pilot.validate(&spec.name)?,
+            (None, _) => {}
+        }
         Ok(Self {
             name: spec.name.clone(),
             tool: spec.tool.clone(),
@@ -137,16 +176,16 @@ impl PlungeRoughing {
 /// Everything planned for channel 0 of one section (before the rotational copy).
 #[derive(Debug, Clone)]
 pub struct SectionPlan {
-    /// Conventional postures per row (outlet → inlet), rows suction → pressure side.
+    /// Conventional postures per row (station order: outlet → inlet), rows suction →
+    /// pressure side.
     pub conventional: Vec<Vec<Posture>>,
-    /// Optimised rows (same order); equal to the conventional ones when optimisation is off.
-    pub optimised: Vec<OptimisedRow>,
+    /// The machining order: segments fed by lean, entries, pilots, walked axes, travels.
+    pub feed: FeedPlan,
     /// Section ends (meridional fractions): outlet side, inlet side.
     pub range: (f64, f64),
-    /// Centre-disk travel through uncut material per plunge, conventional axes (mm).
+    /// Centre-disk travel through uncut material per plunge of the conventional plan:
+    /// conventional axes, every row fed outlet → inlet (mm).
     pub travel_before: Vec<f64>,
-    /// The same with the final axes (mm).
-    pub travel_after: Vec<f64>,
     /// Hub allowance with conventional axes.
     pub allowance_before: HubAllowance,
     /// Hub allowance with the final axes.
@@ -158,14 +197,36 @@ pub struct SectionPlan {
     /// Plunges left out because shank or holder would enter the stock
     /// ([`crate::stock_clearance`]).
     pub skipped_for_stock: usize,
+    /// The pilot drill's radius and the deepest hole it drills in the stock (mm), when the
+    /// plan drills pilots.
+    pub pilot: Option<(f64, f64)>,
+    /// Smallest blade clearance of the pilot drill (cutter, shank, holder) at its holes'
+    /// depths (mm; infinite without pilots).
+    pub pilot_min_blade_clearance_mm: f64,
+    /// Hub length (mm) from the inlet to the section's inlet end: the strip this section
+    /// does not rough toward the inlet.
+    pub unroughed_hub_length_mm: f64,
     /// Wall-clock time of each planning stage (ms).
     pub timings_ms: Vec<(&'static str, f64)>,
 }
 
 impl SectionPlan {
-    /// The final postures per row.
-    pub fn final_rows(&self) -> Vec<Vec<Posture>> {
-        self.optimised.iter().map(|r| r.postures.clone()).collect()
+    /// The final postures per segment, in machining order (each in feed order).
+    pub fn final_segments(&self) -> Vec<Vec<Posture>> {
+        self.feed
+            .segments
+            .iter()
+            .map(|s| s.postures.clone())
+            .collect()
+    }
+
+    /// Number of segment entries of each kind per channel.
+    pub fn entries(&self, kind: EntryKind) -> usize {
+        self.feed
+            .segments
+            .iter()
+            .filter(|s| s.entry == kind)
+            .count()
     }
 }
 
@@ -173,18 +234,7 @@ impl SectionPlan {
 /// blade allowance somewhere across the channel, the posture and whether it was moved.
 type Tried = (f64, Option<(Posture, bool)>);
 
-/// The stroke of one plunge.
-fn stroke(p: &Posture, radius: f64, core: f64) -> Stroke {
-    Stroke {
-        start: p.start.tip,
-        end: p.cl.tip,
-        axis: p.cl.axis.into_inner(),
-        radius,
-        core_radius: core,
-    }
-}
-
-/// The strokes of `rows` in machining order.
+/// The strokes of `rows` in order.
 fn strokes(rows: &[Vec<Posture>], radius: f64, core: f64) -> Vec<Stroke> {
     rows.iter()
         .flatten()
@@ -193,8 +243,14 @@ fn strokes(rows: &[Vec<Posture>], radius: f64, core: f64) -> Vec<Stroke> {
 }
 
 impl PlungeRoughing {
-    /// Plans channel 0 of the section (the geometry behind [`Operation::plan`]).
-    pub fn plan_section(&self, ctx: &PlanContext<'_>) -> Result<SectionPlan, PlanError> {
+    /// Plans channel 0 of the section with the pilot drill `pilot_tool` (needed when
+    /// `entry = "pilot"` and some entry needs a pilot): the geometry behind
+    /// [`Operation::plan_with_steps`].
+    pub fn plan_section(
+        &self,
+        ctx: &PlanContext<'_>,
+        pilot_tool: Option<&Tool>,
+    ) -> Result<SectionPlan, PlanError> {
         let op = self.name.as_str();
         let tool = ctx.tool;
         ctx.process.validate(op)?;
@@ -220,6 +276,10 @@ impl PlungeRoughing {
             )
         })?;
         let core = tool.core_radius().unwrap_or(0.0);
+        let pilot_r = match (self.params.entry, pilot_tool) {
+            (EntryMode::Pilot, Some(t)) => Some(pilot_radius(t, radius, core, op)?),
+            _ => None,
+        };
         let engagement = |key: &str, v: Option<f64>| -> Result<f64, PlanError> {
             let v = v.unwrap_or(DEFAULT_ENGAGEMENT_FRACTION * edge);
             if v < edge {
@@ -287,21 +347,25 @@ impl PlungeRoughing {
             self.params.end_fraction,
         )?;
         lap("rows");
-        // What the strokes run through: the stock, less what an earlier section cleared when
-        // this one starts inside the channel (the interference metric's material).
+        // The region toward the outlet from a later section's start counts as cleared by the
+        // previous section where the stations are placed and in the conventional baseline;
+        // the final plan trusts it only with entry = "cleared" (otherwise its measure ignores
+        // the previous section: an upper bound of the real travel).
+        let cleared = (self.params.start_fraction < 1.0).then(|| ClearedRegion {
+            hub: impeller.hub().meridional(),
+            fraction: self.params.start_fraction,
+        });
         let material = Material {
-            stock: ctx.stock,
-            cleared: (self.params.start_fraction < 1.0).then(|| ClearedRegion {
-                hub: impeller.hub().meridional(),
-                fraction: self.params.start_fraction,
-            }),
+            cleared,
+            ..Material::stock(ctx.stock)
         };
-        // The first plunge of every row must not drill: its centre disk's whole stroke, from
-        // the start above the stock to the depth, passes through no material (the axis leans,
-        // so the top of the stroke can reach material its hub point is clear of). At the
-        // outlet it is a lead-in beyond the outlet whose hub point also lies outside the
-        // blank by the core radius plus a margin; inside the channel (a later section) it is
-        // moved toward the outlet into what the previous section cleared.
+        // The first station: no row's first plunge, fed outlet → inlet, drills with its
+        // centre: its centre disk's whole stroke, from the start above the stock to the
+        // depth, passes through no material (the axis leans, so the top of the stroke can
+        // reach material its hub point is clear of). At the outlet it is a lead-in beyond
+        // the outlet whose hub point also lies outside the blank by the core radius plus a
+        // margin; inside the channel (a later section) it is moved toward the outlet into
+        // what the previous section cleared.
         let at_outlet = self.params.start_fraction >= 1.0;
         let first_clear = |m: f64| -> bool {
             (0..rows.count).all(|j| {
@@ -398,53 +462,68 @@ impl PlungeRoughing {
             rows.end
         };
         let shifted_for_clearance = placed.iter().flatten().filter(|(_, moved)| *moved).count();
-        let conventional: Vec<Vec<Posture>> = placed
-            .into_iter()
-            .map(|r| r.into_iter().map(|(p, _)| p).collect())
-            .collect();
         lap("conventional_axes");
-        let optimised: Vec<OptimisedRow> = if self.params.optimise_axes {
-            conventional
+        // Shank and holder keep out of the stock (blank or turned stock) along every plunge;
+        // a plunge that cannot is left out (the next section or a shorter stroke from a
+        // turned stock reaches its material).
+        let stock_check = StockClearance::new(ctx.stock, &tool.cutter, radius);
+        let mut skipped_for_stock = 0;
+        let mut conventional: Vec<Vec<Posture>> = Vec::with_capacity(placed.len());
+        for row in placed {
+            let keep: Vec<bool> = row
                 .par_iter()
-                .map(|row| {
-                    // A moved axis must keep the blade allowance, and the move must not
-                    // make its centre disk run into more material than without it, counting
-                    // the row's earlier plunges as optimised (a large move of W turns the
-                    // axis by degrees: the centre disk can leave the previous hole on the
-                    // way down). The next plunge is judged when its own turn comes.
-                    let admissible = |p: &Posture, unmoved: &Posture, before: &[Posture]| {
-                        if blades.clearance(&p.cl).distance_mm < required {
-                            return false;
-                        }
-                        let n = before.len();
-                        let mut list: Vec<Stroke> =
-                            before.iter().map(|q| stroke(q, radius, core)).collect();
-                        list.push(stroke(p, radius, core));
-                        let moved = travel_of(&list, n, &material);
-                        list[n] = stroke(unmoved, radius, core);
-                        moved <= travel_of(&list, n, &material).max(INTERFERENCE_TRAVEL_TOL_MM)
-                    };
-                    optimise_row_within(&builder, row, self.params.w_curve_step, op, &admissible)
-                })
-                .collect::<Result<_, _>>()?
-        } else {
-            conventional
-                .iter()
-                .map(|row| OptimisedRow {
-                    postures: row.clone(),
-                    alpha_before: row.iter().map(|p| p.alpha).collect(),
-                    alpha_after: row.iter().map(|p| p.alpha).collect(),
-                    moves: vec![None; row.len()],
-                    monotone: row.windows(2).all(|w| w[1].alpha > w[0].alpha),
-                    w_curve: None,
-                    step: self.params.w_curve_step,
-                    kept_for_clearance: 0,
-                })
-                .collect()
+                .map(|(p, _)| stock_check.plunge_clear(p))
+                .collect();
+            skipped_for_stock += keep.iter().filter(|k| !**k).count();
+            let kept: Vec<Posture> = row
+                .into_iter()
+                .zip(keep)
+                .filter(|(_, k)| *k)
+                .map(|((p, _), _)| p)
+                .collect();
+            if !kept.is_empty() {
+                conventional.push(kept);
+            }
+        }
+        if conventional.is_empty() {
+            return Err(PlanError::tool(
+                op,
+                tool.name(),
+                format!(
+                    "at every plunge of the section the shank or holder would enter the stock \
+                     (clearance {} mm): a longer stick-out or a turned stock is needed",
+                    crate::stock_clearance::STOCK_CLEARANCE_MM
+                ),
+            ));
+        }
+        lap("stock_clearance_check");
+        // The conventional baseline: conventional axes, every row fed outlet → inlet.
+        let before = strokes(&conventional, radius, core);
+        let travel_before = core_travel(&before, &material);
+        lap("interference_before");
+        // The plan: segments fed by lean, entries, pilots, walked axes.
+        let admissible = |p: &Posture| {
+            blades.clearance(&p.cl).distance_mm >= required && stock_check.plunge_clear(p)
         };
-        lap("axis_optimisation");
+        let feed = plan_feed(&FeedInput {
+            rows: &conventional,
+            radius,
+            core,
+            mode: self.params.entry,
+            pilot_radius: pilot_r,
+            material: Material {
+                cleared: cleared.filter(|_| self.params.entry == EntryMode::Cleared),
+                ..Material::stock(ctx.stock)
+            },
+            optimise: self.params.optimise_axes,
+            w_step: self.params.w_curve_step,
+            builder: &builder,
+            admissible: &admissible,
+            operation: op,
+        })?;
+        lap("feed_plan");
         // Every final position keeps the blade allowance (cutter, shank, holder).
-        let finals: Vec<&Posture> = optimised.iter().flat_map(|r| &r.postures).collect();
+        let finals: Vec<&Posture> = feed.segments.iter().flat_map(|s| &s.postures).collect();
         let clear: Vec<f64> = finals
             .par_iter()
             .map(|p| blades.clearance(&p.cl).distance_mm)
@@ -467,132 +546,207 @@ impl PlungeRoughing {
             min_clear = min_clear.min(*c);
         }
         lap("blade_clearance_check");
-        // Shank and holder keep out of the stock (blank or turned stock) along every plunge;
-        // a plunge that cannot is left out (the next section or a shorter stroke from a
-        // turned stock reaches its material).
-        let stock_check = StockClearance::new(ctx.stock, &tool.cutter, radius);
-        let mut optimised = optimised;
-        let mut skipped_for_stock = 0;
-        for row in &mut optimised {
-            let keep: Vec<bool> = row
-                .postures
-                .par_iter()
-                .map(|p| stock_check.plunge_clear(p))
-                .collect();
-            skipped_for_stock += keep.iter().filter(|k| !**k).count();
-            let mut k = keep.iter();
-            row.postures.retain(|_| *k.next().unwrap_or(&true));
-            let mut k = keep.iter();
-            row.alpha_before.retain(|_| *k.next().unwrap_or(&true));
-            let mut k = keep.iter();
-            row.alpha_after.retain(|_| *k.next().unwrap_or(&true));
-            let mut k = keep.iter();
-            row.moves.retain(|_| *k.next().unwrap_or(&true));
+        // The pilot drill: blade allowance at every hole's depth, shank and holder out of the
+        // stock along every hole.
+        let mut pilot = None;
+        let mut pilot_min_clear = f64::INFINITY;
+        if let (Some(r), Some(drill), false) = (pilot_r, pilot_tool, feed.pilots.is_empty()) {
+            let drill_blades = DesignClearance::new(
+                impeller,
+                drill,
+                ClearanceOptions {
+                    parts: PartSet::BLADES,
+                    sample_tol_mm: crate::rows::FINAL_CHECK_SAMPLE_TOL_MM,
+                    above_mm: 0.0,
+                },
+            )?;
+            let drill_stock = StockClearance::new(ctx.stock, &drill.cutter, r);
+            let mut depth: f64 = 0.0;
+            for p in &feed.pilots {
+                let c = drill_blades.clearance(&p.cl).distance_mm;
+                let place = || {
+                    format!(
+                        "pilot hole at meridional fraction {:.4}, row fraction {:.4}",
+                        p.m, p.s
+                    )
+                };
+                if c < required {
+                    return Err(PlanError::geometry(
+                        op,
+                        place(),
+                        format!(
+                            "the pilot drill {} keeps {c:.4} mm from the blades, below the \
+                             blade allowance plus the query's sampling band, {required} mm",
+                            drill.name()
+                        ),
+                    ));
+                }
+                if !drill_stock.plunge_clear(p) {
+                    return Err(PlanError::geometry(
+                        op,
+                        place(),
+                        format!(
+                            "the shank or holder of the pilot drill {} would enter the stock \
+                             (clearance {} mm): a longer drill or stick-out is needed",
+                            drill.name(),
+                            crate::stock_clearance::STOCK_CLEARANCE_MM
+                        ),
+                    ));
+                }
+                pilot_min_clear = pilot_min_clear.min(c);
+                depth = depth.max(depth_in_stock(
+                    &crate::entries::pilot_stroke(p, r),
+                    ctx.stock,
+                ));
+            }
+            pilot = Some((r, depth));
         }
-        optimised.retain(|r| !r.postures.is_empty());
-        if optimised.is_empty() {
-            return Err(PlanError::tool(
-                op,
-                tool.name(),
-                format!(
-                    "at every plunge of the section the shank or holder would enter the stock \
-                     (clearance {} mm): a longer stick-out or a turned stock is needed",
-                    crate::stock_clearance::STOCK_CLEARANCE_MM
-                ),
-            ));
-        }
-        lap("stock_clearance_check");
-        let before = strokes(&conventional, radius, core);
-        let final_rows: Vec<Vec<Posture>> = optimised.iter().map(|r| r.postures.clone()).collect();
-        let after = strokes(&final_rows, radius, core);
-        let travel_before = core_travel(&before, &material);
-        let travel_after = core_travel(&after, &material);
-        lap("interference");
+        lap("pilot_check");
+        let after: Vec<Stroke> = feed
+            .segments
+            .iter()
+            .flat_map(|s| &s.postures)
+            .map(|p| stroke(p, radius, core))
+            .collect();
         let m_hi = rows.start.min(1.0);
         let allowance_before = hub_allowance(&frame, &before, section_end, m_hi);
         let allowance_after = hub_allowance(&frame, &after, section_end, m_hi);
         lap("hub_allowance");
+        let hub = impeller.hub().meridional();
+        let unroughed = hub.arc_length_at(hub.param_at_fraction(section_end.clamp(0.0, 1.0)));
         Ok(SectionPlan {
             conventional,
-            optimised,
+            feed,
             range: (rows.start, section_end),
             travel_before,
-            travel_after,
             allowance_before,
             allowance_after,
             min_blade_clearance_mm: min_clear,
             shifted_for_clearance,
             skipped_for_stock,
+            pilot,
+            pilot_min_blade_clearance_mm: pilot_min_clear,
+            unroughed_hub_length_mm: unroughed,
             timings_ms,
         })
     }
-}
 
-impl Operation for PlungeRoughing {
-    fn kind(&self) -> &'static str {
-        KIND
+    /// The pilot drill named by the job's `[pilot]` table, among `tools`.
+    fn pilot_tool<'t>(&self, tools: &[&'t Tool]) -> Option<&'t Tool> {
+        let name = &self.params.pilot.as_ref()?.tool;
+        tools.iter().copied().find(|t| t.name() == name)
     }
 
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn tool(&self) -> &str {
-        &self.tool
-    }
-
-    fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
-        let plan = self.plan_section(ctx)?;
-        let rows = plan.final_rows();
+    /// The operation and its pilot-drilling step (when the plan drills pilots).
+    fn plan_all(
+        &self,
+        ctx: &PlanContext<'_>,
+        pilot_tool: Option<&Tool>,
+    ) -> Result<(PlannedOperation, Vec<PlannedStep>), PlanError> {
+        let plan = self.plan_section(ctx, pilot_tool)?;
+        let segments = plan.final_segments();
         let radius = ctx
             .tool
             .cutter
             .shape
             .radius_at(ctx.tool.cutter.flute_length);
         let stock_check = StockClearance::new(ctx.stock, &ctx.tool.cutter, radius);
-        let (path, lifted) = channel_path(
-            &self.name,
-            ctx.tool.name(),
-            &rows,
-            ctx.linker,
-            ctx.rates().plunge_mm_per_min,
-            &|a, b| stock_check.rapid_clear(a, b),
-        )
-        .map_err(|e| match e {
+        let rename = |e: PlanError| match e {
             PlanError::Geometry { place, reason, .. } => {
                 PlanError::geometry(&self.name, place, reason)
             }
             other => other,
-        })?;
+        };
+        let (path, lifted) = channel_path(
+            &self.name,
+            ctx.tool.name(),
+            &segments,
+            ctx.linker,
+            ctx.rates().plunge_mm_per_min,
+            &|a, b| stock_check.rapid_clear(a, b),
+        )
+        .map_err(rename)?;
         let set = ctx.impeller.main();
         let channels = set.count();
         let order = order::angular_sequence(channels, self.params.first_channel % channels.max(1));
         let paths = pattern::copy_to(&path, set.pitch_rad(), &order);
 
-        let per_channel = plan.travel_after.len();
+        let mut steps = Vec::new();
+        if let (Some(drill), Some(pp), Some((r, _))) =
+            (pilot_tool, self.params.pilot.as_ref(), plan.pilot)
+        {
+            let process = pp.process(ctx.process);
+            let holes: Vec<Vec<Posture>> = plan.feed.pilots.iter().map(|p| vec![*p]).collect();
+            let drill_stock = StockClearance::new(ctx.stock, &drill.cutter, r);
+            let name = format!("{}-pilot", self.name);
+            let (pilot_path, _) = channel_path(
+                &name,
+                drill.name(),
+                &holes,
+                ctx.linker,
+                process.plunge_mm_per_min(drill.teeth),
+                &|a, b| drill_stock.rapid_clear(a, b),
+            )
+            .map_err(rename)?;
+            let mut m = Metrics::new();
+            m.count("pilots", plan.feed.pilots.len() * channels);
+            m.count("pilots_per_channel", plan.feed.pilots.len());
+            m.number("pilot_diameter_mm", 2.0 * r);
+            m.number("pilot_depth_mm", plan.pilot.map_or(0.0, |p| p.1));
+            m.number("min_blade_clearance_mm", plan.pilot_min_blade_clearance_mm);
+            steps.push(PlannedStep {
+                name: name.clone(),
+                kind: PILOT_KIND.into(),
+                tool: drill.name().into(),
+                process,
+                before: true,
+                planned: PlannedOperation {
+                    paths: pattern::copy_to(&pilot_path, set.pitch_rad(), &order),
+                    metrics: m,
+                    plots: Vec::new(),
+                    notes: vec![format!(
+                        "pilot holes of {}: {} per channel, Ø{:.1} mm flat-bottom drill {} along \
+                         the entry plunges' axes to their depth, up to {:.1} mm deep in the stock",
+                        self.name,
+                        plan.feed.pilots.len(),
+                        2.0 * r,
+                        drill.name(),
+                        plan.pilot.map_or(0.0, |p| p.1)
+                    )],
+                },
+            });
+        }
+        let planned = self.report(ctx, &plan, paths, lifted, channels);
+        Ok((planned, steps))
+    }
+
+    /// Metrics, plots and notes of a planned section.
+    fn report(
+        &self,
+        ctx: &PlanContext<'_>,
+        plan: &SectionPlan,
+        paths: Vec<cam_core::ToolPath>,
+        lifted: usize,
+        channels: usize,
+    ) -> PlannedOperation {
+        let feed = &plan.feed;
+        let per_channel = feed.travel.len();
+        let rows = plan.conventional.len();
         let mut m = Metrics::new();
         let before = interfering_count(&plan.travel_before);
-        let after = interfering_count(&plan.travel_after);
+        let after = interfering_count(&feed.travel);
         m.count("interference_positions_before", before * channels);
         m.count("interference_positions_after", after * channels);
-        // The first plunge of every row (the lead-in beyond the outlet, or the first plunge
-        // inside what the previous section cleared) must not drill (see `plan_section`).
-        let mut k = 0;
-        let mut first: f64 = 0.0;
-        for r in &plan.optimised {
-            if let Some(t) = plan.travel_after.get(k) {
-                first = first.max(*t);
-            }
-            k += r.postures.len();
-        }
-        m.number("first_plunge_max_core_travel_mm", first);
         m.count("plunges", per_channel * channels);
         m.count("plunges_per_channel", per_channel);
-        m.count("rows", rows.len());
-        m.count("stations", rows.first().map_or(0, Vec::len));
+        m.count("rows", rows);
+        m.count(
+            "stations",
+            plan.conventional.iter().map(Vec::len).max().unwrap_or(0),
+        );
         m.number(
             "interference_share_before",
-            before as f64 / per_channel.max(1) as f64,
+            before as f64 / plan.travel_before.len().max(1) as f64,
         );
         m.number(
             "interference_share_after",
@@ -604,15 +758,94 @@ impl Operation for PlungeRoughing {
         );
         m.number(
             "max_core_travel_after_mm",
-            plan.travel_after.iter().copied().fold(0.0, f64::max),
+            feed.travel.iter().copied().fold(0.0, f64::max),
         );
-        let monotone = plan.optimised.iter().all(|r| r.monotone);
+        // Entries.
+        let mut k = 0;
+        let mut entry_travel: f64 = 0.0;
+        for s in &feed.segments {
+            if let Some(t) = feed.travel.get(k) {
+                entry_travel = entry_travel.max(*t);
+            }
+            k += s.postures.len();
+        }
+        m.count("entries_per_channel", feed.segments.len());
+        m.count(
+            "entries_lead_in_per_channel",
+            plan.entries(EntryKind::LeadIn),
+        );
+        m.count(
+            "entries_cleared_per_channel",
+            plan.entries(EntryKind::Cleared),
+        );
+        m.count("pilots_per_channel", feed.pilots.len());
+        m.count("entries_pilot_per_channel", plan.entries(EntryKind::Pilot));
+        m.count("pilots_for_other_plunges_per_channel", feed.interior_pilots);
+        m.count(
+            "entries_unhandled_per_channel",
+            plan.entries(EntryKind::Unhandled),
+        );
+        m.number("entry_max_core_travel_mm", entry_travel);
+        m.number("pilot_diameter_mm", plan.pilot.map_or(0.0, |p| 2.0 * p.0));
+        m.number("pilot_depth_mm", plan.pilot.map_or(0.0, |p| p.1));
+        m.count(
+            "segments_fed_toward_outlet_per_channel",
+            feed.segments
+                .iter()
+                .filter(|s| s.segment.feed == Feed::TowardOutlet)
+                .count(),
+        );
+        // Signed α: the conventional plan (every row fed outlet → inlet) and the final one.
+        let alpha_before: Vec<Vec<f64>> = plan
+            .conventional
+            .iter()
+            .map(|r| {
+                (0..r.len())
+                    .map(|i| signed_alpha(r, i, Feed::TowardInlet))
+                    .collect()
+            })
+            .collect();
+        let final_rows = feed.rows(rows);
+        let alpha_after: Vec<Vec<(usize, f64)>> = final_rows
+            .iter()
+            .map(|r| {
+                let postures: Vec<Posture> = r.iter().map(|e| e.1).collect();
+                r.iter()
+                    .enumerate()
+                    .map(|(i, e)| (e.0, signed_alpha(&postures, i, e.2)))
+                    .collect()
+            })
+            .collect();
+        let deg = |v: f64| v.to_degrees();
+        let range = |vals: &mut dyn Iterator<Item = f64>| {
+            vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+        };
+        let (b_lo, b_hi) = range(&mut alpha_before.iter().flatten().copied());
+        let (a_lo, a_hi) = range(&mut alpha_after.iter().flatten().map(|e| e.1));
+        m.number("alpha_signed_min_deg", deg(a_lo));
+        m.number("alpha_signed_max_deg", deg(a_hi));
+        m.number("alpha_signed_min_before_deg", deg(b_lo));
+        m.number("alpha_signed_max_before_deg", deg(b_hi));
+        // The paper's rule as a diagnostic: signed α increasing along every segment's feed.
+        let monotone = feed.segments.iter().all(|s| {
+            let row = &final_rows[s.segment.row];
+            let postures: Vec<Posture> = row.iter().map(|e| e.1).collect();
+            let by_station = |k: usize| row.iter().position(|e| e.0 == k);
+            let seq: Vec<f64> = s
+                .segment
+                .stations
+                .iter()
+                .filter_map(|&k| by_station(k))
+                .map(|i| signed_alpha(&postures, i, s.segment.feed))
+                .collect();
+            is_increasing(&seq)
+        });
         m.flag("alpha_monotone", monotone);
         m.flag(
             "alpha_monotone_before",
-            plan.optimised
-                .iter()
-                .all(|r| r.alpha_before.windows(2).all(|w| w[1] > w[0])),
+            alpha_before.iter().all(|r| is_increasing(r)),
         );
         m.number("hub_allowance_max_mm", plan.allowance_after.max_mm);
         m.number("hub_allowance_mean_mm", plan.allowance_after.mean_mm);
@@ -624,13 +857,23 @@ impl Operation for PlungeRoughing {
         m.number("min_blade_clearance_mm", plan.min_blade_clearance_mm);
         m.number("section_start_fraction", plan.range.0);
         m.number("section_end_fraction", plan.range.1);
-        let moved = plan
-            .optimised
+        m.number("unroughed_hub_length_mm", plan.unroughed_hub_length_mm);
+        let moved = feed
+            .segments
             .iter()
-            .flat_map(|r| &r.moves)
+            .flat_map(|s| &s.walked)
             .filter(|x| x.is_some())
             .count();
         m.count("axes_moved_per_channel", moved);
+        m.count(
+            "axes_moved_against_feed_per_channel",
+            feed.segments
+                .iter()
+                .flat_map(|s| &s.walked)
+                .filter(|x| x.is_some_and(|w| !w.1))
+                .count(),
+        );
+        m.count("axes_kept_for_clearance_per_channel", feed.kept);
         m.count(
             "positions_shifted_for_clearance_per_channel",
             plan.shifted_for_clearance,
@@ -640,49 +883,80 @@ impl Operation for PlungeRoughing {
             plan.skipped_for_stock,
         );
         m.count("row_rapids_over_safety_surface_per_channel", lifted);
-        m.count(
-            "axes_kept_for_clearance_per_channel",
-            plan.optimised.iter().map(|r| r.kept_for_clearance).sum(),
-        );
 
         let mut series = Vec::new();
-        for (j, r) in plan.optimised.iter().enumerate() {
-            let xs: Vec<f64> = r.postures.iter().map(|p| p.m).collect();
-            let pts = |a: &[f64]| -> Vec<[f64; 2]> {
-                xs.iter()
-                    .zip(a)
-                    .map(|(x, y)| [*x, y.to_degrees()])
-                    .collect()
-            };
+        for (j, row) in plan.conventional.iter().enumerate() {
             series.push(PlotSeries {
-                label: format!("row {j} conventional"),
-                points: pts(&r.alpha_before),
+                label: format!("row {j} conventional, outlet → inlet"),
+                points: row
+                    .iter()
+                    .zip(&alpha_before[j])
+                    .map(|(p, a)| [p.m, deg(*a)])
+                    .collect(),
             });
             series.push(PlotSeries {
-                label: format!("row {j} optimised"),
-                points: pts(&r.alpha_after),
+                label: format!("row {j} planned, fed by lean"),
+                points: final_rows[j]
+                    .iter()
+                    .zip(&alpha_after[j])
+                    .map(|(e, a)| [e.1.m, deg(a.1)])
+                    .collect(),
             });
         }
         let plots = vec![Plot {
             title: format!(
-                "{}: α (hub normal at the contact vs cutter axis) along each row, outlet → inlet",
+                "{}: signed α (hub normal at the contact vs cutter axis, + toward the feed) \
+                 along each row",
                 self.name
             ),
             kind: PlotKind::Lines {
                 x_label: "meridional fraction (1 = outlet)".into(),
-                y_label: "α (deg)".into(),
+                y_label: "signed α (deg)".into(),
                 series,
                 equal_aspect: false,
             },
         }];
         let mut notes = vec![format!(
-            "section from meridional fraction {:.4} to {:.4}: {} rows × {} stations per channel; \
-             interference and hub allowance measured on channel 0 (every channel is its rotated copy)",
+            "section from meridional fraction {:.4} to {:.4}: {} rows, {} plunges per channel \
+             in {} segments fed toward where their axes lean ({} inlet → outlet); interference \
+             and hub allowance measured on channel 0 (every channel is its rotated copy)",
             plan.range.0,
             plan.range.1,
-            rows.len(),
-            rows.first().map_or(0, Vec::len)
+            rows,
+            per_channel,
+            feed.segments.len(),
+            feed.segments
+                .iter()
+                .filter(|s| s.segment.feed == Feed::TowardOutlet)
+                .count(),
         )];
+        notes.push(format!(
+            "entries per channel: {} lead-in, {} cleared, {} pilot, {} unhandled (entry = \"{}\"); \
+             {} more pilot hole(s) for plunges no admissible W clears",
+            plan.entries(EntryKind::LeadIn),
+            plan.entries(EntryKind::Cleared),
+            plan.entries(EntryKind::Pilot),
+            plan.entries(EntryKind::Unhandled),
+            self.params.entry.name(),
+            feed.interior_pilots
+        ));
+        if after > 0 {
+            notes.push(format!(
+                "{after} plunge(s) per channel still run their non-cutting centre through \
+                 material (up to {:.3} mm): {} not corrected by any admissible W, {} unhandled \
+                 entries",
+                feed.travel.iter().copied().fold(0.0, f64::max),
+                feed.kept,
+                plan.entries(EntryKind::Unhandled)
+            ));
+        }
+        notes.push(format!(
+            "the hub from the inlet to meridional fraction {:.4} ({:.1} mm along the hub) is not \
+             roughed by this section: its cutter does not fit between the blades with the blade \
+             allowance there (unroughed_hub_length_mm; a later section with a smaller cutter, \
+             or finishing, must take it)",
+            plan.range.1, plan.unroughed_hub_length_mm
+        ));
         notes.push(format!(
             "planning stages (ms): {}",
             plan.timings_ms
@@ -699,17 +973,113 @@ impl Operation for PlungeRoughing {
                 crate::stock_clearance::STOCK_CLEARANCE_MM
             ));
         }
-        if !monotone {
-            notes.push(
-                "alpha_monotone = false: on some row the W curve ended before α could increase"
-                    .into(),
-            );
-        }
-        Ok(PlannedOperation {
+        let _ = ctx;
+        PlannedOperation {
             paths,
             metrics: m,
             plots,
             notes,
-        })
+        }
+    }
+}
+
+impl Operation for PlungeRoughing {
+    fn kind(&self) -> &'static str {
+        KIND
+    }
+
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn tool(&self) -> &str {
+        &self.tool
+    }
+
+    /// Plans without the pilot drill: fails when an entry needs a pilot hole (the pipeline
+    /// calls [`Operation::plan_with_steps`] with the drill).
+    fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
+        let (planned, steps) = self.plan_all(ctx, None)?;
+        debug_assert!(steps.is_empty());
+        Ok(planned)
+    }
+
+    fn step_tools(&self) -> Vec<StepTool> {
+        self.params
+            .pilot
+            .iter()
+            .map(|p| StepTool {
+                key: "pilot.tool".into(),
+                tool: p.tool.clone(),
+            })
+            .collect()
+    }
+
+    fn plan_with_steps(
+        &self,
+        ctx: &PlanContext<'_>,
+        tools: &[&Tool],
+    ) -> Result<(PlannedOperation, Vec<PlannedStep>), PlanError> {
+        self.plan_all(ctx, self.pilot_tool(tools))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(params: &str) -> OperationSpec {
+        OperationSpec {
+            name: "plunge".into(),
+            kind: KIND.into(),
+            tool: "plunge-d30".into(),
+            process: toml::from_str("spindle_rpm = 3000.0\nfeed_per_tooth_mm = 0.1")
+                .expect("process"),
+            params: toml::from_str(params).expect("params"),
+        }
+    }
+
+    fn key_of(r: Result<PlungeRoughing, PlanError>) -> String {
+        match r {
+            Err(PlanError::Param { key, .. }) => key,
+            other => format!("not a parameter error: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn entry_keys_name_the_pilot_drill_when_and_only_when_it_drills() {
+        // The default entry is "pilot": it needs the drill.
+        assert_eq!(key_of(PlungeRoughing::from_spec(&spec(""))), "pilot");
+        let pilot = "[pilot]\ntool = \"drill-d16\"\nspindle_rpm = 4000.0\nfeed_per_tooth_mm = 0.1";
+        let op = PlungeRoughing::from_spec(&spec(pilot)).expect("pilot entry");
+        assert_eq!(op.params().entry, EntryMode::Pilot);
+        assert_eq!(
+            op.step_tools(),
+            vec![StepTool {
+                key: "pilot.tool".into(),
+                tool: "drill-d16".into()
+            }]
+        );
+        // Without a drill: lead-in or cleared entries, and no step.
+        let op = PlungeRoughing::from_spec(&spec("entry = \"lead_in\"")).expect("lead-in");
+        assert!(op.step_tools().is_empty());
+        assert!(PlungeRoughing::from_spec(&spec("entry = \"cleared\"")).is_ok());
+        // A drill with another mode would not be used; bad values name their key.
+        assert_eq!(
+            key_of(PlungeRoughing::from_spec(&spec(&format!(
+                "entry = \"cleared\"\n{pilot}"
+            )))),
+            "pilot"
+        );
+        assert_eq!(
+            key_of(PlungeRoughing::from_spec(&spec(
+                "[pilot]\ntool = \"d\"\nspindle_rpm = -1.0\nfeed_per_tooth_mm = 0.1"
+            ))),
+            "pilot.spindle_rpm"
+        );
+        assert_eq!(
+            key_of(PlungeRoughing::from_spec(&spec("entry = \"drill\""))),
+            "entry"
+        );
     }
 }

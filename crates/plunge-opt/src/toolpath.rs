@@ -1,11 +1,11 @@
 //! The tool path of one channel: every plunge as rapid to its start along the axis, plunge at
-//! the plunge feed to depth, retract along the axis to the start; rows linked over the job's
-//! safety surface ([`cam_plan::Linker`]).
+//! the plunge feed to depth, retract along the axis to the start; row segments (or pilot
+//! holes, one per "segment") linked over the job's safety surface ([`cam_plan::Linker`]).
 //!
-//! Inside a row the tool moves from one plunge's start to the next one's at rapid: both lie
-//! the start clearance above the shroud and the blank along their axes, a plunge step apart.
-//! Where that rapid would not keep the tool out of the stock (`rapid_clear`, see
-//! [`crate::stock_clearance::StockClearance::rapid_clear`]), and between rows (and at both
+//! Inside a segment the tool moves from one plunge's start to the next one's at rapid: both
+//! lie the start clearance above the shroud and the blank along their axes, a plunge step
+//! apart. Where that rapid would not keep the tool out of the stock (`rapid_clear`, see
+//! [`crate::stock_clearance::StockClearance::rapid_clear`]), and between segments (and at both
 //! ends), the tool retracts along its axis to the safety surface, travels on it and comes
 //! down along the next axis. O(plunges) plus the rapid checks.
 
@@ -13,9 +13,9 @@ use crate::conventional_axes::Posture;
 use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
 use cam_plan::{Linker, PlanError};
 
-/// The moves of one channel for `rows` (each outlet → inlet, rows in machining order), and
-/// the number of in-row rapids that `rapid_clear` rejected and that go over the safety
-/// surface instead.
+/// The moves of one channel for `rows` (row segments, each in its feed order, in machining
+/// order), and the number of in-segment rapids that `rapid_clear` rejected and that go over
+/// the safety surface instead.
 pub fn channel_path(
     name: &str,
     tool: &str,
