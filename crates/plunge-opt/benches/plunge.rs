@@ -42,6 +42,26 @@ fn depth(c: &mut Criterion) {
     });
 }
 
+/// A flat-end tool with 140 mm stick-out: radii and lengths `[radius, flute length, shank
+/// radius, holder radius, holder length]` (mm), teeth, plunge edge length.
+fn flat_tool(number: u32, name: &str, dims: [f64; 5], teeth: u32, edge: Option<f64>) -> Tool {
+    let [radius, flute, shank, holder, holder_length] = dims;
+    let mut cutter =
+        Cutter::new(name, CutterShape::FlatEnd { radius }, flute, shank, 140.0).expect("cutter");
+    cutter.holder = vec![HolderSegment {
+        bottom_radius: holder,
+        top_radius: holder,
+        length: holder_length,
+    }];
+    Tool {
+        number,
+        cutter,
+        teeth,
+        tool_length_mm: 210.0, // gauge length: the post's, not used in planning
+        plunge_edge_length_mm: edge,
+    }
+}
+
 fn channel(c: &mut Criterion) {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/impeller-plunge-400");
     let impeller = impeller_model::load(root.join("impeller.toml")).expect("fixture");
@@ -49,26 +69,15 @@ fn channel(c: &mut Criterion) {
     // uncut blank most plunges of the section are refused by the stock check, and planning
     // measures mostly that).
     let stock = impeller.turned_stock(0.0).expect("turned stock");
-    let mut cutter = Cutter::new(
+    // The Ø30 plunge cutter and its pilot drill of `fixtures/tools/plunge-cutters.toml`.
+    let tool = flat_tool(
+        31,
         "plunge-d30",
-        CutterShape::FlatEnd { radius: 15.0 },
-        45.0,
-        14.0,
-        140.0,
-    )
-    .expect("cutter");
-    cutter.holder = vec![HolderSegment {
-        bottom_radius: 25.0,
-        top_radius: 25.0,
-        length: 45.0,
-    }];
-    let tool = Tool {
-        number: 31,
-        cutter,
-        teeth: 3,
-        tool_length_mm: 210.0,
-        plunge_edge_length_mm: Some(8.0),
-    };
+        [15.0, 45.0, 14.0, 25.0, 45.0],
+        3,
+        Some(8.0),
+    );
+    let drill = flat_tool(34, "drill-d16", [8.0, 90.0, 8.0, 16.0, 40.0], 2, None);
     let process = Process {
         spindle_rpm: 3000.0,
         feed_per_tooth_mm: 0.1,
@@ -78,27 +87,6 @@ fn channel(c: &mut Criterion) {
         blade_allowance_mm: 1.0,
         hub_allowance_mm: 0.5,
         rapid_mm_per_min: 10_000.0,
-    };
-    // The pilot drill of `fixtures/tools/plunge-cutters.toml` (Ø16 flat-bottom drill).
-    let mut drill_cutter = Cutter::new(
-        "drill-d16",
-        CutterShape::FlatEnd { radius: 8.0 },
-        90.0,
-        8.0,
-        140.0,
-    )
-    .expect("drill");
-    drill_cutter.holder = vec![HolderSegment {
-        bottom_radius: 16.0,
-        top_radius: 16.0,
-        length: 40.0,
-    }];
-    let drill = Tool {
-        number: 34,
-        cutter: drill_cutter,
-        teeth: 2,
-        tool_length_mm: 200.0,
-        plunge_edge_length_mm: None,
     };
     let spec = OperationSpec {
         name: "plunge-d30".into(),

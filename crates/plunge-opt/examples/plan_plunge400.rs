@@ -15,13 +15,14 @@ use rayon::prelude::*;
 use std::error::Error;
 use std::path::PathBuf;
 
-/// One cutter: (number, name, diameter, edge length, flute length, shank diameter,
-/// stick-out, tool length, teeth, holder diameter, holder length).
-type CutterRow = (
+/// One flat-end tool: (number, name, diameter, plunge edge length (`None`: cuts to the
+/// centre), flute length, shank diameter, stick-out, tool length, teeth, holder diameter,
+/// holder length).
+type ToolRow = (
     u32,
     &'static str,
     f64,
-    f64,
+    Option<f64>,
     f64,
     f64,
     f64,
@@ -31,13 +32,13 @@ type CutterRow = (
     f64,
 );
 
-/// The cutters of `fixtures/tools/plunge-cutters.toml`.
-const CUTTERS: [CutterRow; 3] = [
+/// The plunge cutters of `fixtures/tools/plunge-cutters.toml`.
+const CUTTERS: [ToolRow; 3] = [
     (
         31,
         "plunge-d30",
         30.0,
-        8.0,
+        Some(8.0),
         45.0,
         28.0,
         140.0,
@@ -50,7 +51,7 @@ const CUTTERS: [CutterRow; 3] = [
         32,
         "plunge-d16",
         16.0,
-        5.0,
+        Some(5.0),
         30.0,
         15.0,
         140.0,
@@ -63,7 +64,7 @@ const CUTTERS: [CutterRow; 3] = [
         33,
         "plunge-d8",
         8.0,
-        3.0,
+        Some(3.0),
         20.0,
         7.5,
         140.0,
@@ -74,8 +75,28 @@ const CUTTERS: [CutterRow; 3] = [
     ),
 ];
 
-fn tool(i: usize) -> Result<Tool, Box<dyn Error>> {
-    let (number, name, d, edge, flute, shank, stick, length, teeth, hd, hl) = CUTTERS[i];
+/// The flat-bottom pilot drills of the same file.
+const DRILLS: [ToolRow; 2] = [
+    (
+        34,
+        "drill-d16",
+        16.0,
+        None,
+        90.0,
+        16.0,
+        140.0,
+        200.0,
+        2,
+        32.0,
+        40.0,
+    ),
+    (
+        35, "drill-d8", 8.0, None, 100.0, 8.0, 140.0, 190.0, 2, 25.0, 35.0,
+    ),
+];
+
+fn flat_tool(row: ToolRow) -> Result<Tool, Box<dyn Error>> {
+    let (number, name, d, edge, flute, shank, stick, length, teeth, hd, hl) = row;
     let mut cutter = Cutter::new(
         name,
         CutterShape::FlatEnd { radius: 0.5 * d },
@@ -93,40 +114,7 @@ fn tool(i: usize) -> Result<Tool, Box<dyn Error>> {
         cutter,
         teeth,
         tool_length_mm: length,
-        plunge_edge_length_mm: Some(edge),
-    })
-}
-
-/// One drill: (number, name, diameter, flute length, stick-out, tool length, holder diameter,
-/// holder length).
-type DrillRow = (u32, &'static str, f64, f64, f64, f64, f64, f64);
-
-/// The flat-bottom pilot drills of `fixtures/tools/plunge-cutters.toml`.
-const DRILLS: [DrillRow; 2] = [
-    (34, "drill-d16", 16.0, 90.0, 140.0, 200.0, 32.0, 40.0),
-    (35, "drill-d8", 8.0, 100.0, 140.0, 190.0, 25.0, 35.0),
-];
-
-fn drill(i: usize) -> Result<Tool, Box<dyn Error>> {
-    let (number, name, d, flute, stick, length, hd, hl) = DRILLS[i];
-    let mut cutter = Cutter::new(
-        name,
-        CutterShape::FlatEnd { radius: 0.5 * d },
-        flute,
-        0.5 * d,
-        stick,
-    )?;
-    cutter.holder = vec![HolderSegment {
-        bottom_radius: 0.5 * hd,
-        top_radius: 0.5 * hd,
-        length: hl,
-    }];
-    Ok(Tool {
-        number,
-        cutter,
-        teeth: 2,
-        tool_length_mm: length,
-        plunge_edge_length_mm: None,
+        plunge_edge_length_mm: edge,
     })
 }
 
@@ -142,7 +130,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let linker = Linker::new(SafetySurface::around_stock(&stock, 10.0)?);
     let mut start = 1.0;
     for i in 0..3 {
-        let tool = tool(i)?;
+        let tool = flat_tool(CUTTERS[i])?;
         let process = Process {
             spindle_rpm: [3000.0, 5000.0, 8000.0][i],
             feed_per_tooth_mm: 0.1,
@@ -153,7 +141,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             hub_allowance_mm: 0.5,
             rapid_mm_per_min: 10_000.0,
         };
-        let drill = drill(if i == 0 { 0 } else { 1 })?;
+        let drill = flat_tool(DRILLS[if i == 0 { 0 } else { 1 }])?;
         let params: toml::Table = toml::from_str(&format!(
             "start_fraction = {start:?}\n[pilot]\ntool = \"{}\"\nspindle_rpm = 4000.0\n\
              feed_per_tooth_mm = 0.05",
@@ -211,8 +199,8 @@ fn main() -> Result<(), Box<dyn Error>> {
             let section = plunge_opt::PlungeRoughing::from_spec(&spec)?;
             let plan = section.plan_section(&ctx, Some(&drill))?;
             let r = 0.5 * CUTTERS[i].2;
-            let core = r - CUTTERS[i].3;
-            let pilot_r = 0.5 * drill.cutter.shape.radius_at(0.0) * 2.0;
+            let core = r - CUTTERS[i].3.unwrap_or(r);
+            let pilot_r = drill.cutter.shape.radius_at(0.0);
             let drilled: Vec<Stroke> = plan
                 .feed
                 .pilots

@@ -165,7 +165,9 @@ pub fn plan_feed(input: &FeedInput<'_>) -> Result<FeedPlan, PlanError> {
             PlanError::param(
                 input.operation,
                 "pilot",
-                "an entry needs a pilot hole and the section names no pilot drill",
+                "a plunge needs a pilot hole and no pilot drill was given to plan with (name it \
+                 in [pilot] and plan with Operation::plan_with_steps), or choose entry = \
+                 \"lead_in\" or \"cleared\"",
             )
         })?;
         Ok(pilot_stroke(p, r))

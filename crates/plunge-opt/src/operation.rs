@@ -716,14 +716,13 @@ impl PlungeRoughing {
                 },
             });
         }
-        let planned = self.report(ctx, &plan, paths, lifted, channels);
+        let planned = self.report(&plan, paths, lifted, channels);
         Ok((planned, steps))
     }
 
     /// Metrics, plots and notes of a planned section.
     fn report(
         &self,
-        ctx: &PlanContext<'_>,
         plan: &SectionPlan,
         paths: Vec<cam_core::ToolPath>,
         lifted: usize,
@@ -973,7 +972,6 @@ impl PlungeRoughing {
                 crate::stock_clearance::STOCK_CLEARANCE_MM
             ));
         }
-        let _ = ctx;
         PlannedOperation {
             paths,
             metrics: m,
@@ -999,8 +997,8 @@ impl Operation for PlungeRoughing {
     /// Plans without the pilot drill: fails when an entry needs a pilot hole (the pipeline
     /// calls [`Operation::plan_with_steps`] with the drill).
     fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
-        let (planned, steps) = self.plan_all(ctx, None)?;
-        debug_assert!(steps.is_empty());
+        // Without the drill no pilot step is planned.
+        let (planned, _) = self.plan_all(ctx, None)?;
         Ok(planned)
     }
 

@@ -89,45 +89,38 @@ fn a_row_leaning_back_is_fed_the_way_it_leans() {
     let impeller = fixture();
     let builder = PostureBuilder::new(&impeller, &stock, R, 0.0, 0.5, 2.0, "test");
     let rows = vec![row.clone()];
-    let plan = plan_feed(&FeedInput {
-        rows: &rows,
-        radius: R,
-        core: CORE,
-        mode: EntryMode::Pilot,
-        pilot_radius: Some(CORE + 0.5),
-        material,
-        optimise: false,
-        w_step: 1e-5,
-        builder: &builder,
-        admissible: &|_| true,
-        operation: "test",
-    })
-    .unwrap();
-    assert_eq!(plan.segments.len(), 1);
-    assert_eq!(plan.segments[0].segment.feed, Feed::TowardOutlet);
-    assert_eq!(plan.segments[0].segment.stations[0], row.len() - 1);
-    assert_eq!(plan.segments[0].entry, EntryKind::Pilot);
-    assert_eq!(plan.pilots.len(), 1);
-    assert!(plan.travel.iter().all(|v| *v <= INTERFERENCE_TRAVEL_TOL_MM));
+    let plan = |mode: EntryMode, pilot_radius: Option<f64>| {
+        plan_feed(&FeedInput {
+            rows: &rows,
+            radius: R,
+            core: CORE,
+            mode,
+            pilot_radius,
+            material,
+            optimise: false,
+            w_step: 1e-5,
+            builder: &builder,
+            admissible: &|_| true,
+            operation: "test",
+        })
+        .unwrap()
+    };
+    let plan_pilot = plan(EntryMode::Pilot, Some(CORE + 0.5));
+    assert_eq!(plan_pilot.segments.len(), 1);
+    assert_eq!(plan_pilot.segments[0].segment.feed, Feed::TowardOutlet);
+    assert_eq!(plan_pilot.segments[0].segment.stations[0], row.len() - 1);
+    assert_eq!(plan_pilot.segments[0].entry, EntryKind::Pilot);
+    assert_eq!(plan_pilot.pilots.len(), 1);
+    assert!(plan_pilot
+        .travel
+        .iter()
+        .all(|v| *v <= INTERFERENCE_TRAVEL_TOL_MM));
     // Without a drill (entry = "lead_in") the entry cannot be handled: the segment is fed
     // from its other end only if that end does not drill either; here both do.
-    let plan = plan_feed(&FeedInput {
-        rows: &rows,
-        radius: R,
-        core: CORE,
-        mode: EntryMode::LeadIn,
-        pilot_radius: None,
-        material,
-        optimise: false,
-        w_step: 1e-5,
-        builder: &builder,
-        admissible: &|_| true,
-        operation: "test",
-    })
-    .unwrap();
-    assert_eq!(plan.segments[0].entry, EntryKind::Unhandled);
-    assert!(plan.travel[0] > 10.0);
-    assert!(plan.travel[1..]
+    let plan_lead_in = plan(EntryMode::LeadIn, None);
+    assert_eq!(plan_lead_in.segments[0].entry, EntryKind::Unhandled);
+    assert!(plan_lead_in.travel[0] > 10.0);
+    assert!(plan_lead_in.travel[1..]
         .iter()
         .all(|v| *v <= INTERFERENCE_TRAVEL_TOL_MM));
 }
