@@ -800,6 +800,12 @@ pub struct DesignClearance<'a> {
     /// The same lever arm for the cutter samples alone (highest sample plus the widest
     /// sample radius): the flutes' part of [`DesignClearance::segment_clearance`].
     flute_reach_mm: f64,
+    /// Height of the ball centre above the tip for ball and tapered ball ends.
+    ball_centre_mm: Option<f64>,
+    /// How far a cutter sample's sphere reaches beyond the tool's surface at most: a cone
+    /// of half angle θ is `ρ·cos θ` from the axis point where the cross-section's radius is
+    /// `ρ`, so the sphere pokes out by `ρ(1 − cos θ)`.
+    sphere_poke_mm: f64,
 }
 
 impl std::fmt::Debug for DesignClearance<'_> {
@@ -942,6 +948,13 @@ impl<'a> DesignClearance<'a> {
             .iter()
             .map(|h| h.bottom_radius.max(h.top_radius))
             .fold(widest, f64::max);
+        let sphere_poke_mm = match c.shape {
+            CutterShape::TaperedBallEnd { half_angle, .. }
+            | CutterShape::TaperedFlatEnd { half_angle, .. } => {
+                samples.iter().map(|s| s.1).fold(0.0, f64::max) * (1.0 - half_angle.cos())
+            }
+            _ => 0.0,
+        };
         Ok(Self {
             impeller,
             options,
@@ -958,6 +971,13 @@ impl<'a> DesignClearance<'a> {
             rows,
             reach_mm: top + widest,
             flute_reach_mm,
+            sphere_poke_mm,
+            ball_centre_mm: match c.shape {
+                CutterShape::BallEnd { radius } => Some(radius),
+                CutterShape::TaperedBallEnd { ball_radius, .. } => Some(ball_radius),
+                _ => None,
+            }
+            .filter(|h| *h <= c.flute_length),
         })
     }
 
@@ -968,6 +988,21 @@ impl<'a> DesignClearance<'a> {
             options,
             ..self.clone()
         }
+    }
+
+    /// Height of the ball centre above the tip (ball and tapered ball ends): the sample
+    /// there is the ball itself, exactly; the samples below it bound the ball from outside
+    /// (conservative spheres that reach below the tip).
+    pub fn ball_centre_mm(&self) -> Option<f64> {
+        self.ball_centre_mm
+    }
+
+    /// The largest amount by which [`Self::clearance`] of the cutter can read below the true
+    /// clearance near a surface (mm): half the sampling tolerance (the rim band between two
+    /// samples) plus how far a sample's sphere pokes out of a tapered cutter's cone. A check
+    /// against a floor the tool is meant to reach exactly allows this much below it.
+    pub fn sampling_error_mm(&self) -> f64 {
+        0.5 * self.options.sample_tol_mm + self.sphere_poke_mm
     }
 
     /// The options of this query.
@@ -1139,6 +1174,20 @@ impl<'a> DesignClearance<'a> {
         )
         .distance_mm
             >= min_clearance_mm
+    }
+
+    /// The smallest clearance when it is below `cap_mm`, else a value of at least `cap_mm`
+    /// (the search stops refining where nothing can fall below the cap): a lower bound of
+    /// the clearance for the certified motion checks, which need no more than that.
+    pub fn clearance_capped(&self, cl: &CutterLocation, cap_mm: f64) -> Clearance {
+        self.evaluate(
+            cl,
+            Want {
+                cap: cap_mm,
+                fail_below: f64::NEG_INFINITY,
+                upper: true,
+            },
+        )
     }
 
     /// [`Self::clearance`] when it is at least `min_clearance_mm`, else `None`: one query where

@@ -12,6 +12,8 @@
 //!   shroud contour, every blade), with the part that is nearest: a triangulated
 //!   [`DesignMesh`] (shared by every tool's query) as prefilter, exact NURBS distances near
 //!   the surface for the cutter, shank and holder frusta as convex shapes against the mesh;
+//! - [`pass_check`]: the whole tool (cutter, shank, holder) of a cutting pass, every posture
+//!   and every motion between two, against the whole design with a floor per part;
 //! - [`linking`]: retract along the tool axis to a safety surface, travel on it, approach
 //!   along the tool axis;
 //! - [`pattern`]: rotational copy of one channel's or blade's paths to every channel/blade
@@ -35,6 +37,7 @@ pub mod metrics;
 pub mod operation;
 pub mod order;
 pub mod params;
+pub mod pass_check;
 pub mod pattern;
 pub mod process;
 pub mod tool;
@@ -48,6 +51,7 @@ pub use metrics::{MetricValue, Metrics, Plot, PlotKind, PlotSeries};
 pub use operation::{
     Builder, Operation, OperationSpec, PlanContext, PlannedOperation, PlannedStep, StepTool,
 };
+pub use pass_check::{PassCheck, PassFloors, PassViolation, PostureClearance};
 pub use process::Process;
 pub use tool::Tool;
 
