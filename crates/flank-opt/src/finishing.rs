@@ -36,12 +36,13 @@ use crate::catalogue::Catalogue;
 use crate::geometry::{ball_radius, guides_through, FlankSide, InitialPath};
 use crate::measure::{measure_written_path, DenseGrid, WrittenDeviation};
 use crate::problem::{deviations_max, Family, FlankProblem, HistoryRow, Mode, ProblemSettings};
+use crate::rows::{self, RowName};
 use crate::slp::{self, SlpOptions, Termination};
 use crate::{FlankError, FLANK_FINISHING};
 use cam_core::{CutterShape, Move, ToolPath};
 use cam_plan::{
-    Metrics, Operation, OperationSpec, PlanContext, PlanError, PlannedOperation, Plot, PlotKind,
-    PlotSeries,
+    Metrics, Operation, OperationSpec, PassCheck, PassFloors, PlanContext, PlanError,
+    PlannedOperation, Plot, PlotKind, PlotSeries, Row,
 };
 use impeller_model::Side;
 use rayon::prelude::*;
@@ -153,6 +154,9 @@ pub struct FinishingParams {
     /// The catalogue (default: 1–6 mm by 0.25 mm, 0–8° by 0.5°).
     #[serde(default)]
     pub catalogue: Option<Catalogue>,
+    /// Blade rows finished: `["main", "splitter"]` (default: both rows the impeller has).
+    #[serde(default)]
+    pub rows: Option<Vec<RowName>>,
 }
 
 impl FinishingParams {
@@ -687,11 +691,19 @@ impl FlankFinishing {
             output_locations: p.output_locations,
         };
         let catalogue = p.catalogue.unwrap_or_default();
-        let sides: &[Side] = match p.sides {
+        let side_list: &[Side] = match p.sides {
             Sides::Both => &[Side::Pressure, Side::Suction],
             Sides::Pressure => &[Side::Pressure],
             Sides::Suction => &[Side::Suction],
         };
+        let row_list = match &p.rows {
+            Some(names) => rows::rows_of(ctx.impeller, names, true)?,
+            None => rows::rows_of(ctx.impeller, &rows::default_rows(), false)?,
+        };
+        let sides: Vec<(Row, Side)> = row_list
+            .iter()
+            .flat_map(|&r| side_list.iter().map(move |&s| (r, s)))
+            .collect();
         let mut out = PlannedOperation::default();
         let mut metrics = Metrics::new();
         let mut over = 0.0f64;
@@ -703,6 +715,9 @@ impl FlankFinishing {
         let mut uncertified = 0usize;
         let mut uncertified_over = 0.0f64;
         let mut worst_at: Option<(Side, crate::measure::DensePoint)> = None;
+        let mut whole_tool_misses: Vec<String> = Vec::new();
+        let mut hub_lifts = 0usize;
+        let mut hub_lift_max = 0.0f64;
         let mut clear = f64::INFINITY;
         let mut hub = 0.0f64;
         let mut iterations = 0;
@@ -711,8 +726,7 @@ impl FlankFinishing {
         let mut cylinder_k = f64::NAN;
         let mut initial_dev = 0.0f64;
         let mut final_dev = 0.0f64;
-        let mut one_path = ToolPath::new(&self.name, &self.tool);
-        let count = ctx.impeller.main().count();
+        let mut row_paths: Vec<(Row, ToolPath)> = Vec::new();
         // The SLP runs are independent of each other (each side's job path; on the first
         // side also the shape study, the best cylinder and the second start): run them in
         // parallel, then report them in the order of the sides.
@@ -726,8 +740,9 @@ impl FlankFinishing {
         let side_runs: Vec<Result<SideRuns, FlankError>> = sides
             .par_iter()
             .enumerate()
-            .map(|(k, &side)| {
-                let fresh = FlankSide::new(ctx.impeller, side, p.samples_along, p.samples_across)?;
+            .map(|(k, &(row, side))| {
+                let fresh =
+                    FlankSide::of_row(ctx.impeller, row, side, p.samples_along, p.samples_across)?;
                 let first = k == 0;
                 let job = || {
                     let mut fs = fresh.clone();
@@ -761,7 +776,7 @@ impl FlankFinishing {
                 })
             })
             .collect();
-        for (&side, runs_of_side) in sides.iter().zip(side_runs) {
+        for (&(row, side), runs_of_side) in sides.iter().zip(side_runs) {
             let SideRuns {
                 fresh: job_side,
                 job,
@@ -833,7 +848,10 @@ impl FlankFinishing {
             out.plots.push(deviation_map(
                 &fs,
                 &res.deviations,
-                &format!("flank finishing: signed deviation over the {side:?} side (mm)"),
+                &format!(
+                    "flank finishing: signed deviation over the {} blade's {side:?} side (mm)",
+                    rows::label(row)
+                ),
             ));
             runs.push(("job tool path (minimax)".into(), res.history.clone()));
             if let Some(cylinder) = cylinder {
@@ -930,18 +948,65 @@ impl FlankFinishing {
                 .map(|(l, h)| (l.as_str(), h.as_slice()))
                 .collect();
             out.plots.extend(history_plots(&refs));
-            // The side's pass, linked to the previous one.
-            let moves: Vec<Move> = res.locations.iter().map(|cl| Move::feed(*cl)).collect();
-            if let (Some(last), Some(first)) = (one_path.moves.last(), moves.first()) {
-                let link = ctx
-                    .link(&last.cl, &first.cl, APPROACH_MM)
-                    .map_err(|e| FlankError::Geometry(e.to_string()))?;
-                one_path.moves.extend(link);
+            // The written locations between the optimiser's hub-tangency samples may hang the
+            // ball over the hub body's edge (the inlet corner of impeller-8+8's hub: 0.03 mm
+            // into it): each such location is lifted along its axis until the ball keeps the
+            // hub tangency tolerance.
+            let (locations, lifted, lift_max) = lift_off_hub(
+                ctx,
+                &res.locations,
+                ball_radius(&cutter.shape),
+                run.problem.hub_tol,
+            );
+            hub_lifts += lifted;
+            hub_lift_max = hub_lift_max.max(lift_max);
+            // The whole tool along the written pass against the whole design: a finishing
+            // pass may touch its side within the overcut tolerance (its accuracy there is the
+            // dense measurement's; this check is for the rest of the design), its motions
+            // within the chord tolerance more, nothing else nearer.
+            let floor = -(run.problem.overcut_tol + ctx.tolerances.chord_tol);
+            let check = PassCheck::new(
+                ctx.clearance,
+                PassFloors {
+                    blades_mm: floor,
+                    hub_mm: floor - run.problem.hub_tol,
+                    motion_tol_mm: ctx.tolerances.chord_tol,
+                },
+                cutter.flute_length,
+            );
+            let violations = check.check(&locations);
+            let worst_violation = violations
+                .iter()
+                .max_by(|a, b| a.depth_mm().total_cmp(&b.depth_mm()));
+            if let Some(v) = worst_violation {
+                whole_tool_misses.push(format!(
+                    "{} blade {side:?} side: {} of {} postures and motions of the pass come \
+                     below their floor; worst: {}",
+                    rows::label(row),
+                    violations.len(),
+                    2 * locations.len() - 1,
+                    v.describe()
+                ));
             }
-            one_path.moves.extend(moves);
+            // The side's pass, linked to the previous one of its row.
+            let moves: Vec<Move> = locations.iter().map(|cl| Move::feed(*cl)).collect();
+            if row_paths.last().is_none_or(|(r, _)| *r != row) {
+                row_paths.push((row, ToolPath::new(&self.name, &self.tool)));
+            }
+            if let Some((_, one_path)) = row_paths.last_mut() {
+                if let (Some(last), Some(first)) = (one_path.moves.last(), moves.first()) {
+                    let link = ctx
+                        .link(&last.cl, &first.cl, APPROACH_MM)
+                        .map_err(|e| FlankError::Geometry(e.to_string()))?;
+                    one_path.moves.extend(link);
+                }
+                one_path.moves.extend(moves);
+            }
         }
-        ctx.close(&mut one_path, APPROACH_MM)
-            .map_err(|e| FlankError::Geometry(e.to_string()))?;
+        for (_, one_path) in &mut row_paths {
+            ctx.close(one_path, APPROACH_MM)
+                .map_err(|e| FlankError::Geometry(e.to_string()))?;
+        }
         // The accuracy gate: a finishing pass that misses its tolerances is not emitted.
         let pr = &run.problem;
         let misses: Vec<String> = [
@@ -974,6 +1039,7 @@ impl FlankFinishing {
                 pr.min_clearance
             )
         }))
+        .chain(whole_tool_misses.iter().map(|m| format!("whole tool: {m}")))
         .collect();
         if !misses.is_empty() {
             return Err(FlankError::NotAccurate(format!(
@@ -984,10 +1050,24 @@ impl FlankFinishing {
                 misses.join(", ")
             )));
         }
-        let order: Vec<usize> = (0..count).collect();
-        out.paths = cam_plan::pattern::copy_to(&one_path, ctx.impeller.main().pitch_rad(), &order);
+        for (row, one_path) in &row_paths {
+            let (pitch, count) = rows::pitch_and_count(ctx.impeller, *row)?;
+            let order: Vec<usize> = (0..count).collect();
+            out.paths
+                .extend(cam_plan::pattern::copy_to(one_path, pitch, &order));
+        }
+        metrics.text(
+            "rows",
+            row_paths
+                .iter()
+                .map(|(r, _)| rows::label(*r))
+                .collect::<Vec<_>>()
+                .join(", "),
+        );
         metrics.number("max_overcut_mm", over);
         metrics.number("max_undercut_mm", under);
+        metrics.count("hub_lifted_locations", hub_lifts);
+        metrics.number("max_hub_lift_mm", hub_lift_max);
         metrics.number("sample_max_overcut_mm", sample_over);
         metrics.number("sample_max_undercut_mm", sample_under);
         metrics.count("dense_points", dense_points);
@@ -1005,6 +1085,52 @@ impl FlankFinishing {
         out.metrics = metrics;
         Ok(out)
     }
+}
+
+/// Bisection steps of a location's lift off the hub (the bracket is the ball radius).
+const HUB_LIFT_BISECTIONS: usize = 40;
+
+/// `locations` with every ball (radius `r`) that reaches deeper than `hub_tol` into the hub
+/// body (exact distance of its centre, [`cam_plan::DesignClearance::hub_signed_distance`],
+/// the body capped by the inlet face and the outlet cylinder) lifted along its axis until it
+/// keeps `hub_tol` (bisection); with the number of locations lifted and the largest lift.
+/// O(locations · bisections) hub distances.
+pub fn lift_off_hub(
+    ctx: &PlanContext<'_>,
+    locations: &[cam_core::CutterLocation],
+    r: f64,
+    hub_tol: f64,
+) -> (Vec<cam_core::CutterLocation>, usize, f64) {
+    let gap = |cl: &cam_core::CutterLocation, lift: f64| {
+        let c = cl.tip + cl.axis.into_inner() * (r + lift);
+        ctx.clearance.hub_signed_distance(&c) - r + hub_tol
+    };
+    let mut lifted = 0;
+    let mut largest = 0.0f64;
+    let out = locations
+        .iter()
+        .map(|cl| {
+            if gap(cl, 0.0) >= 0.0 || gap(cl, r) < 0.0 {
+                return *cl;
+            }
+            let (mut lo, mut hi) = (0.0, r);
+            for _ in 0..HUB_LIFT_BISECTIONS {
+                let mid = 0.5 * (lo + hi);
+                if gap(cl, mid) >= 0.0 {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            lifted += 1;
+            largest = largest.max(hi);
+            cam_core::CutterLocation {
+                tip: cl.tip + cl.axis.into_inner() * hi,
+                axis: cl.axis,
+            }
+        })
+        .collect();
+    (out, lifted, largest)
 }
 
 /// The SLP runs of one blade side, computed in parallel before they are reported.

@@ -4,6 +4,7 @@
 
 use crate::FlankError;
 use cam_core::{CutterShape, GuideCurve, Point3, Vector3};
+use cam_plan::Row;
 use impeller_model::{Blade, Impeller, MeridionalCurve, RevolvedSurface, Side};
 use nalgebra::Vector2;
 use nurbs::fit::{interpolate_curve, Parametrisation};
@@ -89,12 +90,24 @@ impl FlankSide {
     /// band are overcut-only ([`crate::problem`]).
     /// O(nu·(nv + FINE_PER_SAMPLE)) surface evaluations.
     pub fn new(impeller: &Impeller, side: Side, nu: usize, nv: usize) -> Result<Self, FlankError> {
+        Self::of_row(impeller, Row::Main, side, nu, nv)
+    }
+
+    /// [`FlankSide::new`] for the reference blade of `row` (instance 0 of the main blades or
+    /// of the splitters); the facing side is searched among both neighbours of either row.
+    pub fn of_row(
+        impeller: &Impeller,
+        row: Row,
+        side: Side,
+        nu: usize,
+        nv: usize,
+    ) -> Result<Self, FlankError> {
         if nu < 2 || nv < 2 {
             return Err(FlankError::Param(
                 "sample grid needs at least 2 × 2 points".into(),
             ));
         }
-        let set = impeller.main();
+        let set = crate::rows::blade_set(impeller, row)?;
         let blade = set.blade().clone();
         let v_range = match blade.design() {
             Some(_) => blade.hub_shroud_v(side),
@@ -121,17 +134,7 @@ impl FlankSide {
             FlankError::Geometry(format!("{side:?} side: no normal at its middle"))
         })?;
         let probe = s.point(um, vm) + n_mid;
-        let count = set.count();
-        let mut candidates: Vec<Blade> = [1, count.saturating_sub(1)]
-            .into_iter()
-            .filter(|&k| k > 0 && k < count)
-            .map(|k| set.instance(k))
-            .collect();
-        // Splitters sit between main blades: the nearest one may face the side.
-        if let Some(sp) = impeller.splitter() {
-            let n = sp.count();
-            candidates.extend([0, n.saturating_sub(1)].into_iter().map(|k| sp.instance(k)));
-        }
+        let candidates = crate::rows::neighbours(impeller, row);
         let mut best: Option<(f64, Blade, Side)> = None;
         for other in candidates {
             for os in [Side::Pressure, Side::Suction] {

@@ -16,6 +16,15 @@
 //!   sub-ruled strips within the semi-finish tolerance, one flank pass per strip from the
 //!   shroud down; compared with isoparametric point milling at the same scallop height.
 //!
+//! - [`BLADE_POINT_FINISHING`] ([`point_finishing`]): any blade side, ruled or free-form.
+//!   [`regions`] chooses per region: a flank pass over a sub-ruled strip where it is within
+//!   the tolerance and its whole tool is clear ([`cam_plan::PassCheck`]), five-axis point
+//!   milling ([`point`]) elsewhere.
+//!
+//! Every operation plans both rows of blades ([`rows`]: the reference blade of each row,
+//! copied to every blade of the row) and checks its passes for the whole tool against the
+//! whole design.
+//!
 //! The LPs: a primal–dual interior point specialised to the SLP subproblem ([`lp`]: the
 //! elastic slacks eliminated, a dense normal system of the few hundred path variables),
 //! several times faster there than clarabel, the workspace's general conic solver (DESIGN §2),
@@ -29,13 +38,18 @@ pub mod finishing;
 pub mod geometry;
 pub mod lp;
 pub mod measure;
+pub mod point;
+pub mod point_finishing;
 pub mod problem;
+pub mod regions;
+pub mod rows;
 pub mod semi;
 pub mod slp;
 
 pub use catalogue::Catalogue;
 pub use finishing::{build_flank_finishing, FinishingParams};
 pub use geometry::{FlankSide, InitialPath};
+pub use point_finishing::{build_blade_point_finishing, BLADE_POINT_FINISHING};
 pub use semi::{build_flank_semi_finishing, SemiParams};
 
 /// Kind name of flank finishing in job files.

@@ -17,24 +17,31 @@
 //!    by more than the job's `chord_tol` ([`pass_stations`]: around a rounded leading edge);
 //! 3. interference check: the design side below the strip (the lower strips, still carrying
 //!    their allowance) and the hub must stay at least `allowance − strip_tol` from the pass's
-//!    swept envelope ([`cam_core::SweptEnvelope`], certified distances); a pass that comes
-//!    nearer is lifted along its axes by bisection until it keeps that distance;
+//!    swept envelope ([`cam_core::SweptEnvelope`], certified distances), and every ball
+//!    centre its hub allowance less `strip_tol` from the hub body; a pass that comes nearer
+//!    is lifted along its axes by bisection until it keeps that distance ([`strip_pass`]).
+//!    The pass is then checked for its whole tool against the whole design
+//!    ([`crate::regions`]); a strip whose pass is not clear is point-milled instead;
 //! 4. baseline: isoparametric point milling of the same side with the same tool: zig-zag
 //!    passes along u, step-over across for the scallop height `h` equal to `strip_tol_mm`
 //!    (`w = 2√(2Rh − h²)` between passes on a locally flat side, R the ball radius); its path
 //!    length is the sum of the pass lengths and step-overs (arc lengths from 200-point
 //!    polylines).
 //!
-//! Metrics: `sub_ruled_strips` (over every side), `max_deviation_mm` (largest strip
-//! deviation), `point_milling_path_length_mm`, plus `flank_path_length_mm` (cutting moves of
-//! one blade) and `interference_lifts` (passes lifted). Complexity per side: the strip
-//! search (impeller-model) plus O(strips · passes_along · samples) envelope queries.
+//! Both rows are semi-finished (`rows`). Metrics: `sub_ruled_strips` (over every side of
+//! both rows), `max_deviation_mm` (largest strip deviation), `point_milling_path_length_mm`,
+//! `flank_path_length_mm` and `point_path_length_mm` (one blade of each row),
+//! `interference_lifts` (passes lifted) and the region metrics of [`crate::regions`].
+//! Complexity per side: the strip search (impeller-model) plus O(strips · passes_along ·
+//! samples) envelope queries, the whole-tool checks and the point milling of what is not
+//! flanked.
 
 use crate::geometry::{ball_radius, guides_through, member_radius};
+use crate::point::{AxisParams, PointSettings};
+use crate::regions::{self, Method, MethodChoice, SideSettings};
+use crate::rows::RowName;
 use crate::{FlankError, FLANK_SEMI_FINISHING};
-use cam_core::{
-    CutterShape, EnvelopeOptions, Move, Point3, SphereFamily, SweptEnvelope, ToolPath, Vector3,
-};
+use cam_core::{CutterShape, EnvelopeOptions, Point3, SphereFamily, SweptEnvelope, Vector3};
 use cam_plan::{Metrics, Operation, OperationSpec, PlanContext, PlanError, PlannedOperation};
 use impeller_model::{Blade, Side};
 use serde::Deserialize;
@@ -57,6 +64,60 @@ pub struct SemiParams {
     /// Cutter locations per pass (default 30).
     #[serde(default = "default_along")]
     pub passes_along: usize,
+    /// Blade rows semi-finished: `["main", "splitter"]` (default: both rows the impeller
+    /// has).
+    #[serde(default)]
+    pub rows: Option<Vec<RowName>>,
+    /// `auto` (default: flank passes where clear, point milling elsewhere), `flank` or
+    /// `point`.
+    #[serde(default = "default_method")]
+    pub method: MethodChoice,
+    /// Preferred tilt of the point-milling axis from the side (deg; see
+    /// [`AxisParams`]).
+    #[serde(default)]
+    pub tilt_deg: Option<f64>,
+    /// Largest tilt searched (deg, default 60).
+    #[serde(default = "default_max_tilt")]
+    pub max_tilt_deg: f64,
+    /// Largest lead searched (deg, default 30).
+    #[serde(default = "default_max_lead")]
+    pub max_lead_deg: f64,
+    /// Step of the accessibility search (deg, default 3).
+    #[serde(default = "default_search_step")]
+    pub search_step_deg: f64,
+    /// Largest turn of the axis between two postures (deg, default 3).
+    #[serde(default = "default_axis_step")]
+    pub max_axis_step_deg: f64,
+}
+
+impl SemiParams {
+    /// The point-milling axis keys.
+    pub fn axis(&self) -> AxisParams {
+        AxisParams {
+            tilt_deg: self.tilt_deg,
+            max_tilt_deg: self.max_tilt_deg,
+            max_lead_deg: self.max_lead_deg,
+            search_step_deg: self.search_step_deg,
+            max_axis_step_deg: self.max_axis_step_deg,
+        }
+    }
+}
+
+fn default_max_tilt() -> f64 {
+    AxisParams::default().max_tilt_deg
+}
+fn default_max_lead() -> f64 {
+    AxisParams::default().max_lead_deg
+}
+fn default_search_step() -> f64 {
+    AxisParams::default().search_step_deg
+}
+fn default_axis_step() -> f64 {
+    AxisParams::default().max_axis_step_deg
+}
+
+fn default_method() -> MethodChoice {
+    MethodChoice::Auto
 }
 
 /// The operation.
@@ -73,6 +134,7 @@ pub fn build_flank_semi_finishing(spec: &OperationSpec) -> Result<Box<dyn Operat
     if !(params.strip_tol_mm.is_finite() && params.strip_tol_mm > 0.0) {
         return Err(PlanError::param(&spec.name, "strip_tol_mm", "must be > 0"));
     }
+    params.axis().validate().map_err(|e| e.plan(&spec.name))?;
     if !(4..=500).contains(&params.passes_along) {
         return Err(PlanError::param(
             &spec.name,
@@ -280,9 +342,14 @@ pub fn pass_stations(
 }
 
 /// One flank pass over a strip.
-struct Pass {
-    locations: Vec<cam_core::CutterLocation>,
-    lifted: bool,
+#[derive(Debug, Clone)]
+pub struct StripPass {
+    /// The written cutter locations.
+    pub locations: Vec<cam_core::CutterLocation>,
+    /// Whether the pass was lifted along its axes.
+    pub lifted: bool,
+    /// The swept envelope of the pass (its tool surface, for measurements).
+    pub envelope: SweptEnvelope,
 }
 
 fn polyline_length(pts: &[Vector3]) -> f64 {
@@ -338,175 +405,188 @@ impl FlankSemiFinishing {
         let cutter = &ctx.tool.cutter;
         let shape = cutter.shape;
         let r = ball_radius(&shape);
-        if !matches!(
-            shape,
-            CutterShape::BallEnd { .. } | CutterShape::TaperedBallEnd { .. }
-        ) {
-            return Err(FlankError::Param(format!(
-                "flank semi-finishing needs a ball or tapered ball end, not {shape:?}"
-            )));
-        }
-        let allowance = ctx.process.blade_allowance_mm;
-        let blade = ctx.impeller.main().blade().clone();
-        let mut strips_total = 0;
-        let mut max_dev = 0.0f64;
+        let half_angle = match shape {
+            CutterShape::BallEnd { .. } => 0.0,
+            CutterShape::TaperedBallEnd { half_angle, .. } => half_angle,
+            other => {
+                return Err(FlankError::Param(format!(
+                    "flank semi-finishing needs a ball or tapered ball end, not {other:?}"
+                )))
+            }
+        };
+        let row_list = match &p.rows {
+            Some(names) => crate::rows::rows_of(ctx.impeller, names, true)?,
+            None => crate::rows::rows_of(ctx.impeller, &crate::rows::default_rows(), false)?,
+        };
+        let settings = SideSettings {
+            choice: p.method,
+            strip_tol_mm: p.strip_tol_mm,
+            passes_along: p.passes_along,
+            point: PointSettings {
+                ball_radius: r,
+                half_angle,
+                allowance_mm: ctx.process.blade_allowance_mm,
+                hub_allowance_mm: ctx.process.hub_allowance_mm,
+                scallop_mm: p.strip_tol_mm,
+                chord_mm: ctx.tolerances.chord_tol,
+                tol_mm: p.strip_tol_mm,
+                limits: p.axis().limits(half_angle),
+                max_axis_step: p.max_axis_step_deg.to_radians(),
+            },
+        };
+        let plan = regions::plan_rows(ctx, &self.name, &self.tool, &row_list, &settings)?;
         let mut baseline = 0.0;
-        let mut lifts = 0;
-        let mut path = ToolPath::new(&self.name, &self.tool);
-        for side in [Side::Pressure, Side::Suction] {
-            let v_range = match blade.design() {
-                Some(_) => blade.hub_shroud_v(side),
-                None => ctx.impeller.span_v_range(&blade, side).map_err(|e| {
-                    FlankError::Geometry(format!(
-                        "{side:?} side: hub or shroud edge not found: {e}"
-                    ))
-                })?,
-            };
-            let strips =
-                impeller_model::ruled::sub_ruled_strips(&blade, side, v_range, p.strip_tol_mm)?;
-            strips_total += strips.len();
-            baseline += point_milling_length(&blade, side, v_range, r, p.strip_tol_mm);
-            for strip in &strips {
-                max_dev = max_dev.max(strip.max_deviation_mm);
-                let pass = self.strip_pass(ctx, &blade, side, strip, v_range, allowance)?;
-                lifts += usize::from(pass.lifted);
-                let moves: Vec<Move> = pass.locations.iter().map(|cl| Move::feed(*cl)).collect();
-                if let (Some(last), Some(first)) = (path.moves.last(), moves.first()) {
-                    let link = ctx
-                        .link(&last.cl, &first.cl, 5.0)
-                        .map_err(|e| FlankError::Geometry(e.to_string()))?;
-                    path.moves.extend(link);
-                }
-                path.moves.extend(moves);
+        for &row in &row_list {
+            let blade = crate::rows::blade_set(ctx.impeller, row)?.blade().clone();
+            for side in [Side::Pressure, Side::Suction] {
+                let v_range = regions::side_v_range(ctx, &blade, side)?;
+                baseline += point_milling_length(&blade, side, v_range, r, p.strip_tol_mm);
             }
         }
-        let flank_len = path.cutting_length_mm();
-        ctx.close(&mut path, 5.0)
-            .map_err(|e| FlankError::Geometry(e.to_string()))?;
-        let count = ctx.impeller.main().count();
-        let order: Vec<usize> = (0..count).collect();
-        let mut out = PlannedOperation {
-            paths: cam_plan::pattern::copy_to(&path, ctx.impeller.main().pitch_rad(), &order),
-            ..Default::default()
-        };
+        let flank_len: f64 = plan
+            .regions()
+            .filter(|g| g.method != Method::Point)
+            .flat_map(|g| g.runs.iter())
+            .map(|run| {
+                run.windows(2)
+                    .map(|w| (w[1].tip - w[0].tip).norm())
+                    .sum::<f64>()
+            })
+            .sum();
+        let point_len: f64 = plan
+            .regions()
+            .filter(|g| g.method == Method::Point)
+            .flat_map(|g| g.runs.iter())
+            .map(|run| {
+                run.windows(2)
+                    .map(|w| (w[1].tip - w[0].tip).norm())
+                    .sum::<f64>()
+            })
+            .sum();
         let mut m = Metrics::new();
-        m.count("sub_ruled_strips", strips_total);
-        m.number("max_deviation_mm", max_dev);
+        m.count(
+            "sub_ruled_strips",
+            plan.sides.iter().map(|(_, _, s)| s.strips).sum(),
+        );
+        m.number(
+            "max_deviation_mm",
+            plan.sides
+                .iter()
+                .map(|(_, _, s)| s.max_strip_deviation_mm)
+                .fold(0.0, f64::max),
+        );
         m.number("point_milling_path_length_mm", baseline);
         m.number("flank_path_length_mm", flank_len);
-        m.count("interference_lifts", lifts);
-        out.metrics = m;
+        m.number("point_path_length_mm", point_len);
+        plan.metrics(&mut m);
+        m.text(
+            "rows",
+            row_list
+                .iter()
+                .map(|r| crate::rows::label(*r))
+                .collect::<Vec<_>>()
+                .join(", "),
+        );
+        let lifts = plan.regions().filter(|g| g.lifted).count();
+        let mut notes = plan.notes();
         if lifts > 0 {
-            out.notes.push(format!(
+            notes.push(format!(
                 "{lifts} pass(es) lifted along the axis to keep the allowance on the strips \
                  below and the hub"
             ));
         }
-        Ok(out)
-    }
-
-    /// The flank pass of one strip (module docs, steps 2–3).
-    fn strip_pass(
-        &self,
-        ctx: &PlanContext<'_>,
-        blade: &Blade,
-        side: Side,
-        strip: &impeller_model::ruled::RuledStrip,
-        v_range: (f64, f64),
-        allowance: f64,
-    ) -> Result<Pass, FlankError> {
-        let cutter = &ctx.tool.cutter;
-        let shape = cutter.shape;
-        let r = ball_radius(&shape);
-        let n = self.params.passes_along;
-        let s = blade.side(side);
-        let ((u0, u1), _) = s.domain();
-        let (a, b) = strip.v_range;
-        let chord = ctx.tolerances.chord_tol;
-        let stations = pass_stations(blade, side, (a, b), &shape, allowance, n, chord)?;
-        let mut centres = Vec::with_capacity(stations.len());
-        let mut tops = Vec::with_capacity(stations.len());
-        let mut upper: f64 = 0.0;
-        let mut axes = Vec::with_capacity(stations.len());
-        for st in stations {
-            upper = upper.max(st.upper_contact - r);
-            centres.push(st.centre);
-            axes.push(st.axis);
-        }
-        let upper = upper.max(r);
-        for (c, ax) in centres.iter().zip(&axes) {
-            tops.push(c + ax * upper);
-        }
-        // Interference check points: the side below the strip and the hub under the pass.
-        let mut checks: Vec<(Point3, f64)> = Vec::new();
-        let (cu, cv) = CHECK_GRID;
-        if a > v_range.0 + 1e-9 {
-            for i in 0..cu {
-                let u = u0 + (u1 - u0) * i as f64 / (cu - 1) as f64;
-                for j in 0..cv {
-                    let v = v_range.0 + (a - v_range.0) * j as f64 / (cv - 1) as f64;
-                    let q = s.point(u, v);
-                    if ctx.impeller.hub().signed_distance(&q) > r {
-                        checks.push((Point3::from(q), allowance));
-                    }
-                }
-            }
-        }
-        for c in &centres {
-            // The hub point below each ball centre.
-            let hub = ctx.impeller.hub();
-            let (t, phi, _) = hub.closest(c);
-            checks.push((
-                Point3::from(hub.point(t, phi)),
-                ctx.process.hub_allowance_mm,
+        let point_regions = plan.regions().filter(|g| g.method == Method::Point).count();
+        if point_regions > 0 {
+            notes.push(format!(
+                "{point_regions} region(s) point-milled where no flank pass is clear: {}",
+                plan.regions()
+                    .filter(|g| g.method == Method::Point)
+                    .map(|g| format!(
+                        "{} {:?} v {:.3}–{:.3} ({})",
+                        crate::rows::label(g.row),
+                        g.side,
+                        g.v_range.0,
+                        g.v_range.1,
+                        g.reason
+                    ))
+                    .collect::<Vec<_>>()
+                    .join("; ")
             ));
         }
-        let tol = self.params.strip_tol_mm;
-        let family = SphereFamily::from_shape(&shape, cutter.flute_length)?;
-        let fits = |lift: f64| -> Result<bool, FlankError> {
-            let c: Vec<Vector3> = centres
-                .iter()
-                .zip(&axes)
-                .map(|(c, ax)| c + ax * lift)
-                .collect();
-            let t: Vec<Vector3> = tops
-                .iter()
-                .zip(&axes)
-                .map(|(c, ax)| c + ax * lift)
-                .collect();
-            let (g0, g1) = guides_through(&c, &t)?;
-            let env = SweptEnvelope::new(family.clone(), g0, g1, r, EnvelopeOptions::default())?;
-            let mut hint = None;
-            for (q, keep) in &checks {
-                let d = env.signed_distance(q, hint)?;
-                hint = Some(d.param);
-                if d.distance < keep - tol {
-                    return Ok(false);
+        Ok(PlannedOperation {
+            paths: plan.paths,
+            metrics: m,
+            plots: Vec::new(),
+            notes,
+        })
+    }
+}
+
+/// The flank pass of one strip (module docs, steps 2–3): stations along the strip at
+/// `passes_along` even rulings plus the chord refinement, lifted along the axes where the
+/// side below the strip (keeping `allowance − strip_tol`) or the hub under the balls would
+/// be cut. The pass is not checked against the rest of the design here (the caller does,
+/// with [`cam_plan::PassCheck`]).
+#[allow(clippy::too_many_arguments)]
+pub fn strip_pass(
+    ctx: &PlanContext<'_>,
+    blade: &Blade,
+    side: Side,
+    strip: &impeller_model::ruled::RuledStrip,
+    v_range: (f64, f64),
+    allowance: f64,
+    passes_along: usize,
+    strip_tol: f64,
+) -> Result<StripPass, FlankError> {
+    let cutter = &ctx.tool.cutter;
+    let shape = cutter.shape;
+    let r = ball_radius(&shape);
+    let n = passes_along;
+    let s = blade.side(side);
+    let ((u0, u1), _) = s.domain();
+    let (a, b) = strip.v_range;
+    let chord = ctx.tolerances.chord_tol;
+    let stations = pass_stations(blade, side, (a, b), &shape, allowance, n, chord)?;
+    let mut centres = Vec::with_capacity(stations.len());
+    let mut tops = Vec::with_capacity(stations.len());
+    let mut upper: f64 = 0.0;
+    let mut axes = Vec::with_capacity(stations.len());
+    for st in stations {
+        upper = upper.max(st.upper_contact - r);
+        centres.push(st.centre);
+        axes.push(st.axis);
+    }
+    let upper = upper.max(r);
+    for (c, ax) in centres.iter().zip(&axes) {
+        tops.push(c + ax * upper);
+    }
+    // Interference check points: the side below the strip and the hub under the pass.
+    let mut checks: Vec<(Point3, f64)> = Vec::new();
+    let (cu, cv) = CHECK_GRID;
+    if a > v_range.0 + 1e-9 {
+        for i in 0..cu {
+            let u = u0 + (u1 - u0) * i as f64 / (cu - 1) as f64;
+            for j in 0..cv {
+                let v = v_range.0 + (a - v_range.0) * j as f64 / (cv - 1) as f64;
+                let q = s.point(u, v);
+                if ctx.impeller.hub().signed_distance(&q) > r {
+                    checks.push((Point3::from(q), allowance));
                 }
             }
-            Ok(true)
-        };
-        let mut lift = 0.0;
-        let mut lifted = false;
-        if !fits(0.0)? {
-            lifted = true;
-            let (mut lo, mut hi) = (0.0, upper);
-            if !fits(hi)? {
-                return Err(FlankError::Geometry(format!(
-                    "{side:?} side: the pass of strip v ∈ [{a:.4}, {b:.4}] interferes below \
-                     even when lifted by the strip height"
-                )));
-            }
-            for _ in 0..LIFT_BISECTIONS {
-                let mid = 0.5 * (lo + hi);
-                if fits(mid)? {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            lift = hi;
         }
+    }
+    for c in &centres {
+        // The hub point below each ball centre.
+        let hub = ctx.impeller.hub();
+        let (t, phi, _) = hub.closest(c);
+        checks.push((
+            Point3::from(hub.point(t, phi)),
+            ctx.process.hub_allowance_mm,
+        ));
+    }
+    let tol = strip_tol;
+    let family = SphereFamily::from_shape(&shape, cutter.flute_length)?;
+    let fits = |lift: f64| -> Result<bool, FlankError> {
         let c: Vec<Vector3> = centres
             .iter()
             .zip(&axes)
@@ -517,14 +597,69 @@ impl FlankSemiFinishing {
             .zip(&axes)
             .map(|(c, ax)| c + ax * lift)
             .collect();
+        // The ball against the hub body (exact: its centre's distance), wherever the
+        // closest hub point below it is not the nearest part of the hub body (over the
+        // inlet corner of the hub).
+        let hub_keep = ctx.process.hub_allowance_mm - tol;
+        if c.iter()
+            .any(|c| ctx.clearance.hub_signed_distance(&Point3::from(*c)) - r < hub_keep)
+        {
+            return Ok(false);
+        }
         let (g0, g1) = guides_through(&c, &t)?;
-        let env = SweptEnvelope::new(family, g0, g1, r, EnvelopeOptions::default())?;
-        // The guides interpolate the stations at uniform parameters: station i at i/(m − 1).
-        let (lo, hi) = env.domain();
-        let m = centres.len();
-        let locations = (0..m)
-            .map(|i| env.cutter_location(lo + (hi - lo) * i as f64 / (m - 1) as f64))
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(Pass { locations, lifted })
+        let env = SweptEnvelope::new(family.clone(), g0, g1, r, EnvelopeOptions::default())?;
+        let mut hint = None;
+        for (q, keep) in &checks {
+            let d = env.signed_distance(q, hint)?;
+            hint = Some(d.param);
+            if d.distance < keep - tol {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    };
+    let mut lift = 0.0;
+    let mut lifted = false;
+    if !fits(0.0)? {
+        lifted = true;
+        let (mut lo, mut hi) = (0.0, upper);
+        if !fits(hi)? {
+            return Err(FlankError::Geometry(format!(
+                "{side:?} side: the pass of strip v ∈ [{a:.4}, {b:.4}] interferes below \
+                 even when lifted by the strip height"
+            )));
+        }
+        for _ in 0..LIFT_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if fits(mid)? {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        lift = hi;
     }
+    let c: Vec<Vector3> = centres
+        .iter()
+        .zip(&axes)
+        .map(|(c, ax)| c + ax * lift)
+        .collect();
+    let t: Vec<Vector3> = tops
+        .iter()
+        .zip(&axes)
+        .map(|(c, ax)| c + ax * lift)
+        .collect();
+    let (g0, g1) = guides_through(&c, &t)?;
+    let env = SweptEnvelope::new(family, g0, g1, r, EnvelopeOptions::default())?;
+    // The guides interpolate the stations at uniform parameters: station i at i/(m − 1).
+    let (lo, hi) = env.domain();
+    let m = centres.len();
+    let locations = (0..m)
+        .map(|i| env.cutter_location(lo + (hi - lo) * i as f64 / (m - 1) as f64))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(StripPass {
+        locations,
+        lifted,
+        envelope: env,
+    })
 }

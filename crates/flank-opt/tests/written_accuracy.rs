@@ -90,7 +90,7 @@ fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
         tool: "T6".into(),
         process,
         params: toml::from_str(
-            "sides = \"pressure\"\noptimise_shape = false\ncompare_cylindrical = false",
+            "sides = \"pressure\"\nrows = [\"main\"]\noptimise_shape = false\ncompare_cylindrical = false",
         )
         .unwrap(),
     };

@@ -1,0 +1,374 @@
+//! Blade sides of any impeller (issue 31): splitter rows are planned, a flank pass whose
+//! straight flutes would run into the side above its strip is found by the whole-tool check
+//! and point-milled instead, and point milling finishes a free-form side within tolerance.
+//!
+//! Reads the repository's fixtures (`fixtures/impeller-8+8`, `fixtures/impeller-5-freeform`);
+//! the "bowed" impeller is impeller-5-freeform with its mid-span wrap turned 8° further, which
+//! makes its sides strongly curved across the span.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use cam_core::{Cutter, CutterLocation, CutterShape, HolderSegment, MoveKind, Tolerances};
+use cam_plan::{
+    ClearanceOptions, DesignClearance, LinkStats, Linker, OperationSpec, PassCheck, PlanContext,
+    Point3, Process, Row, SafetySurface, Tool,
+};
+use flank_opt::point::{AxisParams, PointSettings};
+use flank_opt::regions::{self, Method, MethodChoice, SideSettings};
+use impeller_model::{Impeller, Side};
+use nalgebra::Vector3;
+
+fn fixture(name: &str) -> String {
+    format!(
+        "{}/../../fixtures/{name}/impeller.toml",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+fn bowed() -> Impeller {
+    let text = std::fs::read_to_string(fixture("impeller-5-freeform")).unwrap();
+    let text = text.replace(
+        "theta_deg = [[0.0, 4.3], [0.4, 27.0], [1.0, 55.4]]",
+        "theta_deg = [[0.0, 12.0], [0.4, 36.0], [1.0, 64.0]]",
+    );
+    assert!(text.contains("36.0"), "the fixture's mid-span wrap changed");
+    impeller_model::from_toml_str(&text, "bowed.toml").unwrap()
+}
+
+fn tool(r: f64, half_angle_deg: f64, flute: f64) -> Tool {
+    let mut cutter = Cutter::new(
+        "t",
+        CutterShape::TaperedBallEnd {
+            ball_radius: r,
+            half_angle: half_angle_deg.to_radians(),
+        },
+        flute,
+        4.0,
+        flute + 15.0,
+    )
+    .unwrap();
+    cutter.holder = vec![HolderSegment {
+        bottom_radius: 10.0,
+        top_radius: 14.0,
+        length: 40.0,
+    }];
+    Tool {
+        number: 1,
+        cutter,
+        teeth: 3,
+        tool_length_mm: flute + 80.0,
+        plunge_edge_length_mm: None,
+    }
+}
+
+fn process(blade: f64, hub: f64) -> Process {
+    Process {
+        spindle_rpm: 6000.0,
+        feed_per_tooth_mm: 0.1,
+        plunge_feed_per_tooth_mm: None,
+        depth_of_cut_mm: None,
+        width_of_cut_mm: None,
+        blade_allowance_mm: blade,
+        hub_allowance_mm: hub,
+        rapid_mm_per_min: 10000.0,
+    }
+}
+
+/// Runs `f` with a planning context of `imp`, `tool` and `process`.
+fn with_ctx<T>(
+    imp: &Impeller,
+    tool: &Tool,
+    process: &Process,
+    f: impl FnOnce(&PlanContext<'_>) -> T,
+) -> T {
+    let tolerances = Tolerances::default();
+    let clearance = DesignClearance::new(imp, tool, ClearanceOptions::default()).unwrap();
+    let linker = Linker::new(SafetySurface::around_stock(imp.stock(), 10.0).unwrap());
+    let links = LinkStats::default();
+    let ctx = PlanContext {
+        impeller: imp,
+        stock: imp.stock(),
+        tool,
+        tolerances: &tolerances,
+        process,
+        clearance: &clearance,
+        linker: &linker,
+        links: &links,
+    };
+    f(&ctx)
+}
+
+fn side_settings(
+    choice: MethodChoice,
+    tol: f64,
+    scallop: f64,
+    p: &Process,
+    t: &Tool,
+) -> SideSettings {
+    let (r, theta) = match t.cutter.shape {
+        CutterShape::TaperedBallEnd {
+            ball_radius,
+            half_angle,
+        } => (ball_radius, half_angle),
+        _ => unreachable!(),
+    };
+    let axis = AxisParams::default();
+    SideSettings {
+        choice,
+        strip_tol_mm: tol,
+        passes_along: 30,
+        point: PointSettings {
+            ball_radius: r,
+            half_angle: theta,
+            allowance_mm: p.blade_allowance_mm,
+            hub_allowance_mm: p.hub_allowance_mm,
+            scallop_mm: scallop,
+            chord_mm: 0.01,
+            tol_mm: tol,
+            limits: axis.limits(theta),
+            max_axis_step: axis.max_axis_step_deg.to_radians(),
+        },
+    }
+}
+
+/// A splitter row is semi-finished and finished like the main row: paths for every blade of
+/// both rows, the splitters' balls running at the allowance from the splitter sides. (The
+/// flank operations planned the main row and copied it before.)
+#[test]
+fn splitter_rows_are_planned() {
+    let imp = impeller_model::load(fixture("impeller-8+8")).unwrap();
+    let t = tool(1.5, 2.0, 20.0);
+    let p = process(0.1, 0.3);
+    let planned = with_ctx(&imp, &t, &p, |ctx| {
+        let spec = OperationSpec {
+            name: "semi".into(),
+            kind: flank_opt::FLANK_SEMI_FINISHING.into(),
+            tool: "t".into(),
+            process: p,
+            params: toml::Table::new(),
+        };
+        let op = flank_opt::build_flank_semi_finishing(&spec).unwrap();
+        op.plan(ctx).unwrap()
+    });
+    assert_eq!(planned.paths.len(), 16, "8 main + 8 splitter blades");
+    // Splitter blade 0's path: its balls touch the splitter's offset by the allowance.
+    let sp = imp.splitter().unwrap().instance(0);
+    let feed: Vec<&CutterLocation> = planned
+        .paths
+        .iter()
+        .flat_map(|path| path.moves.iter())
+        .filter(|m| m.kind == MoveKind::Feed)
+        .map(|m| &m.cl)
+        .collect();
+    let touching = feed
+        .iter()
+        .filter(|cl| {
+            let c = cl.tip.coords + cl.axis.into_inner() * 1.5;
+            [Side::Pressure, Side::Suction].iter().any(|&s| {
+                let (_, d) = impeller_model::query::blade_side_distance(&sp, s, &c, None);
+                (d - 1.6).abs() < 0.11
+            })
+        })
+        .count();
+    assert!(
+        touching > 20,
+        "{touching} postures touch splitter 0 at the allowance"
+    );
+}
+
+/// On a side that is strongly curved across the span the straight flutes of a lower strip's
+/// flank pass run into the side above the strip: the whole-tool check finds it (here
+/// 0.7 mm into the allowance), and the region is point-milled; every emitted posture and
+/// motion keeps the floors.
+#[test]
+fn flutes_reaching_the_upper_blade_are_point_milled() {
+    let imp = bowed();
+    let t = tool(3.0, 0.5, 40.0);
+    let p = process(0.3, 0.3);
+    with_ctx(&imp, &t, &p, |ctx| {
+        let st = side_settings(MethodChoice::Auto, 0.1, 0.1, &p, &t);
+        // The strips' flank passes as paper 001 plans them: the lowest is not clear.
+        let blade = imp.main().blade().clone();
+        let v_range = regions::side_v_range(ctx, &blade, Side::Suction).unwrap();
+        let strips =
+            impeller_model::ruled::sub_ruled_strips(&blade, Side::Suction, v_range, 0.1).unwrap();
+        // The first strip from the shroud down whose pass the flutes carry into the blade.
+        let check = PassCheck::new(ctx.clearance, regions::floors(0.3, 0.3, 0.11, 0.01), 40.0);
+        let (strip, worst) = strips
+            .iter()
+            .find_map(|strip| {
+                let pass = flank_opt::semi::strip_pass(
+                    ctx,
+                    &blade,
+                    Side::Suction,
+                    strip,
+                    v_range,
+                    0.3,
+                    30,
+                    0.1,
+                )
+                .ok()?;
+                let worst = check
+                    .check(&pass.locations)
+                    .into_iter()
+                    .filter(|v| {
+                        matches!(v.design_part, cam_plan::DesignPart::Blade { .. })
+                            && v.tool_part == cam_plan::ToolPart::Cutter
+                            && v.height_mm > 6.0
+                    })
+                    .map(|v| v.depth_mm())
+                    .fold(0.0, f64::max);
+                (worst > 0.0).then_some((strip, worst))
+            })
+            .expect("a strip whose flank pass runs its flutes into the blade");
+        assert!(worst > 0.2, "the flutes reach {worst} mm below the floor");
+        // The rule point-mills it, and what it emits is clear.
+        let plan = regions::plan_side(ctx, Row::Main, Side::Suction, &st).unwrap();
+        let point = plan
+            .regions
+            .iter()
+            .find(|g| g.method == Method::Point)
+            .expect("a point-milled region");
+        assert!(point.reason.contains("main blade"), "{}", point.reason);
+        assert!(
+            point.v_range.0 <= strip.v_range.0 + 1e-9 && point.v_range.1 >= strip.v_range.1 - 1e-9
+        );
+        // The regions cover the side.
+        let lo = plan
+            .regions
+            .iter()
+            .map(|g| g.v_range.0)
+            .fold(f64::INFINITY, f64::min);
+        let hi = plan.regions.iter().map(|g| g.v_range.1).fold(0.0, f64::max);
+        assert!((lo - v_range.0).abs() < 1e-9 && (hi - v_range.1).abs() < 1e-9);
+        let floors = regions::floors(0.3, 0.3, 0.1 + 0.01, 0.01);
+        let whole = PassCheck::new(ctx.clearance, floors, 40.0);
+        for g in &plan.regions {
+            for run in &g.runs {
+                let v = whole.check(run);
+                assert!(
+                    v.is_empty(),
+                    "{} region v {:?}: {}",
+                    g.method.as_str(),
+                    g.v_range,
+                    v[0].describe()
+                );
+            }
+        }
+    });
+}
+
+/// Largest residual (mm, capped at `cap`) left on `points` by balls of radius `r` swept along
+/// the centre polylines `runs`, brute force: the balls at centres every `step` mm along each
+/// chord, the residual the smallest `t ≥ 0` where `P + t·n` enters one.
+fn brute_residual(
+    points: &[(Vector3<f64>, Vector3<f64>)],
+    runs: &[Vec<Vector3<f64>>],
+    r: f64,
+    cap: f64,
+) -> f64 {
+    let step = 0.02;
+    let mut centres = Vec::new();
+    for run in runs {
+        for w in run.windows(2) {
+            let k = ((w[1] - w[0]).norm() / step).ceil().max(1.0) as usize;
+            for i in 0..k {
+                centres.push(w[0] + (w[1] - w[0]) * (i as f64 / k as f64));
+            }
+        }
+        centres.extend(run.last());
+    }
+    let mut worst = 0.0f64;
+    for (p, n) in points {
+        let mut best = cap;
+        for c in &centres {
+            let oc = p - c;
+            if oc.norm() > r + cap {
+                continue;
+            }
+            let b = n.dot(&oc);
+            let h = b * b - (oc.norm_squared() - r * r);
+            if h >= 0.0 {
+                let t = -b - h.sqrt();
+                best = best.min(t.max(0.0));
+            }
+        }
+        worst = worst.max(best);
+    }
+    worst
+}
+
+/// A free-form side that no single flank pass can finish within the tolerance (its ruled
+/// deviation is far above it) is finished: flank strips where they are clear, point milling
+/// elsewhere; the balls never come below the floor of the design, and the residual between
+/// the point-milling passes, measured independently by brute force, stays within the
+/// scallop target (plus the brute force's 0.02 mm sampling of the chords).
+#[test]
+fn free_form_side_is_finished() {
+    let imp = impeller_model::load(fixture("impeller-5-freeform")).unwrap();
+    let blade = imp.main().blade().clone();
+    let t = tool(3.0, 1.0, 40.0);
+    let p = process(0.0, 0.0);
+    let (tol, scallop) = (0.01, 0.05);
+    with_ctx(&imp, &t, &p, |ctx| {
+        let v_range = regions::side_v_range(ctx, &blade, Side::Suction).unwrap();
+        let ruled =
+            impeller_model::ruled::ruled_approximation(&blade, Side::Suction, v_range).unwrap();
+        assert!(
+            ruled.max_deviation_mm > 10.0 * tol,
+            "{}",
+            ruled.max_deviation_mm
+        );
+        let st = side_settings(MethodChoice::Auto, tol, scallop, &p, &t);
+        let plan = regions::plan_side(ctx, Row::Main, Side::Suction, &st).unwrap();
+        assert!(plan.regions.iter().any(|g| g.method == Method::Point));
+        for g in &plan.regions {
+            assert!(
+                g.max_overcut_mm <= tol + 1e-9,
+                "{} overcut {}",
+                g.method.as_str(),
+                g.max_overcut_mm
+            );
+            assert!(
+                g.max_scallop_mm <= scallop * 1.05,
+                "scallop {}",
+                g.max_scallop_mm
+            );
+            let Some(band) = &g.band else { continue };
+            assert_eq!(band.skipped(), 0);
+            let runs: Vec<Vec<Vector3<f64>>> = band
+                .runs()
+                .map(|run| run.iter().map(|s| s.contact.centre).collect())
+                .collect();
+            for c in runs.iter().flatten() {
+                let (d, _) = ctx.clearance.design_signed_distance(&Point3::from(*c));
+                assert!(
+                    d >= 3.0 - tol - 1e-9,
+                    "a ball {:.4} mm into the design",
+                    3.0 - d
+                );
+            }
+            // Independent residual between the band's first line and the lowest contacts,
+            // on a grid away from the band's edges.
+            let s = blade.side(Side::Suction);
+            let ((u0, u1), _) = s.domain();
+            let (vl, vh) = g.v_range;
+            let pts: Vec<(Vector3<f64>, Vector3<f64>)> = (1..40)
+                .flat_map(|i| (1..12).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    let u = u0 + (u1 - u0) * (0.1 + 0.8 * i as f64 / 40.0);
+                    let v = vl + (vh - vl) * (0.3 + 0.65 * j as f64 / 12.0);
+                    (
+                        s.point(u, v),
+                        blade.outward_normal(Side::Suction, u, v).unwrap(),
+                    )
+                })
+                .collect();
+            let brute = brute_residual(&pts, &runs, 3.0, 1.0);
+            assert!(
+                brute <= scallop * 1.1 + 0.002,
+                "brute-force residual {brute}"
+            );
+        }
+    });
+}
