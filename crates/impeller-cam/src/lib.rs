@@ -19,6 +19,7 @@ pub mod plot;
 pub mod progress;
 pub mod registry;
 pub mod report;
+pub mod surface_groups;
 
 pub use error::CliError;
 pub use job::Job;

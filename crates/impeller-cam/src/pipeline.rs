@@ -1001,6 +1001,7 @@ pub fn verify(
         resolution_mm: job.verification.resolution_mm,
         overcut_limit_mm: limit,
         defects,
+        surface_groups: crate::surface_groups::surface_groups(&rep.maps),
         source: source.into(),
         details: serde_json::json!({
             "max_overcut": rep.max_overcut,

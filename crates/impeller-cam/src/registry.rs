@@ -31,6 +31,10 @@ pub static OPERATIONS: &Registry = &[
         channel_paths::build_blade_root_finishing,
     ),
     (flank_opt::FLANK_FINISHING, flank_opt::build_flank_finishing),
+    (
+        flank_opt::BLADE_POINT_FINISHING,
+        flank_opt::build_blade_point_finishing,
+    ),
 ];
 
 /// The builder of `kind`, if registered.

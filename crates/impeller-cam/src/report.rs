@@ -163,6 +163,8 @@ pub struct VerificationReport {
     /// What makes the program defective (overcut above the limit, collisions), one line each;
     /// empty when the program passed.
     pub defects: Vec<String>,
+    /// Residual distribution per surface group (blade sides and tips of each row, hub).
+    pub surface_groups: BTreeMap<String, crate::surface_groups::GroupResidual>,
     /// What was simulated: `program` (the written LinuxCNC program read back through the
     /// machine's kinematics with joint interpolation, every block) or `cutter_locations`
     /// (the posted cutter locations, for dialects the reader does not cover).

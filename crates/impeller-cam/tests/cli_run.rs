@@ -359,9 +359,10 @@ fn bad_job_files_exit_1_with_file_and_line() {
 
 #[test]
 fn finishing_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
-    // fixtures/impeller-8+8/job-finishing.toml: blade semi-finishing (T5), flank finishing
-    // (T6) and blade-root finishing (T7) of every blade side, planned by the registered
-    // flank-opt and channel-paths operations.
+    // fixtures/impeller-8+8/job-finishing.toml: channel roughing (T5) so that the program
+    // can be verified, then blade semi-finishing (T5), flank finishing (T6) and blade-root
+    // finishing (T7) of every blade side of both rows, planned by the registered flank-opt
+    // and channel-paths operations, and verified.
     let dir = scratch("finishing");
     let out = dir.join("out");
     let st = cli()
@@ -382,6 +383,7 @@ fn finishing_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
     assert_eq!(
         kinds,
         [
+            "channel_roughing",
             "flank_semi_finishing",
             "flank_finishing",
             "blade_root_finishing"
@@ -393,11 +395,20 @@ fn finishing_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
     }
     // the finishing pass meets the job's machining tolerance (0.01 mm) on the blade sides
     assert!(
-        ops[1]["max_deviation_mm"].as_f64().unwrap() <= 0.01,
+        ops[2]["max_deviation_mm"].as_f64().unwrap() <= 0.01,
         "{}",
-        ops[1]
+        ops[2]
     );
+    // Both rows are finished: the splitter sides are planned, not copies of the main row.
+    assert_eq!(ops[2]["rows"], "main, splitter", "{}", ops[2]);
     assert_eq!(r["post"]["limit_violations"], 0);
+    // Verified: no collision and the overcut within the limit in force.
+    let v = &r["verification"];
+    assert_eq!(v["collisions"], 0, "{v}");
+    assert!(
+        v["max_overcut_mm"].as_f64().unwrap() <= v["overcut_limit_mm"].as_f64().unwrap_or(0.1),
+        "{v}"
+    );
     let post_err = |name: &str| {
         r["post"]["operations"]
             .as_array()

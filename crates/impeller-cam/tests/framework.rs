@@ -189,10 +189,7 @@ fn repo() -> PathBuf {
 fn scratch(name: &str) -> PathBuf {
     static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let d = std::env::temp_dir().join(format!(
-        "impeller-cam-fw-{}-{n}-{name}",
-        std::process::id()
-    ));
+    let d = std::env::temp_dir().join(format!("impeller-cam-fw-{}-{n}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
