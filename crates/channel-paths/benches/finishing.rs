@@ -3,7 +3,7 @@
 //! (1 mm fillet; tools of its process plan: T7 ball r1 for the root, T6 tapered ball r1 for
 //! the hub, clearance sampled at 0.05 mm).
 //! - `blade_root/plan_side_24`: 24 stations of main blade 0's pressure side (spine roots,
-//!   accessibility search, deviations).
+//!   ball fit, accessibility search, deviations, chord refinement, motion checks).
 //! - `hub_finishing/plan_coarse`: the whole operation at `scallop_mm = 0.5`, 4 stations
 //!   (3 lanes, 24 lines per channel, copied to 8 channels, residual measured).
 //!

@@ -4,8 +4,10 @@
 //! of the hub's and the blade's offset surfaces (paper 004 §2–3).
 
 mod accessibility;
+pub mod ball_fit;
 pub mod blade_root;
 pub mod hub_finishing;
+pub mod root_axis;
 pub mod roughing;
 
 pub use blade_root::{build_blade_root_finishing, BladeRootFinishing, BLADE_ROOT_FINISHING};
