@@ -175,6 +175,8 @@ impl BladePointFinishing {
             choice: p.method,
             strip_tol_mm: p.flank_tol_mm.unwrap_or(tol),
             passes_along: p.passes_along,
+            // Finishing: a flank region must leave no more than the flank tolerance.
+            flank_residual_mm: Some(p.flank_tol_mm.unwrap_or(tol)),
             point: PointSettings {
                 ball_radius: ball_radius(&shape),
                 half_angle,

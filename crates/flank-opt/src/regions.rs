@@ -75,6 +75,12 @@ pub struct SideSettings {
     pub strip_tol_mm: f64,
     /// Even rulings per flank pass.
     pub passes_along: usize,
+    /// Largest material a flank pass may leave on its strip (mm, measured on the side offset
+    /// by the allowance); a strip whose clear flank pass leaves more is point-milled. `None`
+    /// accepts any clear flank pass (semi-finishing, whose leftover the finishing takes).
+    /// A ruled strip within τ does not make a flank pass within τ: the cone cannot stay
+    /// tangent along every ruling of a twisted (non-developable) ruled surface.
+    pub flank_residual_mm: Option<f64>,
     /// Point milling of the other regions.
     pub point: PointSettings,
 }
@@ -238,11 +244,24 @@ pub fn plan_side(
                     None => Ok(pass),
                 }
             });
-        match outcome {
+        // A clear pass must also leave no more than the residual limit on its strip.
+        let outcome = match outcome {
             Ok(pass) => {
-                flush(&mut pending_point, &mut regions)?;
                 let (over, residual) =
                     measure_flank(&blade, side, strip.v_range, &pass.envelope, a)?;
+                match st.flank_residual_mm {
+                    Some(limit) if residual > limit => Err(format!(
+                        "its flank pass is clear but leaves {residual:.4} mm > {limit} mm \
+                         (the cone cannot follow the strip's twist)"
+                    )),
+                    _ => Ok((pass, over, residual)),
+                }
+            }
+            Err(why) => Err(why),
+        };
+        match outcome {
+            Ok((pass, over, residual)) => {
+                flush(&mut pending_point, &mut regions)?;
                 let method = if whole {
                     Method::Flank
                 } else {
@@ -253,10 +272,17 @@ pub fn plan_side(
                     side,
                     v_range: strip.v_range,
                     method,
-                    reason: format!(
-                        "ruled within {:.4} mm ≤ {tol} mm and the whole tool is clear",
-                        strip.max_deviation_mm
-                    ),
+                    reason: match st.flank_residual_mm {
+                        Some(limit) => format!(
+                            "ruled within {:.4} mm ≤ {tol} mm, the whole tool is clear and \
+                             the pass leaves {residual:.4} mm ≤ {limit} mm",
+                            strip.max_deviation_mm
+                        ),
+                        None => format!(
+                            "ruled within {:.4} mm ≤ {tol} mm and the whole tool is clear",
+                            strip.max_deviation_mm
+                        ),
+                    },
                     deviation_mm: Some(strip.max_deviation_mm),
                     runs: vec![pass.locations],
                     max_overcut_mm: over,

@@ -422,6 +422,7 @@ impl FlankSemiFinishing {
             choice: p.method,
             strip_tol_mm: p.strip_tol_mm,
             passes_along: p.passes_along,
+            flank_residual_mm: None,
             point: PointSettings {
                 ball_radius: r,
                 half_angle,

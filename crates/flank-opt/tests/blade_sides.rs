@@ -117,6 +117,7 @@ fn side_settings(
         choice,
         strip_tol_mm: tol,
         passes_along: 30,
+        flank_residual_mm: None,
         point: PointSettings {
             ball_radius: r,
             half_angle: theta,
@@ -370,5 +371,56 @@ fn free_form_side_is_finished() {
                 "brute-force residual {brute}"
             );
         }
+    });
+}
+
+/// A clear flank pass over a strip ruled within τ can still leave far more than τ: the cone
+/// cannot stay tangent along every ruling of a twisted strip. Finishing with a residual limit
+/// point-mills such strips, so every flank region it keeps leaves no more than the limit,
+/// while without the limit (semi-finishing) a strip leaving more is kept as flank.
+#[test]
+fn flank_strips_that_leave_more_than_the_tolerance_are_point_milled() {
+    let imp = impeller_model::load(fixture("impeller-5-freeform")).unwrap();
+    let t = tool(3.0, 1.0, 40.0);
+    let p = process(0.0, 0.0);
+    let (tol, scallop) = (0.01, 0.05);
+    with_ctx(&imp, &t, &p, |ctx| {
+        let flank = |g: &regions::Region| g.method != Method::Point;
+        let loose = side_settings(MethodChoice::Auto, tol, scallop, &p, &t);
+        let mut strict = loose;
+        strict.flank_residual_mm = Some(tol);
+        let mut seen_loose = false;
+        for side in [Side::Pressure, Side::Suction] {
+            let plan = regions::plan_side(ctx, Row::Main, side, &loose).unwrap();
+            let worst = plan
+                .regions
+                .iter()
+                .filter(|g| flank(g))
+                .map(|g| g.max_residual_mm)
+                .fold(0.0f64, f64::max);
+            if worst <= tol {
+                continue;
+            }
+            seen_loose = true;
+            let plan = regions::plan_side(ctx, Row::Main, side, &strict).unwrap();
+            for g in plan.regions.iter().filter(|g| flank(g)) {
+                assert!(
+                    g.max_residual_mm <= tol + 1e-9,
+                    "{side:?} {:?}: flank region leaves {} mm",
+                    g.v_range,
+                    g.max_residual_mm
+                );
+            }
+            assert!(
+                plan.regions
+                    .iter()
+                    .any(|g| g.method == Method::Point && g.reason.contains("leaves")),
+                "{side:?}: no strip point-milled for what its flank pass leaves"
+            );
+        }
+        assert!(
+            seen_loose,
+            "no flank strip of impeller-5-freeform leaves more than {tol} mm without the limit"
+        );
     });
 }
