@@ -17,7 +17,8 @@
 //! `tilt_sign` / `rotary_sign` for head machines (see [`machine`]).
 //!
 //! Modules: [`machine`] (description and TOML file), [`kinematics`] (forward / inverse,
-//! solution choice), [`post`] (path post-processing and metrics), [`reverse_motion`]
+//! solution choice), [`post`] (path post-processing and metrics), [`cycle_time`] (block
+//! times from the axis speed and acceleration limits), [`reverse_motion`]
 //! (detection and removal, paper 004), [`bspline_fit`] (least-squares cubic B-spline used by
 //! the smoothing), [`linearise`] (joint-interpolation error and subdivision), [`feed`]
 //! (inverse-time feed), [`plot`] (SVG displacement curves).
@@ -60,6 +61,7 @@
 
 pub mod banded_lsq;
 pub mod bspline_fit;
+pub mod cycle_time;
 pub mod error;
 pub mod feed;
 pub mod joints;
@@ -70,11 +72,12 @@ pub mod plot;
 pub mod post;
 pub mod reverse_motion;
 
+pub use cycle_time::{BlockProfile, CycleTimeError, MotionTimer};
 pub use error::{KinematicsError, MachineError, PostError};
 pub use joints::{AxisId, Joints};
 pub use kinematics::{wrap_pi, LIMIT_SLACK};
 pub use machine::{
-    AxisSpec, HeadHead, HeadTable, Kinematics, Machine, RotaryMode, TableTable, TiltAxis,
+    AxisSpec, Blending, HeadHead, HeadTable, Kinematics, Machine, RotaryMode, TableTable, TiltAxis,
 };
 pub use post::{
     is_reconfiguration, post_locations, post_path, post_path_checked, post_tool_path,

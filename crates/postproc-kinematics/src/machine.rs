@@ -8,6 +8,8 @@
 //! description = "..."        # optional
 //! safe_z = 100.0              # optional: machine Z for retracts before reorientation
 //! singularity_tol_deg = 1e-5  # optional: tool axis this close to C counts as singular
+//! tool_change_s = 6.0         # optional: tool change time, chip to chip (s), for cycle time
+//! blending = "parabolic"      # optional: "parabolic" (default, continuous path) | "exact_stop"
 //! [kinematics]
 //! type = "table-table"        # "table-table" | "head-table" | "head-head"
 //! tilt_axis = "A"             # "A" (about X) or "B" (about Y); the other rotary axis is C (about Z)
@@ -24,10 +26,13 @@
 //! min = -200.0
 //! max = 200.0
 //! max_speed = 6000.0
+//! max_acceleration = 300.0    # optional: mm/s² (linear) or deg/s² (rotary), for cycle time
 //! # ... Y, Z likewise; rotary axes: mode = "limited" (min/max) or "continuous"
 //! [home]                      # optional per axis (default 0, which must lie in the travel)
 //! X = 0.0
 //! # ...
+//! [program]                   # optional: the controller's program frame, read by `gcode-emit`
+//! # (kinematics switch, header/footer, coolant codes, block numbers); kept as given here
 //! ```
 //!
 //! Unknown keys are rejected. Errors carry the file name, the 1-based line and the dotted
@@ -168,7 +173,8 @@ pub enum RotaryMode {
     Continuous,
 }
 
-/// Travel and speed of one axis (mm, mm/min for linear axes; rad, rad/min for rotary axes).
+/// Travel, speed and acceleration of one axis (mm, mm/min, mm/s² for linear axes; rad,
+/// rad/min, rad/s² for rotary axes).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisSpec {
     /// Axis letter.
@@ -177,6 +183,9 @@ pub struct AxisSpec {
     pub mode: RotaryMode,
     /// Largest speed (mm/min or rad/min); `None` = unlimited.
     pub max_speed: Option<f64>,
+    /// Largest acceleration (mm/s² or rad/s²; LinuxCNC's `MAX_ACCELERATION`); `None` = not
+    /// given (the cycle time then ignores this axis' acceleration and says so).
+    pub max_acceleration: Option<f64>,
 }
 
 impl AxisSpec {
@@ -205,6 +214,21 @@ pub struct Machine {
     pub(crate) home: Joints,
     pub(crate) safe_z: Option<f64>,
     pub(crate) singularity_tol: f64,
+    pub(crate) tool_change_s: Option<f64>,
+    pub(crate) blending: Blending,
+}
+
+/// How the controller runs consecutive motion blocks (for the cycle time,
+/// [`crate::cycle_time`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Blending {
+    /// Continuous path (LinuxCNC `G64`): a block starts while the one before it decelerates
+    /// (parabolic blending; LinuxCNC blends every move that turns a rotary axis this way),
+    /// each block planned at half the acceleration limits so the overlap stays within them.
+    #[default]
+    Parabolic,
+    /// Exact stop (`G61.1`): every block starts and ends at rest.
+    ExactStop,
 }
 
 impl Machine {
@@ -287,6 +311,21 @@ impl Machine {
     pub fn singularity_tol(&self) -> f64 {
         self.singularity_tol
     }
+    /// Tool change time, chip to chip (s), when the file gives one (`tool_change_s`).
+    pub fn tool_change_s(&self) -> Option<f64> {
+        self.tool_change_s
+    }
+    /// How the controller runs consecutive motion blocks (`blending`).
+    pub fn blending(&self) -> Blending {
+        self.blending
+    }
+    /// Whether the tool length enters the kinematics: on head-table and head-head machines
+    /// the head turns about a pivot above the spindle, so the gauge length (spindle gauge
+    /// line to tip) moves the tip; on table-table machines the controller's tool length
+    /// compensation takes it along the fixed spindle axis.
+    pub fn tool_length_matters(&self) -> bool {
+        !matches!(self.kinematics, Kinematics::TableTable(_))
+    }
 
     /// The five axis words of a block for a program: letter and value, mm for linear axes,
     /// **degrees** for rotary axes, in order X Y Z tilt C.
@@ -359,6 +398,11 @@ struct RawMachine {
     home: BTreeMap<Spanned<String>, Spanned<f64>>,
     safe_z: Option<Spanned<f64>>,
     singularity_tol_deg: Option<Spanned<f64>>,
+    tool_change_s: Option<Spanned<f64>>,
+    blending: Option<Spanned<String>>,
+    /// The program frame (`gcode-emit` reads and checks it from the same file).
+    #[serde(rename = "program")]
+    _program: Option<toml::Table>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -393,6 +437,7 @@ struct RawAxis {
     min: Option<Spanned<f64>>,
     max: Option<Spanned<f64>>,
     max_speed: Option<Spanned<f64>>,
+    max_acceleration: Option<Spanned<f64>>,
 }
 
 struct Validator<'a> {
@@ -634,6 +679,17 @@ impl Validator<'_> {
                 Some(conv(v))
             }
         };
+        let max_acceleration = match &raw.max_acceleration {
+            None => None,
+            Some(s) => {
+                let field = format!("{base}.max_acceleration");
+                let v = self.finite(s, &field)?;
+                if v <= 0.0 {
+                    return self.err(Some(s.span()), &field, "must be > 0");
+                }
+                Some(conv(v))
+            }
+        };
         let mode_name = raw
             .mode
             .as_ref()
@@ -701,6 +757,7 @@ impl Validator<'_> {
             letter,
             mode,
             max_speed,
+            max_acceleration,
         })
     }
 
@@ -723,6 +780,7 @@ impl Validator<'_> {
             letter: 'X',
             mode: RotaryMode::Continuous,
             max_speed: None,
+            max_acceleration: None,
         }; 5];
         for (i, l) in letters.iter().enumerate() {
             axes[i] = self.axis(*l, raw.axes.get(l.to_string().as_str()), i >= 3)?;
@@ -789,6 +847,30 @@ impl Validator<'_> {
                 v.to_radians()
             }
         };
+        let tool_change_s = match &raw.tool_change_s {
+            None => None,
+            Some(s) => {
+                let v = self.finite(s, "tool_change_s")?;
+                if v < 0.0 {
+                    return self.err(Some(s.span()), "tool_change_s", "must be >= 0");
+                }
+                Some(v)
+            }
+        };
+        let blending = match &raw.blending {
+            None => Blending::Parabolic,
+            Some(s) => match s.get_ref().as_str() {
+                "parabolic" => Blending::Parabolic,
+                "exact_stop" => Blending::ExactStop,
+                other => {
+                    return self.err(
+                        Some(s.span()),
+                        "blending",
+                        format!("must be \"parabolic\" or \"exact_stop\", got \"{other}\""),
+                    )
+                }
+            },
+        };
         if raw.name.trim().is_empty() {
             return self.err(None, "name", "must not be empty");
         }
@@ -801,6 +883,8 @@ impl Validator<'_> {
             home,
             safe_z,
             singularity_tol,
+            tool_change_s,
+            blending,
         })
     }
 }

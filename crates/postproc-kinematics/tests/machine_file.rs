@@ -131,8 +131,8 @@ fn invalid_values_name_field_and_line() {
         ),
         (
             "xyzac-trt",
-            "max_speed = 1800.0\n\n[axes.C]",
-            "max_speed = 0.0\n\n[axes.C]",
+            "max_speed = 1800.0\nmax_acceleration = 300.0\n\n[axes.C]",
+            "max_speed = 0.0\nmax_acceleration = 300.0\n\n[axes.C]",
             "axes.A.max_speed",
         ),
     ];
@@ -208,4 +208,47 @@ fn unknown_axis_key_has_its_line() {
         }
         other => panic!("{other:?}"),
     }
+}
+
+/// The cycle-time keys: `max_acceleration` per axis (mm/s², deg/s² → rad/s²),
+/// `tool_change_s`, `blending`; the `[program]` table is left to `gcode-emit`. Bad values
+/// name the field and the line.
+#[test]
+fn acceleration_tool_change_and_blending_are_read_and_checked() {
+    let m = Machine::from_toml_str(&fixture_text("xyzac-trt"), "xyzac-trt.toml").unwrap();
+    assert_eq!(m.axis(AxisId::X).max_acceleration, Some(300.0));
+    let a = m.axis(AxisId::Tilt).max_acceleration.unwrap();
+    assert!((a - 300f64.to_radians()).abs() < 1e-12);
+    assert!(m.tool_change_s().is_some());
+    assert_eq!(m.blending(), postproc_kinematics::Blending::Parabolic);
+    assert!(!m.tool_length_matters());
+    let h = Machine::from_toml_str(&fixture_text("headhead-ac"), "headhead-ac.toml").unwrap();
+    assert!(h.tool_length_matters());
+    let text = fixture_text("xyzac-trt");
+    for (from, to, field) in [
+        (
+            "max_acceleration = 300.0\n",
+            "max_acceleration = -1.0\n",
+            "axes.X.max_acceleration",
+        ),
+        (
+            "tool_change_s = 5.0\n",
+            "tool_change_s = -3.0\n",
+            "tool_change_s",
+        ),
+        (
+            "blending = \"parabolic\"\n",
+            "blending = \"g64\"\n",
+            "blending",
+        ),
+    ] {
+        let bad = text.replacen(from, to, 1);
+        assert_ne!(bad, text, "{from}");
+        let e = Machine::from_toml_str(&bad, "bad.toml").unwrap_err();
+        let needle = to.lines().last().unwrap();
+        let want = format!("bad.toml:{}: field `{field}`", line_of(&bad, needle));
+        assert!(e.to_string().starts_with(&want), "{e} / {want}");
+    }
+    // The fixture's [program] table is gcode-emit's to read and check.
+    assert!(text.contains("[program]"));
 }
