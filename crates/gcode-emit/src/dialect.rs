@@ -24,7 +24,13 @@ pub trait Dialect: std::fmt::Debug {
 }
 
 /// Names accepted by [`dialect_by_name`].
-pub const DIALECT_NAMES: [&str; 4] = ["linuxcnc", "fanuc", "sinumerik", "heidenhain"];
+pub const DIALECT_NAMES: [&str; 5] = [
+    "linuxcnc",
+    "fanuc",
+    "sinumerik",
+    "heidenhain",
+    "heidenhain_conversational",
+];
 
 /// A built-in dialect with its default settings, by name (case-insensitive).
 pub fn dialect_by_name(name: &str) -> Result<Box<dyn Dialect>, GcodeError> {
@@ -33,6 +39,7 @@ pub fn dialect_by_name(name: &str) -> Result<Box<dyn Dialect>, GcodeError> {
         "fanuc" => Ok(Box::new(crate::Fanuc)),
         "sinumerik" => Ok(Box::new(crate::Sinumerik::default())),
         "heidenhain" => Ok(Box::new(crate::HeidenhainIso)),
+        "heidenhain_conversational" => Ok(Box::new(crate::HeidenhainConversational::default())),
         _ => Err(GcodeError::UnknownDialect {
             name: name.to_string(),
             valid: DIALECT_NAMES.join(", "),
@@ -73,9 +80,12 @@ impl BlockWriter {
         }
     }
 
-    /// Appends a numbered block.
+    /// Appends a numbered block (numbers start again at `start` after `wrap`).
     pub fn block(&mut self, words: &str) {
         if let Some(n) = self.numbers {
+            if n.wrap.is_some_and(|w| self.next > u64::from(w)) {
+                self.next = u64::from(n.start);
+            }
             self.out.push('N');
             self.out.push_str(&self.next.to_string());
             self.out.push(' ');

@@ -38,6 +38,18 @@ pub enum GcodeError {
         /// The underlying I/O error.
         source: std::io::Error,
     },
+    /// The `[program]` table of a machine file is not acceptable.
+    #[error("{file}:{line}: field `{field}`: {message}")]
+    Frame {
+        /// Machine file.
+        file: String,
+        /// 1-based line (0 when unknown).
+        line: usize,
+        /// Dotted key, e.g. `program.kinematics`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A dialect name was not recognised.
     #[error("unknown dialect `{name}`; valid dialects: {valid}")]
     UnknownDialect {

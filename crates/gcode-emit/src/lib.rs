@@ -1,5 +1,5 @@
-//! G-code dialects (LinuxCNC, Fanuc, Sinumerik 840D, Heidenhain ISO) and APT CLDATA
-//! read/write.
+//! G-code dialects (LinuxCNC, Fanuc, Sinumerik 840D, Heidenhain ISO and conversational) and
+//! APT CLDATA read/write.
 //!
 //! - [`cldata`]: read any CAM system's APT CL file into `cam-core` tool paths with their
 //!   cutters and technology ([`read_cl`]), and write them back ([`write_cl`]).
@@ -8,6 +8,11 @@
 //! - [`dialect`]: the [`Dialect`] trait, [`dialect_by_name`] and [`write_program_file`]
 //!   (temporary file + rename).
 //! - [`assemble`]: CL operations + a `postproc-kinematics` machine → [`NcProgram`].
+//! - [`frame`]: the program frame of a machine's controller from its machine file's
+//!   `[program]` table ([`ProgramFrame`]: kinematics switch, header and footer blocks, end
+//!   code, block numbering, coolant codes).
+//! - [`cycle_time`]: how long an assembled program runs on the machine (cutting, links,
+//!   rapids, tool changes; `postproc_kinematics::cycle_time`'s model).
 //! - [`NumberFormat`]: fixed decimals, never an exponent, `-0` printed as `0`.
 //! - [`gcode_read`]: a small LinuxCNC G-code reader returning joint blocks, for verification
 //!   by forward kinematics ([`gcode_read::joints_of`]).
@@ -61,9 +66,11 @@ mod apt_cutter;
 pub mod assemble;
 mod atomic_write;
 pub mod cldata;
+pub mod cycle_time;
 pub mod dialect;
 mod dialects;
 mod error;
+pub mod frame;
 pub mod gcode_read;
 mod number;
 pub mod program;
@@ -77,17 +84,25 @@ pub use cldata::{
     read_cl, read_cl_file, write_cl, write_cl_file, ClOperation, ClProgram, ClReadOptions,
     ClWarning, ClWriteOptions, Coolant, Spindle,
 };
+pub use cycle_time::{program_time, OperationTime, ProgramTime};
 pub use dialect::{dialect_by_name, write_program_file, Dialect, DIALECT_NAMES};
-pub use dialects::{Fanuc, HeidenhainIso, LinuxCnc, Sinumerik};
+pub use dialects::{
+    Fanuc, HeidenhainConversational, HeidenhainIso, KinematicsSwitch, LinuxCnc, Sinumerik, Tcpm,
+};
 pub use error::GcodeError;
+pub use frame::ProgramFrame;
 pub use gcode_read::{read_gcode, read_gcode_file, GcodeBlock, GcodeFeed, GcodeMotion};
 pub use number::NumberFormat;
 pub use program::{
-    Feed, LineNumbers, Motion, NcMove, NcOperation, NcProgram, OutputMode, ProgramOptions,
-    RotaryWord, ToolCall,
+    CoolantCodes, Feed, LineNumbers, Motion, NcMove, NcOperation, NcProgram, OutputMode,
+    ProgramOptions, RotaryWord, ToolCall,
 };
 pub use readback::{read_back, Readback, ReadbackMode, ReadbackOptions};
 pub use tilted_plane::TiltedPlane;
+
+// Dependencies: `cam-core` and `postproc-kinematics` (the project's), `nalgebra`, `serde`,
+// `thiserror`, and `toml` for the `[program]` table of machine files (line numbers of its
+// keys in errors come from the parser's spans) — the workspace's chosen crates.
 
 // The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
 #[cfg(doctest)]

@@ -120,6 +120,57 @@ pub struct LineNumbers {
     pub start: u32,
     /// Increment.
     pub step: u32,
+    /// Largest number the control reads (e.g. 99999 on a Fanuc with five-digit sequence
+    /// numbers): numbering starts again at `start` after it. `None`: no limit.
+    pub wrap: Option<u32>,
+}
+
+impl LineNumbers {
+    /// `start`, `start + step`, ... without a limit.
+    pub const fn new(start: u32, step: u32) -> Self {
+        Self {
+            start,
+            step,
+            wrap: None,
+        }
+    }
+}
+
+/// The M codes of each coolant state (the program frame of a machine may change them, e.g.
+/// through-tool coolant on `M88`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CoolantCodes {
+    /// Flood coolant (`M8`).
+    pub flood: String,
+    /// Mist (`M7`).
+    pub mist: String,
+    /// Through-tool coolant (`M8` unless the machine says otherwise).
+    pub through: String,
+    /// Coolant off (`M9`).
+    pub off: String,
+}
+
+impl Default for CoolantCodes {
+    fn default() -> Self {
+        Self {
+            flood: "M8".into(),
+            mist: "M7".into(),
+            through: "M8".into(),
+            off: "M9".into(),
+        }
+    }
+}
+
+impl CoolantCodes {
+    /// The code of `c`.
+    pub fn code(&self, c: crate::Coolant) -> &str {
+        match c {
+            crate::Coolant::Off => &self.off,
+            crate::Coolant::Flood => &self.flood,
+            crate::Coolant::Mist => &self.mist,
+            crate::Coolant::ThroughTool => &self.through,
+        }
+    }
 }
 
 /// Options shared by every dialect.
@@ -144,15 +195,20 @@ pub struct ProgramOptions {
     pub program_number: u32,
     /// Write operation and tool comments.
     pub comments: bool,
+    /// Blocks written after the program's setup block (the machine's own start sequence).
+    pub header: Vec<String>,
+    /// Blocks written before the program end code.
+    pub footer: Vec<String>,
+    /// Program end code (`M30`, `M2`); `None`: the dialect's (LinuxCNC `M2`, others `M30`).
+    pub program_end: Option<String>,
+    /// M codes of the coolant states.
+    pub coolant_codes: CoolantCodes,
 }
 
 impl Default for ProgramOptions {
     fn default() -> Self {
         Self {
-            line_numbers: Some(LineNumbers {
-                start: 10,
-                step: 10,
-            }),
+            line_numbers: Some(LineNumbers::new(10, 10)),
             linear_decimals: 4,
             angular_decimals: 4,
             feed_decimals: 1,
@@ -161,6 +217,10 @@ impl Default for ProgramOptions {
             safe_z_machine: 0.0,
             program_number: 1000,
             comments: true,
+            header: Vec::new(),
+            footer: Vec::new(),
+            program_end: None,
+            coolant_codes: CoolantCodes::default(),
         }
     }
 }
@@ -181,6 +241,38 @@ impl ProgramOptions {
         if let Some(n) = self.line_numbers {
             if n.step == 0 {
                 return bad("line_numbers.step", "must be > 0".into());
+            }
+            if let Some(w) = n.wrap {
+                if w < n.start.saturating_add(n.step) {
+                    return bad(
+                        "line_numbers.wrap",
+                        format!(
+                            "{w} leaves no room after the first number {} (step {})",
+                            n.start, n.step
+                        ),
+                    );
+                }
+            }
+        }
+        let codes = &self.coolant_codes;
+        for (field, text) in self
+            .header
+            .iter()
+            .map(|t| ("header", t))
+            .chain(self.footer.iter().map(|t| ("footer", t)))
+            .chain(self.program_end.iter().map(|t| ("program_end", t)))
+            .chain([
+                ("coolant_codes.flood", &codes.flood),
+                ("coolant_codes.mist", &codes.mist),
+                ("coolant_codes.through", &codes.through),
+                ("coolant_codes.off", &codes.off),
+            ])
+        {
+            if text.contains(['\n', '\r']) || text.trim().is_empty() {
+                return bad(
+                    field,
+                    format!("{text:?} must be one non-empty line (one block each)"),
+                );
             }
         }
         for (field, d) in [

@@ -418,3 +418,25 @@ fn windows_files_with_bom_and_crlf_read_like_unix_ones() {
     let win = format!("\u{feff}{}", SAMPLE.replace('\n', "\r\n"));
     assert_eq!(read(&win).unwrap(), unix);
 }
+
+/// `LOADTL/n,LENGTH,l` gives the gauge length (in the file's units) that head machines need
+/// in their kinematics; it is written back and a change of length starts a new operation.
+#[test]
+fn loadtl_length_is_the_tool_gauge_length() {
+    let text = "UNITS/INCHES\nMULTAX/ON\nLOADTL/3,LENGTH,4.5\nFEDRAT/IPM,10\n\
+                GOTO/1,0,0,0,0,1\nGOTO/2,0,0,0,0,1\nLOADTL/3\nGOTO/3,0,0,0,0,1\nFINI\n";
+    let p = read(text).unwrap();
+    assert_eq!(p.operations.len(), 2);
+    assert_eq!(p.operations[0].tool_length_mm, Some(4.5 * 25.4));
+    assert_eq!(p.operations[1].tool_length_mm, None);
+    assert!(p.warnings.is_empty(), "{:?}", p.warnings);
+    let back = read(&write_cl(&p, &ClWriteOptions::default()).unwrap()).unwrap();
+    assert_eq!(back.operations[0].tool_length_mm, Some(4.5 * 25.4));
+    match read("LOADTL/3,LENGTH,-2\n") {
+        Err(GcodeError::ClParse { line, field, .. }) => assert_eq!((line, field), (1, 3)),
+        other => panic!("{other:?}"),
+    }
+    // Other modifiers are reported as not used.
+    let p = read("MULTAX/ON\nLOADTL/3,ADJUST,3\nGOTO/1,0,0,0,0,1\nFINI\n").unwrap();
+    assert_eq!(p.warnings.len(), 1);
+}

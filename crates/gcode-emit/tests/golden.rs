@@ -5,9 +5,9 @@
 
 use cam_core::{Point3, UnitVector3, Vector3};
 use gcode_emit::{
-    dialect_by_name, Coolant, Dialect, Fanuc, Feed, GcodeError, HeidenhainIso, LinuxCnc, Motion,
-    NcMove, NcOperation, NcProgram, OutputMode, ProgramOptions, RotaryWord, Sinumerik, Spindle,
-    ToolCall, DIALECT_NAMES,
+    dialect_by_name, Coolant, Dialect, Fanuc, Feed, GcodeError, HeidenhainConversational,
+    HeidenhainIso, LinuxCnc, Motion, NcMove, NcOperation, NcProgram, OutputMode, ProgramOptions,
+    RotaryWord, Sinumerik, Spindle, ToolCall, DIALECT_NAMES,
 };
 
 fn rot(a: f64, c: f64) -> Vec<RotaryWord> {
@@ -289,7 +289,8 @@ fn unknown_dialect_lists_the_valid_ones() {
     let e = dialect_by_name("haas").unwrap_err();
     assert_eq!(
         e.to_string(),
-        "unknown dialect `haas`; valid dialects: linuxcnc, fanuc, sinumerik, heidenhain"
+        "unknown dialect `haas`; valid dialects: linuxcnc, fanuc, sinumerik, heidenhain, \
+         heidenhain_conversational"
     );
     for n in DIALECT_NAMES {
         assert_eq!(dialect_by_name(&n.to_uppercase()).unwrap().name(), n);
@@ -414,4 +415,98 @@ fn slow_inverse_time_blocks_keep_significant_digits() {
         .write(&program(vec![op]), &options())
         .unwrap();
     assert!(text.contains("G93 G1 Z2 F0.0001235\n"), "{text}");
+}
+
+#[test]
+fn heidenhain_conversational_matches_golden() {
+    let p = program(vec![rough(OutputMode::TcpAngles), finish_indexed()]);
+    let text = HeidenhainConversational::default()
+        .write(&p, &options())
+        .unwrap();
+    if std::env::var_os("GOLDEN_PRINT").is_some() {
+        println!("{text}");
+    }
+    assert_same(&text, "heidenhain_conversational.h");
+}
+
+/// The machine's program frame reaches every dialect: its header blocks after the setup
+/// block, footer blocks and end code at the end, its coolant codes, block numbers that wrap
+/// at the control's largest number; a trivkins LinuxCNC program has no kinematics switch
+/// (a stock configuration rejects `M429`) and refuses tool-tip output.
+#[test]
+fn the_program_frame_shapes_every_dialect() {
+    let mut op = rough(OutputMode::Joint);
+    op.tool.coolant = Coolant::ThroughTool;
+    let p = program(vec![op]);
+    let mut o = ProgramOptions {
+        header: vec!["G64 P0.01".into()],
+        footer: vec!["G53 G0 Y0".into()],
+        program_end: Some("M30".into()),
+        line_numbers: Some(gcode_emit::LineNumbers {
+            start: 1,
+            step: 1,
+            wrap: Some(9),
+        }),
+        ..options()
+    };
+    o.coolant_codes.through = "M88".into();
+    let text = LinuxCnc::trivial().write(&p, &o).unwrap();
+    assert!(!text.contains("M429") && !text.contains("M428"), "{text}");
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[2], "N1 G21 G17 G90 G94 G40 G49 G54", "{text}");
+    assert_eq!(lines[3], "N2 G64 P0.01", "{text}");
+    assert!(text.contains(" M88\n"), "{text}");
+    let n = lines.len();
+    assert!(lines[n - 3].ends_with(" G53 G0 Y0"), "{text}");
+    assert!(
+        lines[n - 2].ends_with(" M30") && lines[n - 1] == "%",
+        "{text}"
+    );
+    // Numbers run 1..=9 and start again.
+    let numbers: Vec<u32> = lines
+        .iter()
+        .filter_map(|l| l.strip_prefix('N'))
+        .map(|l| l.split(' ').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(numbers.iter().all(|&k| (1..=9).contains(&k)), "{numbers:?}");
+    assert!(numbers.windows(2).any(|w| w == [9, 1]), "{numbers:?}");
+    // The switchkins default still selects identity kinematics first.
+    assert!(LinuxCnc::default()
+        .write(&p, &options())
+        .unwrap()
+        .contains("N20 M429\n"));
+    let tcp = program(vec![rough(OutputMode::TcpAngles)]);
+    assert!(matches!(
+        LinuxCnc::trivial().write(&tcp, &options()),
+        Err(GcodeError::Unsupported { .. })
+    ));
+    // The other dialects take the same frame.
+    let mut op = rough(OutputMode::TcpAngles);
+    op.tool.coolant = Coolant::ThroughTool;
+    let p = program(vec![op]);
+    for d in [
+        "fanuc",
+        "sinumerik",
+        "heidenhain",
+        "heidenhain_conversational",
+    ] {
+        let text = dialect_by_name(d).unwrap().write(&p, &o).unwrap();
+        assert!(text.contains("G64 P0.01"), "{d}: {text}");
+        assert!(text.contains("G53 G0 Y0"), "{d}: {text}");
+        assert!(text.contains("M88"), "{d}: {text}");
+        let end = text.find("M30").unwrap();
+        assert!(text.find("G53 G0 Y0").unwrap() < end, "{d}: {text}");
+    }
+    // A header block must be one line.
+    let bad = ProgramOptions {
+        header: vec!["G64\nM3".into()],
+        ..options()
+    };
+    assert!(matches!(
+        LinuxCnc::trivial().write(&p, &bad),
+        Err(GcodeError::InvalidOption {
+            field: "header",
+            ..
+        })
+    ));
 }

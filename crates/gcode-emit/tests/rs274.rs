@@ -85,6 +85,19 @@ fn remap_ini(dir: &Path) -> PathBuf {
     ini
 }
 
+/// An ini of a stock trivkins configuration (`trivkins coordinates=xyzac`: the axes are the
+/// joints): no remapped M codes, so a kinematics switch such as `M429` is an error
+/// ("M-code greater than 199").
+fn trivkins_ini(dir: &Path) -> PathBuf {
+    let ini = dir.join("trivkins.ini");
+    std::fs::write(
+        &ini,
+        "[TRAJ]\nCOORDINATES = XYZAC\nLINEAR_UNITS = mm\nANGULAR_UNITS = deg\n",
+    )
+    .unwrap();
+    ini
+}
+
 /// Canonical motion lines of rs274's output as (name, [x y z a b c]).
 fn canonical_moves(stdout: &str) -> Vec<(String, [f64; 6])> {
     let mut out = Vec::new();
@@ -268,6 +281,58 @@ fn rs274_accepts_joint_output_and_executes_our_joint_values() {
         check(&text, &stdout, &assembled.program);
         std::fs::remove_dir_all(&dir).unwrap();
     }
+}
+
+/// A machine file saying `[program] kinematics = "trivial"` gives a program a stock trivkins
+/// configuration runs, with the same joint moves; the switchkins program (identity selected
+/// by `M429` first) is rejected there, so the check is live.
+#[test]
+fn rs274_runs_trivkins_joint_output_in_a_trivkins_configuration() {
+    let Some(rs) = require_rs274() else { return };
+    let machine = support::xyzac();
+    let ops = vec![
+        support::five_axis_op("flank", 3, 12),
+        support::indexed_op("pocket", 4),
+    ];
+    let dialect = LinuxCnc::trivial();
+    let assembled = assemble_program(
+        "rs274_trivkins",
+        &ops,
+        &machine,
+        &dialect,
+        &AssembleOptions::default(),
+    )
+    .unwrap();
+    let options = ProgramOptions {
+        safe_z_machine: machine.safe_z().unwrap_or(0.0),
+        ..Default::default()
+    };
+    let text = dialect.write(&assembled.program, &options).unwrap();
+    assert!(!text.contains("M429") && !text.contains("M428"));
+    let dir = scratch("trivkins");
+    let ini = trivkins_ini(&dir);
+    let stdout = run(&rs, &dir, &text, Some(&ini));
+    check(&text, &stdout, &assembled.program);
+    // The switchkins program: rejected by the same configuration.
+    let switched = LinuxCnc::default()
+        .write(&assembled.program, &options)
+        .unwrap();
+    std::fs::write(dir.join("switched.ngc"), &switched).unwrap();
+    let out = Command::new(&rs)
+        .arg("-i")
+        .arg(&ini)
+        .arg("-g")
+        .arg(dir.join("switched.ngc"))
+        .env("HOME", &dir)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("M-code greater than 199"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -804,10 +804,7 @@ pub fn post(
     )
     .map_err(msg)?;
     let program_options = ProgramOptions {
-        line_numbers: Some(LineNumbers {
-            start: 10,
-            step: 10,
-        }),
+        line_numbers: Some(LineNumbers::new(10, 10)),
         safe_z_machine: machine.safe_z().unwrap_or(0.0),
         ..ProgramOptions::default()
     };

@@ -60,7 +60,8 @@ pub struct ClOperation {
     /// `PPRINT` texts met inside the operation, in order.
     pub comments: Vec<String>,
     /// Gauge length of the tool (spindle gauge line to tip, mm) for the kinematics of head
-    /// machines; `None`: the post options' tool length. Not read from or written to APT files.
+    /// machines: `LOADTL/n,LENGTH,l` in APT files; `None`: not given (the post options' tool
+    /// length).
     pub tool_length_mm: Option<f64>,
 }
 

@@ -117,6 +117,7 @@ struct Reader<'a> {
     feed: Option<f64>,
     rapid_next: bool,
     tool_number: Option<u32>,
+    tool_length: Option<f64>,
     apt_cutter: Option<AptCutter>,
     cutter: Option<Cutter>,
     spindle: Option<Spindle>,
@@ -141,6 +142,7 @@ impl<'a> Reader<'a> {
             feed: None,
             rapid_next: false,
             tool_number: None,
+            tool_length: None,
             apt_cutter: None,
             cutter: None,
             spindle: None,
@@ -214,6 +216,7 @@ impl<'a> Reader<'a> {
     fn open(&mut self, line: usize) -> &mut ClOperation {
         let stale = self.current.as_ref().is_some_and(|op| {
             op.tool_number != self.tool_number
+                || op.tool_length_mm != self.tool_length
                 || op.apt_cutter != self.apt_cutter
                 || op.spindle != self.spindle
                 || op.coolant != self.coolant
@@ -227,6 +230,7 @@ impl<'a> Reader<'a> {
                 };
                 if let Some(op) = self.current.as_mut() {
                     op.tool_number = self.tool_number;
+                    op.tool_length_mm = self.tool_length;
                     op.apt_cutter = self.apt_cutter;
                     op.cutter.clone_from(&self.cutter);
                     op.spindle = self.spindle;
@@ -252,6 +256,7 @@ impl<'a> Reader<'a> {
             };
             let mut op = ClOperation::new(ToolPath::new(name, tool));
             op.tool_number = self.tool_number;
+            op.tool_length_mm = self.tool_length;
             op.apt_cutter = self.apt_cutter;
             op.cutter.clone_from(&self.cutter);
             op.spindle = self.spindle;
@@ -320,12 +325,35 @@ impl<'a> Reader<'a> {
                         format!("tool number {v} is not a non-negative integer"),
                     ));
                 }
-                if params.len() > 1 {
+                // `LOADTL/n,LENGTH,l` (ISO 4343) gives the gauge length; other modifiers are
+                // not used.
+                let mut length = None;
+                let mut ignored = Vec::new();
+                let mut i = 1;
+                while i < params.len() {
+                    if params[i].eq_ignore_ascii_case("LENGTH") {
+                        let l = self.num(line, w, &params, i + 1)? * self.scale;
+                        if l <= 0.0 {
+                            return Err(self.err(
+                                line,
+                                w,
+                                i + 2,
+                                format!("tool length {l} must be > 0"),
+                            ));
+                        }
+                        length = Some(l);
+                        i += 2;
+                    } else {
+                        ignored.push(params[i]);
+                        i += 1;
+                    }
+                }
+                if !ignored.is_empty() {
                     self.warn(
                         line,
                         format!(
                             "LOADTL parameters after the tool number ignored: {}",
-                            params[1..].join(",")
+                            ignored.join(",")
                         ),
                     );
                 }
@@ -337,6 +365,7 @@ impl<'a> Reader<'a> {
                     self.close(line);
                 }
                 self.tool_number = Some(v as u32);
+                self.tool_length = length;
                 if let Some(c) = self.cutter.as_mut() {
                     c.name = format!("T{}", v as u32);
                 }

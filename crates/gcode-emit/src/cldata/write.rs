@@ -1,12 +1,13 @@
 //! Writing a [`ClProgram`] as APT CLDATA text that [`super::read_cl`] reads back.
 //!
-//! Layout per operation: `TOOL PATH/name,TOOL,tool`, `LOADTL`, `CUTTER/d,r,e,f,a,b,h`,
+//! Layout per operation: `TOOL PATH/name,TOOL,tool`, `LOADTL/n` (`LOADTL/n,LENGTH,l` with the
+//! gauge length), `CUTTER/d,r,e,f,a,b,h`,
 //! `SPINDL/RPM,n,CLW|CCLW`, `COOLNT`, `PPRINT` comments, then `RAPID` + `GOTO` for rapid moves
 //! and `FEDRAT/MMPM,f` (only when the feed changes) + `GOTO` for the others, and
 //! `END-OF-PATH`; the file ends with `FINI`. Units are millimetres (`UNITS/MM`).
 //!
 //! Round trip: tips, axes, rapid/non-rapid, feeds (a `None` feed inherits the previous one,
-//! as in the move model), tool numbers, cutters, spindle, coolant and comments read back as
+//! as in the move model), tool numbers and lengths, cutters, spindle, coolant and comments read back as
 //! written. `Plunge` and `Retract` moves read back as `Feed` (APT has no such kinds).
 //! With `decimals = None` numbers use Rust's shortest exact representation, so positions
 //! read back bit for bit (axes that are unit to rounding are kept as written).
@@ -75,8 +76,15 @@ pub fn write_cl(program: &ClProgram, options: &ClWriteOptions) -> Result<String,
             one_line(&op.path.tool).replace(',', " ")
         ));
         line(if op.multax { "MULTAX/ON" } else { "MULTAX/OFF" });
-        if let Some(n) = op.tool_number {
-            line(&format!("LOADTL/{n}"));
+        match (op.tool_number, op.tool_length_mm) {
+            (Some(n), Some(l)) => {
+                line(&format!(
+                    "LOADTL/{n},LENGTH,{}",
+                    num.f(l, "LOADTL", name, 2)?
+                ));
+            }
+            (Some(n), None) => line(&format!("LOADTL/{n}")),
+            _ => {}
         }
         let apt = op.apt_cutter.or_else(|| {
             op.cutter

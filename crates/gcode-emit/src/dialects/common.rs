@@ -3,7 +3,7 @@
 use crate::dialect::{num, At, BlockWriter, MotionStyle, MotionWriter};
 use crate::program::{Feed, Motion, NcMove, NcOperation, OutputMode, ProgramOptions, ToolCall};
 use crate::tilted_plane::TiltedPlane;
-use crate::{Coolant, GcodeError, NumberFormat, Spindle};
+use crate::{GcodeError, NumberFormat, Spindle};
 use cam_core::Point3;
 
 /// `G0`/`G1`, `G93`/`G94`, tool vector as `I J K`; lengths and angles formatted by
@@ -39,15 +39,35 @@ pub fn retract_block(
     Ok(format!("{before} Z{z}{after}"))
 }
 
-/// The spindle block (`S.. M3`/`M4`, integer speed, or `M5`) and the coolant block.
+/// The spindle block (`S.. M3`/`M4`, integer speed, or `M5`) and the coolant block (the
+/// options' code of the operation's coolant).
 pub fn spindle_and_coolant(
     w: &mut BlockWriter,
     tool: &ToolCall,
+    o: &ProgramOptions,
     at: At<'_>,
 ) -> Result<(), GcodeError> {
     w.block(&spindle_words(tool.spindle, NumberFormat::trimmed(0), at)?);
-    w.block(coolant_word(tool.coolant));
+    w.block(o.coolant_codes.code(tool.coolant));
     Ok(())
+}
+
+/// The machine's own start blocks ([`ProgramOptions::header`]).
+pub fn header(w: &mut BlockWriter, o: &ProgramOptions) {
+    for line in &o.header {
+        w.block(line.trim());
+    }
+}
+
+/// The program's closing blocks: spindle and coolant off (`M5`, the off code), the machine's
+/// own blocks ([`ProgramOptions::footer`]), then the end code (the options' or `default_end`).
+pub fn footer(w: &mut BlockWriter, o: &ProgramOptions, default_end: &str) {
+    w.block("M5");
+    w.block(&o.coolant_codes.off);
+    for line in &o.footer {
+        w.block(line.trim());
+    }
+    w.block(o.program_end.as_deref().unwrap_or(default_end).trim());
 }
 
 /// Rapid of the rotary axes alone to the first move's angles, before the linear approach;
@@ -132,15 +152,6 @@ pub fn spindle_words(
         ),
         None => "M5".to_string(),
     })
-}
-
-/// Coolant M word (`M7` mist, `M8` flood and through-tool, `M9` off).
-pub fn coolant_word(c: Coolant) -> &'static str {
-    match c {
-        Coolant::Off => "M9",
-        Coolant::Mist => "M7",
-        Coolant::Flood | Coolant::ThroughTool => "M8",
-    }
 }
 
 /// The rotary words of a move, formatted (`A10 C-20`).

@@ -19,7 +19,7 @@
 //!   retracts in machine coordinates before any tool change or reorientation.
 
 use super::common::{
-    iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block,
+    footer, header, iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block,
     spindle_and_coolant, write_moves, write_tilted_tips, xy_approach,
 };
 use crate::dialect::{num, program_name, sanitize, At, BlockWriter, Dialect, MotionWriter};
@@ -73,6 +73,7 @@ impl Dialect for Fanuc {
             "G21 G17 G90 G94 G40 G49 G80 G{}",
             53 + o.work_offset
         ));
+        header(&mut w, o);
         let safe = retract_block("G53 G0", "", o, style.linear_fmt)?;
         let mut tool: Option<u32> = None;
         for op in &program.operations {
@@ -85,7 +86,7 @@ impl Dialect for Fanuc {
                 w.block(&format!("T{} M6", op.tool.number));
                 tool = Some(op.tool.number);
             }
-            spindle_and_coolant(&mut w, &op.tool, at)?;
+            spindle_and_coolant(&mut w, &op.tool, o, at)?;
             mw.forget_positions();
             let h = op.tool.number;
             match &op.motion {
@@ -123,9 +124,8 @@ impl Dialect for Fanuc {
             }
             mw.forget_positions();
         }
-        for end in [safe.as_str(), "M5", "M9", "M30"] {
-            w.block(end);
-        }
+        w.block(&safe);
+        footer(&mut w, o, "M30");
         w.raw("%");
         Ok(w.finish())
     }

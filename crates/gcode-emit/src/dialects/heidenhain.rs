@@ -18,7 +18,7 @@
 //!   through M116/M128, not `G93`.
 
 use super::common::{
-    coolant_word, iso_style, op_comment, preposition_rotary, retract_block, write_moves,
+    footer, header, iso_style, op_comment, preposition_rotary, retract_block, write_moves,
     write_tilted_tips,
 };
 use crate::dialect::{
@@ -62,14 +62,12 @@ impl Dialect for HeidenhainIso {
         };
         let ang = style.angular_fmt;
         let name = program_name(&program.name);
-        let numbers = o.line_numbers.unwrap_or(LineNumbers {
-            start: 10,
-            step: 10,
-        });
+        let numbers = o.line_numbers.unwrap_or(LineNumbers::new(10, 10));
         let mut w = BlockWriter::new(Some(numbers), " *");
         let mut mw = MotionWriter::new(style);
         w.raw(&format!("%{name} G71 *"));
         w.block("G17 G90 G40");
+        header(&mut w, o);
         let safe = retract_block("G00", " M91", o, style.linear_fmt)?;
         let mut tool: Option<u32> = None;
         for op in &program.operations {
@@ -96,7 +94,7 @@ impl Dialect for HeidenhainIso {
                 Some(_) => "M3",
                 None => "M5",
             });
-            w.block(coolant_word(op.tool.coolant));
+            w.block(o.coolant_codes.code(op.tool.coolant));
             mw.forget_positions();
             match &op.motion {
                 Motion::Simultaneous { mode, moves } => {
@@ -130,9 +128,8 @@ impl Dialect for HeidenhainIso {
             }
             mw.forget_positions();
         }
-        for end in [safe.as_str(), "M5", "M9", "M30"] {
-            w.block(end);
-        }
+        w.block(&safe);
+        footer(&mut w, o, "M30");
         w.raw(&format!("N99999999 %{name} G71 *"));
         Ok(w.finish())
     }

@@ -18,7 +18,7 @@
 //!   plane at the operation's end.
 
 use super::common::{
-    iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block,
+    footer, header, iso_style, leave_inverse_time, op_comment, preposition_rotary, retract_block,
     spindle_and_coolant, write_moves, write_tilted_tips, xy_approach,
 };
 use crate::dialect::{
@@ -70,6 +70,7 @@ impl Dialect for Sinumerik {
             w.raw(&format!("; {}", program_name(&program.name)));
         }
         w.block(&format!("G17 G71 G90 G94 G40 G{}", 53 + o.work_offset));
+        header(&mut w, o);
         let safe = retract_block("G0 SUPA", " D0", o, style.linear_fmt)?;
         for op in &program.operations {
             let at = At::start(&op.name);
@@ -81,7 +82,7 @@ impl Dialect for Sinumerik {
             w.block(&format!("T{}", op.tool.number));
             w.block("M6");
             w.block("D1");
-            spindle_and_coolant(&mut w, &op.tool, at)?;
+            spindle_and_coolant(&mut w, &op.tool, o, at)?;
             mw.forget_positions();
             match &op.motion {
                 Motion::Simultaneous { mode, moves } => {
@@ -125,9 +126,8 @@ impl Dialect for Sinumerik {
             }
             mw.forget_positions();
         }
-        for end in [safe.as_str(), "M5", "M9", "M30"] {
-            w.block(end);
-        }
+        w.block(&safe);
+        footer(&mut w, o, "M30");
         Ok(w.finish())
     }
 }

@@ -114,10 +114,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let assembled = assemble_program(&name, &cl.operations, &machine, dialect.as_ref(), &options)
         .map_err(|e| CliError::Message(format!("{}: {e}", args.cl_file.display())))?;
     let program_options = ProgramOptions {
-        line_numbers: (!args.no_line_numbers).then_some(LineNumbers {
-            start: 10,
-            step: 10,
-        }),
+        line_numbers: (!args.no_line_numbers).then_some(LineNumbers::new(10, 10)),
         linear_decimals: args.decimals,
         angular_decimals: args.decimals,
         safe_z_machine: match args.safe_z {
