@@ -810,6 +810,8 @@ impl Job {
             v.resolution_mm,
         )?;
 
+        check_files(&raw, path, text, files, &resolve)?;
+
         // Tools.
         let tools: Vec<Tool> = match raw.tools {
             None => Vec::new(),
@@ -939,6 +941,15 @@ impl Job {
             operations.push(spec);
         }
 
+        // A job with neither operations nor CL files used to run `0 operation(s)` and exit 0.
+        if operations.is_empty() && raw.cl_files.is_empty() {
+            return Err(at(
+                path,
+                None,
+                "operations",
+                "no operations: the job has no [[operations]] and no [[cl_files]], nothing to machine",
+            ));
+        }
         let name = raw.name.unwrap_or_else(|| {
             path.parent()
                 .and_then(|p| p.file_name())
@@ -987,6 +998,55 @@ impl Job {
             None => CliError::Message(e.to_string()),
         }
     }
+}
+
+/// The job's other inputs, checked before anything runs (an unknown dialect used to be found
+/// after planning, leaving `toolpath.cls` behind): the dialect name; the impeller, machine
+/// and CL files readable; the machine file valid (kinematics, limits and its `[program]`
+/// frame, errors naming the machine file's line and key).
+fn check_files(
+    raw: &RawJob,
+    path: &Path,
+    text: &str,
+    files: &'static [(&'static str, &'static str)],
+    resolve: &dyn Fn(PathBuf) -> PathBuf,
+) -> Result<(), CliError> {
+    let top = |key: &str| line_of(text, &[Seg::Key(key.into())]);
+    gcode_emit::dialect_by_name(&raw.dialect)
+        .map_err(|e| at(path, top("dialect"), "dialect", e))?;
+    if let Some(p) = &raw.impeller {
+        read_text(files, &resolve(p.clone()))
+            .map_err(|e| at(path, top("impeller"), "impeller", e))?;
+    }
+    if let Some(p) = &raw.machine {
+        let file = resolve(p.clone());
+        let machine =
+            read_text(files, &file).map_err(|e| at(path, top("machine"), "machine", e))?;
+        let name = file.display().to_string();
+        let invalid = |e: &dyn std::fmt::Display| {
+            at(
+                path,
+                top("machine"),
+                "machine",
+                format!("invalid machine file: {e}"),
+            )
+        };
+        postproc_kinematics::Machine::from_toml_str(&machine, &name).map_err(|e| invalid(&e))?;
+        gcode_emit::ProgramFrame::from_machine_toml(&machine, &name).map_err(|e| invalid(&e))?;
+    }
+    for (i, c) in raw.cl_files.iter().enumerate() {
+        let line = line_of(
+            text,
+            &[
+                Seg::Key("cl_files".into()),
+                Seg::Index(i),
+                Seg::Key("path".into()),
+            ],
+        );
+        read_text(files, &resolve(c.path.clone()))
+            .map_err(|e| at(path, line, &format!("cl_files[{i}].path"), e))?;
+    }
+    Ok(())
 }
 
 fn embedded(files: &'static [(&'static str, &'static str)], path: &Path) -> Option<&'static str> {

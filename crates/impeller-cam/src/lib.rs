@@ -14,12 +14,14 @@
 pub mod cmd;
 pub mod error;
 pub mod job;
+pub mod outputs;
 pub mod pipeline;
 pub mod plot;
 pub mod progress;
 pub mod registry;
 pub mod report;
 pub mod surface_groups;
+pub mod verdict;
 
 pub use error::CliError;
 pub use job::Job;

@@ -25,8 +25,8 @@ use cam_plan::{
 };
 use gcode_emit::assemble::{assemble_program_with_access, AssembledProgram, OperationAccess};
 use gcode_emit::{
-    dialect_by_name, read_cl, write_cl_file, write_program_file, AssembleOptions, ClOperation,
-    ClProgram, ClReadOptions, ClWriteOptions, LineNumbers, OutputMode, ProgramOptions, Spindle,
+    read_cl, write_cl_file, write_program_file, AssembleOptions, ClOperation, ClProgram,
+    ClReadOptions, ClWriteOptions, LineNumbers, OutputMode, ProgramFrame, ProgramOptions, Spindle,
 };
 use impeller_model::Impeller;
 use machining_sim::{
@@ -105,12 +105,25 @@ pub fn run_job(job: &Job, out: &Path) -> Result<Report, CliError> {
 /// Runs `job` with the operation kinds of `registry`, writing every output file into `out`:
 /// `toolpath.cls`, `program.<ext>` (when there is something to machine),
 /// `verification_maps.json` (when verified), `report.json` and `report.html`.
+///
+/// The run owns these files: an earlier run's (every dialect's program included) are removed
+/// first, and the ones written are removed again when the run fails
+/// ([`crate::outputs::clear_run_outputs`]).
 pub fn run_job_with(job: &Job, out: &Path, registry: &Registry) -> Result<Report, CliError> {
-    let total = Instant::now();
     std::fs::create_dir_all(out).map_err(|source| CliError::Io {
         path: out.display().to_string(),
         source,
     })?;
+    crate::outputs::clear_run_outputs(out)?;
+    let run = run_stages(job, out, registry);
+    if run.is_err() {
+        let _ = crate::outputs::clear_run_outputs(out);
+    }
+    run
+}
+
+fn run_stages(job: &Job, out: &Path, registry: &Registry) -> Result<Report, CliError> {
+    let total = Instant::now();
     let mut report = Report::new(&job.name);
     let progress = Progress::new(job.quiet);
 
@@ -156,6 +169,10 @@ pub fn run_job_with(job: &Job, out: &Path, registry: &Registry) -> Result<Report
     )?;
     report.timings_ms.insert("verify_ms".into(), ms(t));
     withhold_defective_program(job, out, &mut report)?;
+    report.verdict = Some(crate::verdict::Verdict::of(
+        &report,
+        job.tolerances.machining_tol,
+    ));
     report
         .timings_ms
         .insert("total_ms".into(), total.elapsed().as_secs_f64() * 1e3);
@@ -202,11 +219,23 @@ fn withhold_defective_program(job: &Job, out: &Path, report: &mut Report) -> Res
 
 /// The job's machine (the embedded xyzac-trt when it names none).
 fn load_machine(job: &Job) -> Result<Machine, CliError> {
+    let (text, file) = machine_text(job)?;
+    Machine::from_toml_str(&text, &file).map_err(msg)
+}
+
+/// The text of the job's machine file and its name for errors.
+fn machine_text(job: &Job) -> Result<(String, String), CliError> {
     match &job.machine {
-        Some(p) => Machine::from_toml_str(&job.read_text(p)?, &p.display().to_string()),
-        None => Machine::from_toml_str(DEFAULT_MACHINE, "embedded xyzac-trt.toml"),
+        Some(p) => Ok((job.read_text(p)?, p.display().to_string())),
+        None => Ok((DEFAULT_MACHINE.into(), "embedded xyzac-trt.toml".into())),
     }
-    .map_err(msg)
+}
+
+/// The program frame of the job's machine file (`[program]`: kinematics switch, header,
+/// footer, block numbers, coolant codes; see [`gcode_emit::frame`]).
+fn load_frame(job: &Job) -> Result<ProgramFrame, CliError> {
+    let (text, file) = machine_text(job)?;
+    ProgramFrame::from_machine_toml(&text, &file).map_err(msg)
 }
 
 /// Largest deviation (mm) of the read-back chords from the controller's motion.
@@ -645,6 +674,21 @@ pub fn link_for_machine(
         return Ok(());
     }
     let machine = load_machine(job)?;
+    // On a head machine the gauge length moves the tip: planned operations carry their
+    // tool's `tool_length_mm`; CL data must give it (`LOADTL/n,LENGTH,l`), never a silent 0.
+    if machine.tool_length_matters() {
+        if let Some(op) = operations.iter().find(|o| o.cl.tool_length_mm.is_none()) {
+            return Err(CliError::Message(format!(
+                "operation \"{}\" (T{}) has no tool length: machine {} ({}) turns the tool \
+                 about its head, so the gauge length moves the tip; give it in the CL file \
+                 with LOADTL/n,LENGTH,l",
+                op.cl.path.name,
+                op.cl.tool_number.unwrap_or_default(),
+                machine.name(),
+                machine.kinematics().kind_name()
+            )));
+        }
+    }
     let surface =
         SafetySurface::around_stock(impeller.stock(), job.safety.clearance_mm).map_err(msg)?;
     let linker = Linker::with_blank(surface, impeller.stock());
@@ -720,7 +764,8 @@ pub fn post(
     .map_err(msg)?;
 
     let machine = load_machine(job)?;
-    let dialect = dialect_by_name(&job.dialect).map_err(msg)?;
+    let frame = load_frame(job)?;
+    let dialect = frame.dialect(&job.dialect).map_err(msg)?;
     let mode = match dialect.name() {
         "linuxcnc" | "fanuc" => OutputMode::Joint,
         _ => OutputMode::TcpAngles,
@@ -803,11 +848,12 @@ pub fn post(
         &access,
     )
     .map_err(msg)?;
-    let program_options = ProgramOptions {
+    let mut program_options = ProgramOptions {
         line_numbers: Some(LineNumbers::new(10, 10)),
         safe_z_machine: machine.safe_z().unwrap_or(0.0),
         ..ProgramOptions::default()
     };
+    frame.apply(&mut program_options);
     write_program_file(
         &program_path,
         dialect.as_ref(),

@@ -188,6 +188,9 @@ pub struct Report {
     pub post: PostReport,
     /// Verification (`null` when nothing was verified).
     pub verification: Option<VerificationReport>,
+    /// Pass or fail with the limits in force, and what became of the program (`null` until
+    /// the run's verification gate has run).
+    pub verdict: Option<crate::verdict::Verdict>,
     /// Wall-clock time per stage (ms).
     pub timings_ms: BTreeMap<String, f64>,
     /// What was skipped and why, and reader warnings.
@@ -210,6 +213,7 @@ impl Report {
             operations: Vec::new(),
             post: PostReport::default(),
             verification: None,
+            verdict: None,
             timings_ms: BTreeMap::new(),
             notes: Vec::new(),
             plots: Vec::new(),
@@ -510,6 +514,9 @@ impl Report {
             esc(&self.job),
             esc(&self.version)
         );
+        if let Some(v) = &self.verdict {
+            verdict_html(&mut h, v, &self.post.program);
+        }
         h.push_str("<h2>Impeller</h2>");
         table_of_object(&mut h, &self.impeller);
         for svg in &self.plots {
@@ -580,9 +587,9 @@ impl Report {
             Some(v) => {
                 let _ = write!(
                     h,
-                    "<table><tr><th>max overcut (mm)</th><th>max residual (mm)</th><th>collisions</th><th>resolution (mm)</th></tr>\
-                     <tr><td>{:.4}</td><td>{:.4}</td><td>{}</td><td>{}</td></tr></table>",
-                    v.max_overcut_mm, v.max_residual_mm, v.collisions, v.resolution_mm
+                    "<table><tr><th>max overcut (mm)</th><th>overcut limit (mm)</th><th>max residual (mm)</th><th>collisions</th><th>resolution (mm)</th></tr>\
+                     <tr><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td><td>{}</td><td>{}</td></tr></table>",
+                    v.max_overcut_mm, v.overcut_limit_mm, v.max_residual_mm, v.collisions, v.resolution_mm
                 );
             }
             None => h.push_str("<p>Nothing was verified.</p>"),
@@ -630,6 +637,30 @@ fn render_plot(plot: &cam_plan::Plot) -> String {
             let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
             heat_map(&plot.title, values, lo, hi, unit)
         }
+    }
+}
+
+/// The verdict at the top of the report: PASS / FAIL / NOT VERIFIED, the program, the limits
+/// in force and the defects.
+fn verdict_html(h: &mut String, v: &crate::verdict::Verdict, program: &str) {
+    let colour = match v.status {
+        crate::verdict::Status::Pass => "#1a7f37",
+        crate::verdict::Status::Fail => "#cf222e",
+        crate::verdict::Status::NotVerified => "#9a6700",
+    };
+    let _ = write!(
+        h,
+        "<h2 id=\"verdict\" style=\"color:{colour}\">Verdict: {}</h2><p>Program: {}</p><p>{}</p>",
+        v.word(),
+        esc(&v.program_text(program)),
+        esc(&v.verification())
+    );
+    if !v.defects.is_empty() {
+        h.push_str("<ul>");
+        for d in &v.defects {
+            let _ = write!(h, "<li>{}</li>", esc(d));
+        }
+        h.push_str("</ul>");
     }
 }
 

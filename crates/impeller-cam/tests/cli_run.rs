@@ -83,6 +83,12 @@ fn default_job_is_the_impeller_8_8_fixture_job() {
     assert_eq!(r["verification"]["source"], "program");
     assert_eq!(r["verification"]["collisions"], 0);
     assert!(r["verification"]["defects"].as_array().unwrap().is_empty());
+    assert_eq!(r["verdict"]["status"], "pass");
+    let last = stderr.lines().last().unwrap_or_default();
+    assert!(
+        last.contains("program.ngc, verification PASS (overcut") && last.contains("<= limit"),
+        "{last}"
+    );
     for k in ["model_ms", "plan_ms", "post_ms", "verify_ms", "total_ms"] {
         assert!(r["timings_ms"][k].as_f64().is_some(), "{k}");
     }
@@ -484,6 +490,16 @@ fn gouging_program_is_withheld_with_exit_3_unless_defects_are_allowed() {
     );
     let stderr = String::from_utf8_lossy(&st.stderr);
     assert!(stderr.contains("DEFECT: overcut"), "{stderr}");
+    // The last line says the program was withheld and why, with the limit in force (it
+    // used to say `program (none: nothing to machine)`).
+    let last = stderr.lines().last().unwrap_or_default();
+    assert!(
+        last.contains("program withheld (verification failed: overcut")
+            && last.contains("verification FAIL (overcut")
+            && last.contains("> limit")
+            && !last.contains("nothing to machine"),
+        "{last}"
+    );
     let r = report(&out);
     let v = &r["verification"];
     assert!(
@@ -491,6 +507,11 @@ fn gouging_program_is_withheld_with_exit_3_unless_defects_are_allowed() {
         "{v}"
     );
     assert!(!v["defects"].as_array().unwrap().is_empty(), "{v}");
+    assert_eq!(r["verdict"]["status"], "fail");
+    assert_eq!(r["verdict"]["program"], "withheld");
+    assert_eq!(r["verdict"]["overcut_limit_mm"], v["overcut_limit_mm"]);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("Verdict: FAIL") && html.contains("withheld (verification failed"));
     assert_eq!(r["post"]["written"], false);
     assert!(!out.join("program.ngc").exists());
     assert!(out.join("report.html").is_file());
@@ -584,4 +605,57 @@ fn progress_goes_to_stderr_as_lines_off_a_terminal_and_not_at_all_with_quiet() {
     assert!(!quiet.contains("planning operations"), "{quiet}");
     assert!(!quiet.contains('\u{1b}'), "{quiet}");
     assert!(quiet.contains(": 1 operation(s)"), "{quiet}");
+}
+
+/// An unknown dialect is refused when the job is read (it used to be found after planning,
+/// without file or line, leaving `toolpath.cls` behind): exit 1, nothing written.
+#[test]
+fn an_unknown_dialect_is_refused_before_anything_runs() {
+    let job = ring_job("haas", &ring_cl());
+    let text = std::fs::read_to_string(&job).unwrap();
+    std::fs::write(&job, text.replace("\"linuxcnc\"", "\"haas\"")).unwrap();
+    let out = job.parent().unwrap().join("out");
+    let st = cli()
+        .arg("run")
+        .arg(&job)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("job.toml:4: dialect: unknown dialect `haas`"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written");
+}
+
+/// A run owns its output folder: a Sinumerik run into a folder a LinuxCNC run used leaves
+/// no `program.ngc` beside its `program.mpf` (it used to keep the old program); other files
+/// stay.
+#[test]
+fn a_run_removes_the_earlier_runs_program_of_another_dialect() {
+    let job = ring_job("stale", &ring_cl());
+    let text = std::fs::read_to_string(&job).unwrap();
+    std::fs::write(&job, text.replace("\"linuxcnc\"", "\"sinumerik\"")).unwrap();
+    let out = job.parent().unwrap().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("program.ngc"), "G0 X0\n").unwrap();
+    std::fs::write(out.join("mine.txt"), "keep").unwrap();
+    let st = cli()
+        .arg("run")
+        .arg(&job)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    assert!(out.join("program.mpf").is_file());
+    assert!(!out.join("program.ngc").exists());
+    assert!(out.join("mine.txt").is_file());
 }

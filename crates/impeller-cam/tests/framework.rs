@@ -377,7 +377,7 @@ fn a_turned_start_stock_follows_the_shroud_and_bad_keys_are_named() {
     let stock = "[stock]\nstart = \"turned\"\n\n";
     let dir = scratch("turned");
     let path = dir.join("job.toml");
-    std::fs::write(&path, job_text(stock)).unwrap();
+    std::fs::write(&path, job_text(&format!("{stock}{RING_OP}"))).unwrap();
     let job = Job::from_file_with(&path, TEST_REGISTRY).unwrap();
     let imp = impeller_cam::pipeline::model(&job).unwrap();
     let s = imp.stock();
@@ -391,7 +391,7 @@ fn a_turned_start_stock_follows_the_shroud_and_bad_keys_are_named() {
         assert!(s.radius_at(p.x).unwrap() >= p.y - 1e-9, "at z {}", p.x);
     }
     // The default starts from the file's blank.
-    std::fs::write(&path, job_text("")).unwrap();
+    std::fs::write(&path, job_text(RING_OP)).unwrap();
     let job = Job::from_file_with(&path, TEST_REGISTRY).unwrap();
     let imp = impeller_cam::pipeline::model(&job).unwrap();
     assert!((imp.stock().max_radius() - 39.5).abs() < 1e-9);

@@ -4,7 +4,7 @@
 use crate::error::CliError;
 use gcode_emit::{
     assemble_program, dialect_by_name, read_cl_file, write_program_file, AssembleOptions,
-    ClReadOptions, LineNumbers, OutputMode, ProgramOptions,
+    ClReadOptions, LineNumbers, OutputMode, ProgramFrame, ProgramOptions,
 };
 use postproc_kinematics::{Machine, PostOptions};
 use std::path::PathBuf;
@@ -28,7 +28,7 @@ pub struct Args {
     /// Machine description (TOML, see fixtures/machines/).
     #[arg(long)]
     pub machine: PathBuf,
-    /// Controller dialect: linuxcnc, fanuc, sinumerik or heidenhain.
+    /// Controller dialect: linuxcnc, fanuc, sinumerik, heidenhain (ISO) or heidenhain_conversational (Klartext).
     #[arg(long)]
     pub dialect: String,
     /// Program file to write (written to a temporary file, renamed when complete).
@@ -37,9 +37,11 @@ pub struct Args {
     /// Output mode (default: joint for linuxcnc and fanuc, tcp for sinumerik and heidenhain).
     #[arg(long, value_enum)]
     pub mode: Option<Mode>,
-    /// Tool length, gauge line to tip (mm); enters the kinematics of head machines only.
-    #[arg(long, default_value_t = 0.0)]
-    pub tool_length: f64,
+    /// Tool length, gauge line to tip (mm), for the operations whose `LOADTL` gives none
+    /// (`LOADTL/n,LENGTH,l` wins). It enters the kinematics of head-table and head-head
+    /// machines only, which refuse a program without it.
+    #[arg(long)]
+    pub tool_length: Option<f64>,
     /// Approach / retract distance along the tool axis at each operation's ends (mm).
     #[arg(long, default_value_t = 10.0)]
     pub retract: f64,
@@ -76,7 +78,22 @@ pub fn run(args: Args) -> Result<(), CliError> {
             dialect.name()
         )));
     }
-    let machine = Machine::from_file(&args.machine).map_err(|e| msg(&e))?;
+    let machine_text = std::fs::read_to_string(&args.machine).map_err(|source| CliError::Io {
+        path: args.machine.display().to_string(),
+        source,
+    })?;
+    let machine_file = args.machine.display().to_string();
+    let machine = Machine::from_toml_str(&machine_text, &machine_file).map_err(|e| msg(&e))?;
+    let frame =
+        ProgramFrame::from_machine_toml(&machine_text, &machine_file).map_err(|e| msg(&e))?;
+    let dialect = frame.dialect(dialect.name()).map_err(|e| msg(&e))?;
+    if let Some(l) = args.tool_length {
+        if !(l.is_finite() && l > 0.0) {
+            return Err(CliError::Message(format!(
+                "--tool-length must be a length > 0 mm, got {l}"
+            )));
+        }
+    }
     let cl = read_cl_file(&args.cl_file, &ClReadOptions::default()).map_err(|e| msg(&e))?;
     for w in &cl.warnings {
         eprintln!(
@@ -92,11 +109,27 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.cl_file.display()
         )));
     }
+    // On a head machine the gauge length moves the tip: never a silent 0 (the program of
+    // top-ring.cls on headhead-ac used to be 20 mm off without --tool-length 115).
+    if machine.tool_length_matters() && args.tool_length.is_none() {
+        if let Some(op) = cl.operations.iter().find(|op| op.tool_length_mm.is_none()) {
+            return Err(CliError::Message(format!(
+                "{}: operation \"{}\" (T{}) has no tool length: machine {} ({}) turns the \
+                 tool about its head, so the gauge length moves the tip; give it with \
+                 LOADTL/n,LENGTH,l in the CL file or --tool-length",
+                args.cl_file.display(),
+                op.path.name,
+                op.tool_number.unwrap_or_default(),
+                machine.name(),
+                machine.kinematics().kind_name()
+            )));
+        }
+    }
     let options = AssembleOptions {
         mode,
         retract_mm: args.retract,
         post: PostOptions {
-            tool_length: args.tool_length,
+            tool_length: args.tool_length.unwrap_or(0.0),
             ..PostOptions::default()
         },
         ..AssembleOptions::default()
@@ -113,8 +146,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .unwrap_or_else(|| "PROGRAM".into());
     let assembled = assemble_program(&name, &cl.operations, &machine, dialect.as_ref(), &options)
         .map_err(|e| CliError::Message(format!("{}: {e}", args.cl_file.display())))?;
-    let program_options = ProgramOptions {
-        line_numbers: (!args.no_line_numbers).then_some(LineNumbers::new(10, 10)),
+    let mut program_options = ProgramOptions {
+        line_numbers: Some(LineNumbers::new(10, 10)),
         linear_decimals: args.decimals,
         angular_decimals: args.decimals,
         safe_z_machine: match args.safe_z {
@@ -126,6 +159,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         program_number: args.program_number,
         ..ProgramOptions::default()
     };
+    frame.apply(&mut program_options);
+    if args.no_line_numbers {
+        program_options.line_numbers = None;
+    }
     write_program_file(
         &args.out,
         dialect.as_ref(),
@@ -169,7 +206,7 @@ mod tests {
             dialect: dialect.into(),
             out: dir.join(format!("out.{dialect}")),
             mode,
-            tool_length: 0.0,
+            tool_length: None,
             retract: 10.0,
             safe_z: None,
             decimals: 4,
@@ -198,6 +235,12 @@ mod tests {
             run(a).unwrap();
             let text = std::fs::read_to_string(&out).unwrap();
             assert!(text.contains(needle), "{d}:\n{text}");
+            // xyzac-trt is set up for a trivkins controller: no kinematics switch (M429
+            // used to be line 2, which a stock trivkins LinuxCNC rejects).
+            assert!(
+                !text.contains("M429") && !text.contains("M428"),
+                "{d}:\n{text}"
+            );
             // The machine file's safe_z (100 mm) is the retract height.
             assert!(
                 text.contains("Z100") || text.contains("Z+100"),
@@ -207,13 +250,54 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// A head-head machine never gets a silent tool length of 0: without `LOADTL/n,LENGTH,l`
+    /// or `--tool-length` the post refuses (and writes nothing); the CL file's length and
+    /// the option give the same program, and a different one from another length (the tip
+    /// moves with the gauge length).
+    #[test]
+    fn head_machines_take_the_tool_length_from_loadtl_or_refuse() {
+        let dir = scratch("headhead");
+        let head = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/machines/headhead-ac.toml");
+        let mut a = args(&dir, "fanuc", None);
+        a.machine = head.clone();
+        let out = a.out.clone();
+        let e = run(a).unwrap_err().to_string();
+        assert!(
+            e.contains("in.cls: operation")
+                && e.contains("has no tool length")
+                && e.contains("head-head"),
+            "{e}"
+        );
+        assert!(!out.exists(), "no program written");
+        let program = |tool_length: Option<f64>, loadtl: &str, file: &str| {
+            let mut a = args(&dir, "fanuc", None);
+            let cl = std::fs::read_to_string(&a.cl_file).unwrap();
+            std::fs::write(&a.cl_file, cl.replace("LOADTL/2", loadtl)).unwrap();
+            a.machine = head.clone();
+            a.tool_length = tool_length;
+            a.out = dir.join(file);
+            let out = a.out.clone();
+            run(a).unwrap();
+            std::fs::read_to_string(out).unwrap()
+        };
+        let by_option = program(Some(115.0), "LOADTL/2", "a.nc");
+        let by_loadtl = program(None, "LOADTL/2,LENGTH,115", "b.nc");
+        let shorter = program(Some(95.0), "LOADTL/2", "c.nc");
+        assert_eq!(by_option, by_loadtl);
+        assert_ne!(by_option, shorter);
+        // A table-table machine needs none.
+        run(args(&dir, "fanuc", None)).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn user_errors_are_one_line_messages() {
         let dir = scratch("err");
         let e = run(args(&dir, "haas", None)).unwrap_err().to_string();
         assert_eq!(
             e,
-            "unknown dialect `haas`; valid dialects: linuxcnc, fanuc, sinumerik, heidenhain"
+            "unknown dialect `haas`; valid dialects: linuxcnc, fanuc, sinumerik, heidenhain, heidenhain_conversational"
         );
         let e = run(args(&dir, "heidenhain", Some(Mode::Joint)))
             .unwrap_err()

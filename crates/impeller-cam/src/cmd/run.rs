@@ -2,6 +2,7 @@
 
 use crate::error::CliError;
 use crate::job::Job;
+use crate::verdict::Verdict;
 use std::path::PathBuf;
 
 /// Arguments of `impeller-cam run`.
@@ -42,34 +43,30 @@ pub fn run(args: Args) -> Result<Outcome, CliError> {
     job.verification.allow_defects = args.allow_defects;
     job.quiet = args.quiet;
     let report = crate::pipeline::run_job(&job, &args.out)?;
-    eprintln!(
-        "[impeller-cam] {}: {} operation(s), program {}, report {}",
-        report.job,
-        report.operations.len(),
-        if report.post.written {
-            report.post.program.as_str()
-        } else {
-            "(none: nothing to machine)"
-        },
-        args.out.join("report.html").display()
-    );
     for n in &report.notes {
         eprintln!("[impeller-cam] note: {n}");
     }
-    let defects = report
-        .verification
-        .as_ref()
-        .map(|v| v.defects.clone())
-        .unwrap_or_default();
-    if defects.is_empty() {
-        return Ok(Outcome::Clean);
-    }
-    for d in &defects {
+    let verdict = report
+        .verdict
+        .clone()
+        .unwrap_or_else(|| Verdict::of(&report, job.tolerances.machining_tol));
+    for d in &verdict.defects {
         eprintln!("[impeller-cam] DEFECT: {d}");
     }
-    if args.allow_defects {
+    if !verdict.defects.is_empty() && args.allow_defects {
         eprintln!("[impeller-cam] the program was written anyway (--allow-defects)");
-        return Ok(Outcome::Clean);
     }
-    Ok(Outcome::Defects)
+    // The last line: what was made, whether it passed, under which limits.
+    eprintln!(
+        "[impeller-cam] {}: {} operation(s), {}, report {}",
+        report.job,
+        report.operations.len(),
+        verdict.summary(&report.post.program),
+        args.out.join("report.html").display()
+    );
+    if verdict.defects.is_empty() || args.allow_defects {
+        Ok(Outcome::Clean)
+    } else {
+        Ok(Outcome::Defects)
+    }
 }

@@ -1,16 +1,89 @@
 use super::*;
 
-#[test]
-fn paths_resolve_against_the_job_folder() {
-    let job = Job::from_toml_str(
-        "name = \"j\"\nimpeller = \"imp.toml\"\nmachine = \"../m.toml\"\n[[cl_files]]\npath = \"a.cls\"\n",
-        Path::new("/x/y/job.toml"),
+/// A folder of its own per call, with `imp.toml`, `../m.toml` (the LinuxCNC sample machine)
+/// and `a.cls` for jobs in `<folder>/y/job.toml`.
+fn job_folder(tag: &str) -> PathBuf {
+    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let d = std::env::temp_dir().join(format!("impeller-cam-job-{}-{n}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(d.join("y")).unwrap();
+    std::fs::write(d.join("y/imp.toml"), "").unwrap();
+    std::fs::write(
+        d.join("m.toml"),
+        include_str!("../../embedded/machines/xyzac-trt.toml"),
     )
     .unwrap();
-    assert_eq!(job.impeller.unwrap(), Path::new("/x/y/imp.toml"));
-    assert_eq!(job.machine.unwrap(), Path::new("/x/y/../m.toml"));
-    assert_eq!(job.cl_files, vec![PathBuf::from("/x/y/a.cls")]);
+    std::fs::write(d.join("y/a.cls"), "GOTO/1,2,3\n").unwrap();
+    d
+}
+
+#[test]
+fn paths_resolve_against_the_job_folder() {
+    let d = job_folder("paths");
+    let job = Job::from_toml_str(
+        "name = \"j\"\nimpeller = \"imp.toml\"\nmachine = \"../m.toml\"\n[[cl_files]]\npath = \"a.cls\"\n",
+        &d.join("y/job.toml"),
+    )
+    .unwrap();
+    assert_eq!(job.impeller.unwrap(), d.join("y/imp.toml"));
+    assert_eq!(job.machine.unwrap(), d.join("y/../m.toml"));
+    assert_eq!(job.cl_files, vec![d.join("y/a.cls")]);
     assert_eq!(job.dialect, "linuxcnc");
+}
+
+/// Inputs are checked when the job is read, before anything runs, each error naming the job
+/// file, the line and the key: the dialect (`haas` used to be found after planning, leaving
+/// `toolpath.cls` behind), missing files, an invalid machine file, a job with nothing to
+/// machine (it used to run `0 operation(s)` and exit 0).
+#[test]
+fn inputs_are_checked_before_anything_runs() {
+    let d = job_folder("inputs");
+    let job = d.join("y/job.toml");
+    let cl = "[[cl_files]]\npath = \"a.cls\"\n";
+    let err = |text: &str| Job::from_toml_str(text, &job).unwrap_err().to_string();
+    let e = err(&format!("name = \"j\"\ndialect = \"haas\"\n{cl}"));
+    let at = format!("{}:2: dialect: unknown dialect `haas`", job.display());
+    assert!(e.starts_with(&at), "{e}");
+    let e = err(&format!("machine = \"../none.toml\"\n{cl}"));
+    assert!(
+        e.starts_with(&format!("{}:1: machine: ", job.display())) && e.contains("none.toml"),
+        "{e}"
+    );
+    let e = err(&format!("impeller = \"none.toml\"\n{cl}"));
+    assert!(
+        e.starts_with(&format!("{}:1: impeller: ", job.display())),
+        "{e}"
+    );
+    let e = err("name = \"j\"\n\n[[cl_files]]\npath = \"b.cls\"\n");
+    assert!(
+        e.starts_with(&format!("{}:4: cl_files[0].path: ", job.display())) && e.contains("b.cls"),
+        "{e}"
+    );
+    // The machine file's own errors name its line and key.
+    let text = include_str!("../../embedded/machines/xyzac-trt.toml")
+        .replace("kinematics = \"trivial\"", "kinematics = \"trivkins\"");
+    std::fs::write(d.join("bad.toml"), &text).unwrap();
+    let e = err(&format!("machine = \"../bad.toml\"\n{cl}"));
+    let line = text
+        .lines()
+        .position(|l| l.contains("kinematics = \"trivkins\""))
+        .unwrap()
+        + 1;
+    assert!(
+        e.starts_with(&format!(
+            "{}:1: machine: invalid machine file: ",
+            job.display()
+        )) && e.contains(&format!("bad.toml:{line}"))
+            && e.contains("program.kinematics"),
+        "{e}"
+    );
+    let e = err("name = \"j\"\n");
+    assert!(
+        e.starts_with(&format!("{}:0: operations: no operations", job.display())),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]

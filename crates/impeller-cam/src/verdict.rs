@@ -1,0 +1,220 @@
+//! The run's verdict: whether the program passed the independent verification, with the
+//! limits that were in force, and what became of the program.
+//!
+//! A program passes when the stock simulation of the program as written finds no overcut
+//! deeper than the limit (the job's `machining_tol` plus the simulation's own error bound at
+//! its resolution, [`machining_sim::overcut_error_bound`]) and no collision. A program that
+//! fails is withheld (removed) unless the run allows defects. The residual (material left)
+//! is reported beside the verdict but does not decide it: roughing leaves stock by design.
+//!
+//! The verdict is one line for the terminal ([`Verdict::summary`]), a table at the top of
+//! `report.html` and the `verdict` object of `report.json`.
+
+use crate::report::Report;
+use serde::Serialize;
+
+/// Pass or fail of the verification.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Verified: no overcut beyond the limit, no collision.
+    Pass,
+    /// Verified: an overcut beyond the limit or a collision.
+    Fail,
+    /// Nothing was verified (verification disabled, nothing to machine, or no cutter known).
+    NotVerified,
+}
+
+/// What became of the program.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProgramState {
+    /// Written to the output folder.
+    Written,
+    /// Posted but removed because verification failed (no `--allow-defects`).
+    Withheld,
+    /// Nothing to machine: no program was posted.
+    None,
+}
+
+/// The verdict of a run (`verdict` in `report.json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verdict {
+    /// Pass, fail or not verified.
+    pub status: Status,
+    /// Written, withheld or none.
+    pub program: ProgramState,
+    /// The job's `machining_tol` (mm).
+    pub machining_tol_mm: f64,
+    /// The overcut limit in force: `machining_tol` + the simulation's error bound (mm);
+    /// `None` when nothing was verified.
+    pub overcut_limit_mm: Option<f64>,
+    /// Largest overcut measured (mm).
+    pub max_overcut_mm: Option<f64>,
+    /// Largest residual measured (mm; reported, not judged).
+    pub max_residual_mm: Option<f64>,
+    /// Moves with a collision (the limit is 0).
+    pub collisions: Option<usize>,
+    /// Dexel spacing of the simulation (mm).
+    pub resolution_mm: Option<f64>,
+    /// The defects, one line each, with where they are.
+    pub defects: Vec<String>,
+}
+
+impl Verdict {
+    /// The verdict of `report` (after the verification gate ran) for a job whose
+    /// `machining_tol` is `machining_tol_mm`.
+    pub fn of(report: &Report, machining_tol_mm: f64) -> Self {
+        let v = report.verification.as_ref();
+        let status = match v {
+            None => Status::NotVerified,
+            Some(v) if v.defects.is_empty() => Status::Pass,
+            Some(_) => Status::Fail,
+        };
+        let program = if report.post.written {
+            ProgramState::Written
+        } else if report.post.program.is_empty() {
+            ProgramState::None
+        } else {
+            ProgramState::Withheld
+        };
+        Self {
+            status,
+            program,
+            machining_tol_mm,
+            overcut_limit_mm: v.map(|v| v.overcut_limit_mm),
+            max_overcut_mm: v.map(|v| v.max_overcut_mm),
+            max_residual_mm: v.map(|v| v.max_residual_mm),
+            collisions: v.map(|v| v.collisions),
+            resolution_mm: v.map(|v| v.resolution_mm),
+            defects: v.map(|v| v.defects.clone()).unwrap_or_default(),
+        }
+    }
+
+    /// `PASS`, `FAIL` or `NOT VERIFIED`.
+    pub fn word(&self) -> &'static str {
+        match self.status {
+            Status::Pass => "PASS",
+            Status::Fail => "FAIL",
+            Status::NotVerified => "NOT VERIFIED",
+        }
+    }
+
+    /// The verification with its limits, e.g. `verification PASS (overcut 0.0197 mm <= limit
+    /// 0.1190 mm = machining_tol 0.01 mm + simulation bound at 0.25 mm resolution; 0
+    /// collisions; residual 0.52 mm, not judged)`.
+    pub fn verification(&self) -> String {
+        match (
+            self.max_overcut_mm,
+            self.overcut_limit_mm,
+            self.collisions,
+            self.resolution_mm,
+        ) {
+            (Some(o), Some(limit), Some(c), Some(res)) => format!(
+                "verification {} (overcut {o:.4} mm {} limit {limit:.4} mm = machining_tol {} mm \
+                 + simulation bound at {res} mm resolution; {c} collision(s), limit 0; \
+                 residual {:.4} mm, not judged)",
+                self.word(),
+                if o > limit { ">" } else { "<=" },
+                self.machining_tol_mm,
+                self.max_residual_mm.unwrap_or(0.0),
+            ),
+            _ => format!("verification {}", self.word()),
+        }
+    }
+
+    /// What became of the program at `path`: the path, `withheld (verification failed: …)`
+    /// or `(none: nothing to machine)`.
+    pub fn program_text(&self, path: &str) -> String {
+        match self.program {
+            ProgramState::Written => path.to_string(),
+            ProgramState::Withheld => format!(
+                "withheld (verification failed: {})",
+                self.defects.join("; ")
+            ),
+            ProgramState::None => "(none: nothing to machine)".to_string(),
+        }
+    }
+
+    /// The terminal's last line after `job: N operation(s), `: program and verification.
+    pub fn summary(&self, program_path: &str) -> String {
+        format!(
+            "program {}, {}",
+            self.program_text(program_path),
+            self.verification()
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::VerificationReport;
+
+    fn verified(defects: Vec<String>, written: bool) -> Report {
+        let mut r = Report::new("j");
+        r.post.program = "out/program.ngc".into();
+        r.post.written = written;
+        r.verification = Some(VerificationReport {
+            max_overcut_mm: 0.2,
+            max_residual_mm: 0.5,
+            collisions: 0,
+            resolution_mm: 0.25,
+            overcut_limit_mm: 0.119,
+            defects,
+            surface_groups: Default::default(),
+            source: "program".into(),
+            details: serde_json::Value::Null,
+        });
+        r
+    }
+
+    /// A withheld program is reported as withheld with the failure, never as "nothing to
+    /// machine" (the old summary said `program (none: nothing to machine)`).
+    #[test]
+    fn a_withheld_program_says_withheld_and_why() {
+        let r = verified(vec!["overcut 0.2000 mm exceeds 0.1190 mm".into()], false);
+        let v = Verdict::of(&r, 0.01);
+        assert_eq!(v.status, Status::Fail);
+        assert_eq!(v.program, ProgramState::Withheld);
+        let s = v.summary(&r.post.program);
+        assert!(
+            s.starts_with(
+                "program withheld (verification failed: overcut 0.2000 mm exceeds 0.1190 mm)"
+            ),
+            "{s}"
+        );
+        assert!(s.contains("verification FAIL (overcut 0.2000 mm > limit 0.1190 mm"));
+        assert!(!s.contains("nothing to machine"), "{s}");
+    }
+
+    #[test]
+    fn a_passing_program_names_its_path_and_the_limit_in_force() {
+        let mut r = verified(Vec::new(), true);
+        if let Some(v) = r.verification.as_mut() {
+            v.max_overcut_mm = 0.0197;
+        }
+        let v = Verdict::of(&r, 0.01);
+        assert_eq!((v.status, v.program), (Status::Pass, ProgramState::Written));
+        assert_eq!(
+            v.summary(&r.post.program),
+            "program out/program.ngc, verification PASS (overcut 0.0197 mm <= limit 0.1190 mm \
+             = machining_tol 0.01 mm + simulation bound at 0.25 mm resolution; 0 collision(s), \
+             limit 0; residual 0.5000 mm, not judged)"
+        );
+    }
+
+    #[test]
+    fn nothing_posted_is_nothing_to_machine_and_not_verified() {
+        let r = Report::new("j");
+        let v = Verdict::of(&r, 0.01);
+        assert_eq!(
+            (v.status, v.program),
+            (Status::NotVerified, ProgramState::None)
+        );
+        assert_eq!(
+            v.summary(""),
+            "program (none: nothing to machine), verification NOT VERIFIED"
+        );
+    }
+}
