@@ -12,6 +12,7 @@
 //! success and 1 on a user error with one clear line on stderr (`../shared/DESIGN.md` §4).
 
 pub mod cmd;
+pub mod cycle;
 pub mod error;
 pub mod job;
 pub mod outputs;

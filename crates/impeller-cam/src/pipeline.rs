@@ -901,6 +901,19 @@ pub fn post(
     post.program = program_path.display().to_string();
     post.written = true;
     report.post = post;
+    match gcode_emit::program_time(
+        &machine,
+        &assembled,
+        &cl_ops,
+        &options,
+        program_options.safe_z_machine,
+    ) {
+        Ok(time) => crate::cycle::add_cycle_time(report, time),
+        Err(e) => report.notes.push(format!(
+            "no cycle time: the machine file {} cannot time the program: {e}",
+            machine.name()
+        )),
+    }
     Ok(Some(assembled))
 }
 

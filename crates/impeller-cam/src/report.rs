@@ -67,6 +67,8 @@ pub struct PostReport {
     pub reconfigurations: usize,
     /// The same figures per simultaneous operation, with the reverse-motion removal details.
     pub operations: Vec<PostOperationReport>,
+    /// The program's running time from the machine's limits (`null` without a program).
+    pub cycle_time: Option<gcode_emit::ProgramTime>,
 }
 
 /// Post-processing figures of one simultaneous operation.
@@ -556,6 +558,7 @@ impl Report {
         let mut post = serde_json::to_value(&self.post).unwrap_or_default();
         if let Some(m) = post.as_object_mut() {
             m.remove("operations");
+            m.remove("cycle_time");
         }
         table_of_object(&mut h, &post);
         if !self.post.operations.is_empty() {
@@ -578,6 +581,9 @@ impl Report {
                 );
             }
             h.push_str("</table>");
+        }
+        if let Some(t) = &self.post.cycle_time {
+            h.push_str(&crate::cycle::html(t));
         }
         for svg in &self.post_plots {
             h.push_str(svg);

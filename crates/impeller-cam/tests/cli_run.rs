@@ -256,6 +256,42 @@ fn run_ring_job_with(
     // The ring stays outside the design: no overcut beyond the dexel resolution.
     assert!(v["max_overcut_mm"].as_f64().unwrap() <= 0.5, "{v}");
     assert_eq!(v["collisions"], 0, "{v}");
+    // The cycle time from the machine's limits: per operation (cutting, air, tool change)
+    // and for the program, whose total is the operations' sum (the final retract is the
+    // last operation's); cutting at the machine is never faster than at programmed feed.
+    let t = &r["post"]["cycle_time"];
+    let total = t["total_s"].as_f64().unwrap();
+    let mut sum = 0.0;
+    for (o, row) in t["operations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(r["operations"].as_array().unwrap())
+    {
+        let f = |k: &str| o[k].as_f64().unwrap();
+        assert!(
+            (f("cutting_s") + f("link_s") + f("rapid_s") + f("tool_change_s") - f("total_s")).abs()
+                < 1e-9,
+            "{o}"
+        );
+        assert_eq!(row["total_time_s"].as_f64().unwrap(), f("total_s"));
+        assert!(
+            f("cutting_s") >= row["cutting_time_s"].as_f64().unwrap() * (1.0 - 1e-9),
+            "{o} {row}"
+        );
+        let change = f("tool_change_s");
+        assert!(
+            change == 0.0 || change == t["tool_change_each_s"].as_f64().unwrap(),
+            "{o}"
+        );
+        sum += f("total_s");
+    }
+    assert!(
+        total > 0.0 && (total - sum).abs() < 1e-6 * total,
+        "{total} vs {sum}"
+    );
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("<h2>Cycle time: "), "cycle time table");
     // The CL file written back contains every move.
     let cls = std::fs::read_to_string(out.join("toolpath.cls")).unwrap();
     assert_eq!(cls.matches("GOTO/").count(), cl.matches("GOTO/").count());

@@ -57,8 +57,14 @@ pub fn run(args: Args) -> Result<Outcome, CliError> {
         eprintln!("[impeller-cam] the program was written anyway (--allow-defects)");
     }
     // The last line: what was made, whether it passed, under which limits.
+    let cycle = report
+        .post
+        .cycle_time
+        .as_ref()
+        .map(|t| format!(", cycle time {}", crate::cycle::hms(t.total_s)))
+        .unwrap_or_default();
     eprintln!(
-        "[impeller-cam] {}: {} operation(s), {}, report {}",
+        "[impeller-cam] {}: {} operation(s){cycle}, {}, report {}",
         report.job,
         report.operations.len(),
         verdict.summary(&report.post.program),
