@@ -22,6 +22,7 @@ pub mod progress;
 pub mod registry;
 pub mod report;
 pub mod surface_groups;
+pub mod travel;
 pub mod verdict;
 
 pub use error::CliError;

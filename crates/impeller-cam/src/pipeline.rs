@@ -694,6 +694,7 @@ pub fn link_for_machine(
     let linker = Linker::with_blank(surface, impeller.stock());
     let retract_mm = AssembleOptions::default().retract_mm;
     let mut initial: Option<postproc_kinematics::Joints> = None;
+    let mut travel = Vec::new();
     for op in operations.iter_mut() {
         let mut options = post_options(job);
         options.initial = initial;
@@ -712,6 +713,7 @@ pub fn link_for_machine(
             )
             .map_err(msg)?;
             initial = links.last.or(initial);
+            travel.extend(links.travel);
             continue;
         }
         let links = machine_links::reroute_swinging_rapids(
@@ -725,6 +727,7 @@ pub fn link_for_machine(
         .map_err(msg)?;
         set_feeds(&mut op.cl.path, &op.rates);
         initial = links.last.or(initial);
+        travel.extend(links.travel.clone());
         op.metrics
             .count("machine_links", links.rerouted)
             .count("swinging_rapids_left", links.remaining);
@@ -738,6 +741,12 @@ pub fn link_for_machine(
                 machine.name()
             ));
         }
+    }
+    if !travel.is_empty() {
+        return Err(CliError::Message(crate::travel::travel_error(
+            machine.name(),
+            &travel,
+        )));
     }
     Ok(())
 }

@@ -695,3 +695,58 @@ fn a_run_removes_the_earlier_runs_program_of_another_dialect() {
     assert!(!out.join("program.ngc").exists());
     assert!(out.join("mine.txt").is_file());
 }
+
+/// A machine whose A axis cannot reach the ring's 10° tilt: the run stops right after
+/// planning, before anything is posted or written, naming the operation, how many blocks
+/// and moves leave the travel and the range A needs (it used to stop in the post at the
+/// first block with no count and no range).
+#[test]
+fn travel_the_machine_cannot_hold_is_reported_with_count_and_range() {
+    let job = ring_job("travel", &ring_cl());
+    let dir = job.parent().unwrap();
+    let machine = std::fs::read_to_string(repo().join("fixtures/machines/xyzac-trt.toml")).unwrap();
+    let (a, c) = (
+        machine.find("[axes.A]").unwrap(),
+        machine.find("[axes.C]").unwrap(),
+    );
+    let narrow = format!(
+        "{}{}{}",
+        &machine[..a],
+        machine[a..c]
+            .replace("min = -100.0", "min = -5.0")
+            .replace("max = 50.0", "max = 5.0"),
+        &machine[c..]
+    );
+    std::fs::write(dir.join("narrow.toml"), narrow).unwrap();
+    let text = std::fs::read_to_string(&job).unwrap();
+    let fixture = format!(
+        "{:?}",
+        repo()
+            .join("fixtures/machines/xyzac-trt.toml")
+            .display()
+            .to_string()
+    );
+    assert!(text.contains(&fixture));
+    std::fs::write(&job, text.replace(&fixture, "\"narrow.toml\"")).unwrap();
+    let out = dir.join("out");
+    let st = cli()
+        .arg("run")
+        .arg(&job)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("cannot hold the planned tool paths within its travel")
+            && err.contains(" blocks (moves 0–")
+            && err.contains("A needs -10.000 to -10.000 (travel -5 to 5)"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("post-processing"),
+        "stops before posting: {err}"
+    );
+    assert!(!out.join("toolpath.cls").exists() && !out.join("report.json").exists());
+}

@@ -35,7 +35,7 @@ use postproc_kinematics::{post_path, swinging_rapids, Joints, LimitPolicy, Machi
 pub const MAX_RELINK_PASSES: usize = 4;
 
 /// What [`reroute_swinging_rapids`] did to one operation.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct MachineLinks {
     /// Rapids replaced by a detour over the safety surface, or approaches from it fed so that
     /// the swing happens on the surface.
@@ -45,6 +45,8 @@ pub struct MachineLinks {
     pub remaining: usize,
     /// The last posture of the operation as posted (the next operation starts from it).
     pub last: Option<Joints>,
+    /// The blocks of the operation as posted that leave the machine's travel.
+    pub travel: Option<crate::travel::TravelViolations>,
 }
 
 /// Errors of [`reroute_swinging_rapids`].
@@ -141,6 +143,8 @@ pub fn reroute_swinging_rapids(
             .collect();
         if flagged.is_empty() || pass + 1 == MAX_RELINK_PASSES {
             out.remaining = flagged.len();
+            out.travel =
+                crate::travel::TravelViolations::of(&path.name, path.moves.len(), &posted.blocks);
             return Ok(out);
         }
         let mut rebuilt: Vec<Move> = Vec::with_capacity(path.moves.len() + 8 * flagged.len());
