@@ -21,6 +21,7 @@ pub mod plot;
 pub mod progress;
 pub mod registry;
 pub mod report;
+pub mod setup;
 pub mod surface_groups;
 pub mod travel;
 pub mod verdict;

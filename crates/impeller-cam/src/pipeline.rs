@@ -173,6 +173,18 @@ fn run_stages(job: &Job, out: &Path, registry: &Registry) -> Result<Report, CliE
         &report,
         job.tolerances.machining_tol,
     ));
+    report.setup = crate::setup::section(
+        &impeller,
+        &load_machine(job)?,
+        &job.tools,
+        &operations,
+        &report,
+    );
+    gcode_emit::write_atomic(
+        &out.join("setup.html"),
+        crate::setup::document(&report.job, &report.setup).as_bytes(),
+    )
+    .map_err(msg)?;
     report
         .timings_ms
         .insert("total_ms".into(), total.elapsed().as_secs_f64() * 1e3);

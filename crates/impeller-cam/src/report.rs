@@ -197,6 +197,9 @@ pub struct Report {
     pub timings_ms: BTreeMap<String, f64>,
     /// What was skipped and why, and reader warnings.
     pub notes: Vec<String>,
+    /// The setup sheet's section ([`crate::setup`]), also written as `setup.html`.
+    #[serde(skip)]
+    pub setup: String,
     #[serde(skip)]
     plots: Vec<String>,
     #[serde(skip)]
@@ -218,6 +221,7 @@ impl Report {
             verdict: None,
             timings_ms: BTreeMap::new(),
             notes: Vec::new(),
+            setup: String::new(),
             plots: Vec::new(),
             post_plots: Vec::new(),
             operation_plots: Vec::new(),
@@ -519,6 +523,7 @@ impl Report {
         if let Some(v) = &self.verdict {
             verdict_html(&mut h, v, &self.post.program);
         }
+        h.push_str(&self.setup);
         h.push_str("<h2>Impeller</h2>");
         table_of_object(&mut h, &self.impeller);
         for svg in &self.plots {

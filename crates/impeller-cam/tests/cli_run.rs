@@ -310,26 +310,13 @@ fn rs274_accepts(dir: &Path, program: &Path, tool_table: &str, min_feeds: usize)
         Some(rs) => {
             let tbl = dir.join("tool.tbl");
             std::fs::write(&tbl, tool_table).unwrap();
-            // The machine configuration maps the kinematics switches (M428 TCP, M429
-            // identity, which every program selects first) to remap subroutines.
-            let subs = dir.join("subs");
-            std::fs::create_dir_all(&subs).unwrap();
-            for m in ["428", "429"] {
-                std::fs::write(
-                    subs.join(format!("{m}remap.ngc")),
-                    format!("o<{m}remap>sub\no<{m}remap>endsub\n"),
-                )
-                .unwrap();
-            }
+            // A stock trivkins configuration (xyzac-trt's machine file says kinematics =
+            // "trivial"): no remapped kinematics switch, so an M429 would be rejected
+            // ("M-code greater than 199").
             let ini = dir.join("machine.ini");
             std::fs::write(
                 &ini,
-                format!(
-                    "[RS274NGC]\nSUBROUTINE_PATH = {}\nREMAP = M428 modalgroup=10 ngc=428remap\n\
-                     REMAP = M429 modalgroup=10 ngc=429remap\n[TRAJ]\nCOORDINATES = XYZAC\n\
-                     LINEAR_UNITS = mm\nANGULAR_UNITS = deg\n",
-                    subs.display()
-                ),
+                "[TRAJ]\nCOORDINATES = XYZAC\nLINEAR_UNITS = mm\nANGULAR_UNITS = deg\n",
             )
             .unwrap();
             let res = Command::new(rs)

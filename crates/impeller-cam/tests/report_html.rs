@@ -119,5 +119,38 @@ fn report_html_renders_every_plot_in_headless_chromium() {
     for (k, svg) in rendered.iter().enumerate() {
         assert!(draws(svg), "plot {k} is empty:\n{svg}");
     }
+    // The setup sheet renders too, with every tool of the program listed (name, stick-out,
+    // gauge length), the cycle time and the verdict.
+    let setup = out.join("setup.html");
+    let r = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg("--dump-dom")
+        .arg(format!("file://{}", setup.display()))
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "chromium failed on setup.html");
+    let dom = String::from_utf8_lossy(&r.stdout);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    for op in report["operations"].as_array().unwrap() {
+        let tool = op["tool"].as_str().unwrap();
+        assert!(
+            dom.contains(&format!("<td>{tool}</td>")),
+            "tool {tool} in the setup sheet"
+        );
+        assert!(dom.contains(&format!("<td>{}</td>", op["name"].as_str().unwrap())));
+    }
+    assert!(dom.contains("<td>cycle time</td>") && dom.contains("verification PASS"));
+    assert!(
+        written.contains("<h2 id=\"setup\">Setup sheet</h2>"),
+        "a section of report.html"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
