@@ -31,7 +31,8 @@ fn default_job_is_the_impeller_8_8_fixture_job() {
     let st = cli().args(["run", "--out"]).arg(&out).output().unwrap();
     assert!(
         st.status.success(),
-        "{}",
+        "{:?}: {}",
+        st.status,
         String::from_utf8_lossy(&st.stderr)
     );
     let r = report(&out);
@@ -246,7 +247,8 @@ fn run_ring_job_with(
         .unwrap();
     assert!(
         st.status.success(),
-        "{}",
+        "{:?}: {}",
+        st.status,
         String::from_utf8_lossy(&st.stderr)
     );
     let r = report(&out);
@@ -403,7 +405,8 @@ fn finishing_job_of_the_fixture_is_planned_posted_and_accepted_by_rs274() {
         .unwrap();
     assert!(
         st.status.success(),
-        "{}",
+        "{:?}: {}",
+        st.status,
         String::from_utf8_lossy(&st.stderr)
     );
     let r = report(&out);
@@ -550,7 +553,8 @@ fn gouging_program_is_withheld_with_exit_3_unless_defects_are_allowed() {
         .unwrap();
     assert!(
         st.status.success(),
-        "{}",
+        "{:?}: {}",
+        st.status,
         String::from_utf8_lossy(&st.stderr)
     );
     assert!(out2.join("program.ngc").is_file());
@@ -675,7 +679,8 @@ fn a_run_removes_the_earlier_runs_program_of_another_dialect() {
         .unwrap();
     assert!(
         st.status.success(),
-        "{}",
+        "{:?}: {}",
+        st.status,
         String::from_utf8_lossy(&st.stderr)
     );
     assert!(out.join("program.mpf").is_file());
