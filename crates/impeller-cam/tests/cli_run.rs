@@ -634,6 +634,17 @@ fn progress_goes_to_stderr_as_lines_off_a_terminal_and_not_at_all_with_quiet() {
     assert!(quiet.contains(": 1 operation(s)"), "{quiet}");
 }
 
+/// `impeller-cam run JOB --out OUT`.
+fn run_into(job: &Path, out: &Path) -> std::process::Output {
+    cli()
+        .arg("run")
+        .arg(job)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
 /// An unknown dialect is refused when the job is read (it used to be found after planning,
 /// without file or line, leaving `toolpath.cls` behind): exit 1, nothing written.
 #[test]
@@ -642,13 +653,7 @@ fn an_unknown_dialect_is_refused_before_anything_runs() {
     let text = std::fs::read_to_string(&job).unwrap();
     std::fs::write(&job, text.replace("\"linuxcnc\"", "\"haas\"")).unwrap();
     let out = job.parent().unwrap().join("out");
-    let st = cli()
-        .arg("run")
-        .arg(&job)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let st = run_into(&job, &out);
     assert_eq!(st.status.code(), Some(1));
     let err = String::from_utf8_lossy(&st.stderr);
     assert!(
@@ -670,13 +675,7 @@ fn a_run_removes_the_earlier_runs_program_of_another_dialect() {
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("program.ngc"), "G0 X0\n").unwrap();
     std::fs::write(out.join("mine.txt"), "keep").unwrap();
-    let st = cli()
-        .arg("run")
-        .arg(&job)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let st = run_into(&job, &out);
     assert!(
         st.status.success(),
         "{:?}: {}",
@@ -721,13 +720,7 @@ fn travel_the_machine_cannot_hold_is_reported_with_count_and_range() {
     assert!(text.contains(&fixture));
     std::fs::write(&job, text.replace(&fixture, "\"narrow.toml\"")).unwrap();
     let out = dir.join("out");
-    let st = cli()
-        .arg("run")
-        .arg(&job)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let st = run_into(&job, &out);
     assert_eq!(st.status.code(), Some(1));
     let err = String::from_utf8_lossy(&st.stderr);
     assert!(
