@@ -71,6 +71,9 @@ pub struct Job {
     /// The operations in machining order (kinds checked against the registry the job was
     /// parsed with, and each built once so its parameters are checked).
     pub operations: Vec<OperationSpec>,
+    /// The coolant of each operation (`[operations.process] coolant`), in the order of
+    /// `operations`; steps (a pilot drill) run with their operation's.
+    pub coolant: Vec<gcode_emit::Coolant>,
     /// CL files to post-process and verify.
     pub cl_files: Vec<PathBuf>,
     /// The job text and file, to name the line of a key in errors found after parsing.
@@ -326,6 +329,31 @@ struct RawProcess {
     blade_allowance_mm: Option<f64>,
     hub_allowance_mm: Option<f64>,
     rapid_mm_per_min: Option<f64>,
+    #[serde(default)]
+    coolant: RawCoolant,
+}
+
+/// `coolant = "flood" | "mist" | "through" | "off"` of a process row (default off); the
+/// machine file's `[program.coolant]` gives each one's M code.
+#[derive(Debug, Default, Clone, Copy, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum RawCoolant {
+    Flood,
+    Mist,
+    Through,
+    #[default]
+    Off,
+}
+
+impl From<RawCoolant> for gcode_emit::Coolant {
+    fn from(c: RawCoolant) -> Self {
+        match c {
+            RawCoolant::Flood => Self::Flood,
+            RawCoolant::Mist => Self::Mist,
+            RawCoolant::Through => Self::ThroughTool,
+            RawCoolant::Off => Self::Off,
+        }
+    }
 }
 
 /// One `[[operations]]` table: the common keys typed, the kind's own keys kept as TOML.
@@ -850,6 +878,7 @@ impl Job {
         // Operations.
         let stock_allowance = tolerances.stock_allowance;
         let mut operations: Vec<OperationSpec> = Vec::with_capacity(raw.operations.len());
+        let mut coolant = Vec::with_capacity(raw.operations.len());
         for (i, op) in raw.operations.into_iter().enumerate() {
             let here = |key: &str| {
                 let mut p = vec![Seg::Key("operations".into()), Seg::Index(i)];
@@ -893,6 +922,7 @@ impl Job {
                     ),
                 ));
             }
+            coolant.push(p.coolant.into());
             let process = Process {
                 spindle_rpm: p.spindle_rpm,
                 feed_per_tooth_mm: p.feed_per_tooth_mm,
@@ -969,6 +999,7 @@ impl Job {
             quiet: false,
             tools,
             operations,
+            coolant,
             cl_files: raw.cl_files.into_iter().map(|c| resolve(c.path)).collect(),
             source: Some(JobSource {
                 path: path.to_path_buf(),

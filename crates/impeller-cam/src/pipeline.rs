@@ -482,6 +482,9 @@ pub fn plan(
             }
             before.push(main);
             before.extend(after);
+            for op in &mut before {
+                op.cl.coolant = job.coolant.get(i).copied().unwrap_or_default();
+            }
             Ok(before)
         })
         .collect();

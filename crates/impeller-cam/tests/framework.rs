@@ -223,7 +223,11 @@ const RING_OP: &str = "[[operations]]\nname = \"ring\"\nkind = \"test_ring\"\nto
 fn a_registered_operation_is_planned_linked_posted_verified_and_reported() {
     let dir = scratch("e2e");
     let job_path = dir.join("job.toml");
-    std::fs::write(&job_path, job_text(RING_OP)).unwrap();
+    std::fs::write(
+        &job_path,
+        job_text(&format!("{RING_OP}coolant = \"flood\"\n")),
+    )
+    .unwrap();
     let job = Job::from_file_with(&job_path, TEST_REGISTRY).unwrap();
     assert_eq!(job.operations.len(), 1);
     // stock_allowance (default 0.5) fills the allowances the row does not give.
@@ -263,6 +267,9 @@ fn a_registered_operation_is_planned_linked_posted_verified_and_reported() {
     );
     // The program is written and verification found no overcut and no collision.
     assert!(out.join("program.ngc").is_file());
+    // The process row's coolant is switched on with the operation (it was always M9).
+    let program = std::fs::read_to_string(out.join("program.ngc")).unwrap();
+    assert!(program.contains(" M8"), "flood coolant");
     let v = &json["verification"];
     assert!(v["max_overcut_mm"].as_f64().unwrap() <= 0.5, "{v}");
     assert_eq!(v["collisions"], 0, "{v}");

@@ -257,12 +257,12 @@ fn unknown_keys_are_named_with_file_and_line() {
         "tools[0].holder[0].lenght_mm",
     );
     // Inside the process row.
-    let text = format!("{TOOL}{OP}coolant = \"flood\"\n");
+    let text = format!("{TOOL}{OP}feed_mm_per_min = 800.0\n");
     assert_at(
         &err_of(&text),
         &text,
-        "coolant",
-        "operations[0].process.coolant",
+        "feed_mm_per_min",
+        "operations[0].process.feed_mm_per_min",
     );
     // A key of the kind (its builder rejects it).
     let text = format!(
@@ -429,4 +429,19 @@ fn tool_file_errors_name_the_tool_file() {
         err.contains("job.toml:1: tools") && err.contains("missing.toml"),
         "{err}"
     );
+}
+
+/// `coolant` in a process row: flood, mist, through or off (default off); anything else is
+/// named with file, line and key.
+#[test]
+fn the_process_row_gives_the_coolant() {
+    let text = format!("{TOOL}{OP}coolant = \"mist\"\n");
+    let job = Job::from_toml_str_with(&text, Path::new("dir/job.toml"), PROBE).unwrap();
+    assert_eq!(job.coolant, [gcode_emit::Coolant::Mist]);
+    let job =
+        Job::from_toml_str_with(&format!("{TOOL}{OP}"), Path::new("dir/job.toml"), PROBE).unwrap();
+    assert_eq!(job.coolant, [gcode_emit::Coolant::Off]);
+    let text = format!("{TOOL}{OP}coolant = \"water\"\n");
+    let err = err_of(&text);
+    assert_at(&err, &text, "water", "operations[0].process.coolant");
 }
