@@ -1065,12 +1065,7 @@ pub fn verify(
         let first = rep
             .collisions
             .first()
-            .map(|c| {
-                format!(
-                    "; first: move {} of {} ({:?} {:?} into the {:?}, {:.3} mm deep)",
-                    c.move_index, c.operation, c.part, c.move_kind, c.target, c.depth_mm
-                )
-            })
+            .map(|c| format!("; first: {}", crate::verdict::collision_text(c)))
             .unwrap_or_default();
         defects.push(format!("{} collision(s){first}", rep.metrics.collisions));
     }

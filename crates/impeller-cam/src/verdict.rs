@@ -146,6 +146,31 @@ impl Verdict {
     }
 }
 
+/// A collision in a shop's words: `move 12 of rough (a rapid): the tool runs into the
+/// finished part, 0.512 mm deep at (1.000, 2.000, 3.000)` (it was `RapidMove Rapid into
+/// the Design`).
+pub fn collision_text(c: &machining_sim::Collision) -> String {
+    let what = match c.move_kind {
+        cam_core::MoveKind::Rapid => "a rapid",
+        cam_core::MoveKind::Feed => "a cutting move",
+        cam_core::MoveKind::Plunge => "a plunge",
+        cam_core::MoveKind::Retract => "a retract",
+    };
+    let part = match c.part {
+        machining_sim::PartKind::Shank => "the shank",
+        machining_sim::PartKind::Holder => "the holder",
+        machining_sim::PartKind::RapidMove => "the tool",
+    };
+    let target = match c.target {
+        machining_sim::CollisionTarget::Stock => "stock not yet cut",
+        machining_sim::CollisionTarget::Design => "the finished part",
+    };
+    format!(
+        "move {} of {} ({what}): {part} runs into {target}, {:.3} mm deep at ({:.3}, {:.3}, {:.3})",
+        c.move_index, c.operation, c.depth_mm, c.point[0], c.point[1], c.point[2]
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,6 +226,24 @@ mod tests {
             "program out/program.ngc, verification PASS (overcut 0.0197 mm <= limit 0.1190 mm \
              = machining_tol 0.01 mm + simulation bound at 0.25 mm resolution; 0 collision(s), \
              limit 0; residual 0.5000 mm, not judged)"
+        );
+    }
+
+    #[test]
+    fn a_collision_reads_in_a_shops_words() {
+        let c = machining_sim::Collision {
+            operation: "rough".into(),
+            move_index: 12,
+            move_kind: cam_core::MoveKind::Rapid,
+            part: machining_sim::PartKind::RapidMove,
+            target: machining_sim::CollisionTarget::Design,
+            depth_mm: 0.5123,
+            point: [1.0, 2.0, 3.0],
+        };
+        assert_eq!(
+            collision_text(&c),
+            "move 12 of rough (a rapid): the tool runs into the finished part, 0.512 mm deep \
+             at (1.000, 2.000, 3.000)"
         );
     }
 

@@ -54,6 +54,29 @@ fn invalid_values_exit_1_with_one_line() {
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8(out.stderr).unwrap();
     assert_eq!(err.trim().lines().count(), 1, "{err}");
-    assert!(err.contains("bottom_radius"), "{err}");
+    // The command line's own names (it said `bottom_radius` = -1).
+    assert!(
+        err.contains("--tip-radius -1: must be a radius > 0 mm"),
+        "{err}"
+    );
     assert!(!err.contains("panicked"));
+    let out = cli()
+        .args([
+            "stiffness",
+            "--tip-radius",
+            "3",
+            "--half-angle",
+            "95",
+            "--length",
+            "40",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8(out.stderr).unwrap();
+    // It said `ball_radius` = -0.26.
+    assert!(
+        err.contains("--half-angle 95: must be an angle in [0, 90) degrees"),
+        "{err}"
+    );
 }

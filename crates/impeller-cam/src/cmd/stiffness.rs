@@ -45,6 +45,25 @@ pub struct Args {
 pub fn run(args: Args) -> Result<(), CliError> {
     // The command speaks the literature's beam form; the model is parametrised by ball radius
     // r = r_c cos θ and tip-to-chuck length L + r (see cutter_stiffness::ConicalCutter).
+    // Checked here in the command's own names (the model's error would name its internal
+    // parameters: `--tip-radius -1` said `bottom_radius`, `--half-angle 95` `ball_radius`).
+    let bad = |option: &str, value: f64, want: &str| {
+        Err(CliError::Message(format!(
+            "--{option} {value}: must be {want}"
+        )))
+    };
+    if !(args.tip_radius.is_finite() && args.tip_radius > 0.0) {
+        return bad("tip-radius", args.tip_radius, "a radius > 0 mm");
+    }
+    if !(args.half_angle.is_finite() && (0.0..90.0).contains(&args.half_angle)) {
+        return bad("half-angle", args.half_angle, "an angle in [0, 90) degrees");
+    }
+    if !(args.length.is_finite() && args.length > 0.0) {
+        return bad("length", args.length, "a length > 0 mm");
+    }
+    if !(args.youngs.is_finite() && args.youngs > 0.0) {
+        return bad("youngs", args.youngs, "a modulus > 0 GPa");
+    }
     let theta = args.half_angle.to_radians();
     let cutter =
         ConicalCutter::from_load_plane(args.tip_radius, theta, args.length, args.youngs * 1000.0)
