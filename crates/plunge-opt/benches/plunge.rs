@@ -65,7 +65,7 @@ fn flat_tool(number: u32, name: &str, dims: [f64; 5], teeth: u32, edge: Option<f
 fn channel(c: &mut Criterion) {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/impeller-plunge-400");
     let impeller = impeller_model::load(root.join("impeller.toml")).expect("fixture");
-    // The stock of `job-plunge.toml`: the blank turned to the shroud contour (from the
+    // The stock of `job.toml`: the blank turned to the shroud contour (from the
     // uncut blank most plunges of the section are refused by the stock check, and planning
     // measures mostly that).
     let stock = impeller.turned_stock(0.0).expect("turned stock");

@@ -122,7 +122,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let fine = std::env::args().any(|a| a == "--fine");
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/impeller-plunge-400");
     let impeller = impeller_model::load(root.join("impeller.toml"))?;
-    // The blank turned to the shroud contour (as `job-plunge.toml` starts): from the uncut
+    // The blank turned to the shroud contour (as `job.toml` starts): from the uncut
     // cylinder the Ø16 and Ø8 strokes near the inlet are longer than the stick-out and their
     // holders would enter the blank (the planner refuses such plunges).
     let stock = impeller.turned_stock(0.0)?;
@@ -231,7 +231,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             );
         }
         // The next section starts a little toward the outlet from where this one ended
-        // (as job-plunge.toml does).
+        // (as job.toml does).
         start = [0.33, 0.07, 0.0][i];
     }
     Ok(())
