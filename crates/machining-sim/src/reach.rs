@@ -211,7 +211,7 @@ pub(crate) struct RowReach {
 impl Reach {
     /// The reach restricted to the row of rays at coordinate `v`; `None` when the solid
     /// meets no ray of the row. Same bounds as [`Reach::extent`] with `vs = (v, v)`.
-    #[inline(never)]
+    #[inline]
     pub(crate) fn row(&self, v: f64) -> Option<RowReach> {
         let mut pieces = [RowPiece::Ball {
             cu: 0.0,
@@ -282,7 +282,7 @@ impl Reach {
 impl RowReach {
     /// An interval along the rays containing every point of the solid on the rays of the
     /// row with `u ∈ us`; `None` when it meets none of them.
-    #[inline(never)]
+    #[inline]
     pub(crate) fn extent(&self, us: (f64, f64)) -> Option<(f64, f64)> {
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;

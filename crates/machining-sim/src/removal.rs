@@ -817,7 +817,7 @@ fn meets_material(segs: &[[f32; 2]], (lo, hi): (f64, f64)) -> bool {
 impl RowContext<'_> {
     /// Applies the placements `order` (batch indices, in order) to row `j`; returns the
     /// length removed and the collision hits.
-    #[inline(never)]
+    #[inline]
     fn row(
         &self,
         scratch: &mut RowScratch,

@@ -526,7 +526,7 @@ impl RevolvedSolid {
     }
 
     /// Hull of the piece intervals (exact for a convex solid, i.e. a cutting part).
-    #[inline(never)]
+    #[inline]
     pub fn ray_hull(&self, r: &RayLocal) -> Option<(f64, f64)> {
         if r.min_rho_sq() > self.r_max * self.r_max {
             return None;

@@ -58,7 +58,7 @@ impl Witness {
     /// Whether the witness proves that the cutting solid `solid`, placed with tip
     /// coordinate `tip_d` along the ray and seen from the ray as `rl`, meets no material of
     /// the ray, with `margin` (mm) against rounding.
-    #[inline(never)]
+    #[inline]
     pub(crate) fn holds(
         &self,
         rl: &RayLocal,
