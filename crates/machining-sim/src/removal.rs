@@ -118,6 +118,39 @@ impl Range2 {
     fn has(&self, i: usize) -> bool {
         i >= self.i0 && i <= self.i1
     }
+
+    /// The range shrunk to the `cull::TILE`² tiles whose material bound meets `extent`
+    /// (an interval along the rays containing the part's points on every ray of the tile,
+    /// given the tile's coordinate ranges `(ua, ub)`, `(va, vb)`); `None` when no tile does.
+    /// `(u0, v0)`: coordinates of ray (0, 0). O(tiles of the range).
+    fn shrink(
+        &self,
+        tiles: &TileBounds,
+        (u0, v0): (f64, f64),
+        cell: f64,
+        extent: impl Fn((f64, f64), (f64, f64)) -> Option<(f64, f64)>,
+    ) -> Option<Self> {
+        let Range2 { i0, i1, j0, j1 } = *self;
+        let (mut a0, mut a1, mut b0, mut b1) = (usize::MAX, 0, usize::MAX, 0);
+        for tj in j0 / TILE..=j1 / TILE {
+            let (ja, jb) = ((tj * TILE).max(j0), (tj * TILE + TILE - 1).min(j1));
+            let vs = (v0 + ja as f64 * cell, v0 + jb as f64 * cell);
+            for ti in i0 / TILE..=i1 / TILE {
+                let (ia, ib) = ((ti * TILE).max(i0), (ti * TILE + TILE - 1).min(i1));
+                let us = (u0 + ia as f64 * cell, u0 + ib as f64 * cell);
+                if extent(us, vs).is_some_and(|e| tiles.get(ti, tj).meets(e)) {
+                    (a0, a1) = (a0.min(ia), a1.max(ib));
+                    (b0, b1) = (b0.min(ja), b1.max(jb));
+                }
+            }
+        }
+        (a0 <= a1).then_some(Range2 {
+            i0: a0,
+            i1: a1,
+            j0: b0,
+            j1: b1,
+        })
+    }
 }
 
 /// Clips a piece of a solid placed at (tip, axis) to the box `[lo, hi]` inflated by the
@@ -424,40 +457,23 @@ impl Footprint {
     /// ray whose material meets the part's extent lies in a tile whose bound meets the
     /// part's extent over the whole tile (a superset, see [`Self::extent_over`]).
     /// `(u0, v0)`: coordinates of ray (0, 0). O(tiles of the range).
-    fn shrink(mut self, tiles: &TileBounds, (u0, v0): (f64, f64), cell: f64) -> Option<Self> {
-        let Range2 { i0, i1, j0, j1 } = self.range;
-        let (mut a0, mut a1, mut b0, mut b1) = (usize::MAX, 0, usize::MAX, 0);
-        for tj in j0 / TILE..=j1 / TILE {
-            let (ja, jb) = ((tj * TILE).max(j0), (tj * TILE + TILE - 1).min(j1));
-            let (va, vb) = (v0 + ja as f64 * cell, v0 + jb as f64 * cell);
-            let row = axis_window(
-                0.5 * (va + vb),
-                self.tip[1],
-                self.axis[1],
-                self.r + 0.5 * (vb - va) + CULL_SLACK_MM,
-                self.span,
-            );
-            if row.0 > row.1 {
-                continue;
-            }
-            for ti in i0 / TILE..=i1 / TILE {
-                let (ia, ib) = ((ti * TILE).max(i0), (ti * TILE + TILE - 1).min(i1));
-                let ext = self.extent_over(u0 + ia as f64 * cell, u0 + ib as f64 * cell, row);
-                if ext.is_some_and(|e| tiles.get(ti, tj).meets(e)) {
-                    (a0, a1) = (a0.min(ia), a1.max(ib));
-                    (b0, b1) = (b0.min(ja), b1.max(jb));
+    fn shrink(mut self, tiles: &TileBounds, origin: (f64, f64), cell: f64) -> Option<Self> {
+        self.range = self
+            .range
+            .shrink(tiles, origin, cell, |(ua, ub), (va, vb)| {
+                let row = axis_window(
+                    0.5 * (va + vb),
+                    self.tip[1],
+                    self.axis[1],
+                    self.r + 0.5 * (vb - va) + CULL_SLACK_MM,
+                    self.span,
+                );
+                if row.0 > row.1 {
+                    return None;
                 }
-            }
-        }
-        (a0 <= a1).then(|| {
-            self.range = Range2 {
-                i0: a0,
-                i1: a1,
-                j0: b0,
-                j1: b1,
-            };
-            self
-        })
+                self.extent_over(ua, ub, row)
+            })?;
+        Some(self)
     }
 
     /// The part's extent along the rays of the columns with coordinates in `[ua, ub]` (row
@@ -753,34 +769,11 @@ impl CutFootprint {
     /// The footprint with its ray range shrunk to the tiles whose material bound meets the
     /// reach over the tile (exact: the reach over a tile contains the reach of each of its
     /// rays). O(tiles of the range).
-    fn shrink(mut self, tiles: &TileBounds, (u0, v0): (f64, f64), cell: f64) -> Option<Self> {
-        let Range2 { i0, i1, j0, j1 } = self.range;
-        let (mut a0, mut a1, mut b0, mut b1) = (usize::MAX, 0, usize::MAX, 0);
-        for tj in j0 / TILE..=j1 / TILE {
-            let (ja, jb) = ((tj * TILE).max(j0), (tj * TILE + TILE - 1).min(j1));
-            let vs = (v0 + ja as f64 * cell, v0 + jb as f64 * cell);
-            for ti in i0 / TILE..=i1 / TILE {
-                let (ia, ib) = ((ti * TILE).max(i0), (ti * TILE + TILE - 1).min(i1));
-                let us = (u0 + ia as f64 * cell, u0 + ib as f64 * cell);
-                if self
-                    .reach
-                    .extent(us, vs)
-                    .is_some_and(|e| tiles.get(ti, tj).meets(e))
-                {
-                    (a0, a1) = (a0.min(ia), a1.max(ib));
-                    (b0, b1) = (b0.min(ja), b1.max(jb));
-                }
-            }
-        }
-        (a0 <= a1).then(|| {
-            self.range = Range2 {
-                i0: a0,
-                i1: a1,
-                j0: b0,
-                j1: b1,
-            };
-            self
-        })
+    fn shrink(mut self, tiles: &TileBounds, origin: (f64, f64), cell: f64) -> Option<Self> {
+        self.range = self
+            .range
+            .shrink(tiles, origin, cell, |us, vs| self.reach.extent(us, vs))?;
+        Some(self)
     }
 }
 

@@ -119,16 +119,21 @@ fn check(cutter: &Cutter, shape: &dyn StockShape, cell: f64, radius: f64, top: f
     assert!(stock0.volume() - fast.volume() > 1.0);
 }
 
-#[test]
-fn culled_parallel_removal_is_bit_identical_on_a_revolved_blank() {
-    let blank = RevolvedStock::new(vec![
+/// A Ø28 × 12 mm blank with a conical shoulder.
+fn revolved_blank() -> RevolvedStock {
+    RevolvedStock::new(vec![
         (0.0, 0.0),
         (0.0, 12.0),
         (8.0, 12.0),
         (14.0, 6.0),
         (14.0, 0.0),
     ])
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn culled_parallel_removal_is_bit_identical_on_a_revolved_blank() {
+    let blank = revolved_blank();
     check(&workload_cutter(), &blank, 0.2, 10.0, 14.0, 37);
 }
 
@@ -143,14 +148,7 @@ fn culled_parallel_removal_is_bit_identical_on_a_block() {
 /// placements revisiting the same rays many times in one batch.
 #[test]
 fn culled_parallel_removal_is_bit_identical_for_every_cutting_profile() {
-    let blank = RevolvedStock::new(vec![
-        (0.0, 0.0),
-        (0.0, 12.0),
-        (8.0, 12.0),
-        (14.0, 6.0),
-        (14.0, 0.0),
-    ])
-    .unwrap();
+    let blank = revolved_blank();
     for shape in [
         CutterShape::FlatEnd { radius: 2.0 },
         CutterShape::BallEnd { radius: 2.0 },
