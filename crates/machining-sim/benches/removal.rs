@@ -2,10 +2,10 @@
 //! tapered ball-end workload (shank/holder checked against the stock):
 //!
 //! * `machining_sim/removal_1k_moves`: 1,000 moves at 0.1 mm (kept for its history);
-//! * `machining_sim/removal_10k_moves_0.1mm`, `…_0.05mm`: 10,000 moves, throughput in moves
-//!   (removal is linear in the moves once the culling has found the rays each one reaches,
-//!   so 100,000 moves take ten times the median; the full 100,000-move figure and peak
-//!   memory come from `examples/removal_100k.rs`, too long for the bench harness);
+//! * `machining_sim/removal_10k_moves_0.1mm`, `…_0.05mm`: the first 10,000 moves (the
+//!   top layers, where every move cuts a full-depth slot), throughput in moves; a move costs
+//!   what it cuts, so this is not a tenth of a 100,000-move path's time: that figure and
+//!   peak memory come from `examples/removal_100k.rs`, too long for the bench harness;
 //! * `machining_sim/measure_design_points`: the measurement ([`machining_sim::measure`]:
 //!   normal probes at every design sample plus the depth of every cut end point) of the
 //!   default impeller's design after those 10,000 moves at 0.1 mm, throughput in design
