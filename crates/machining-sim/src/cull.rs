@@ -121,6 +121,52 @@ impl TileBounds {
     }
 }
 
+/// An open interval along the rays of a chunk that none of its rays holds material in
+/// (empty when `lo >= hi`). Removal only shrinks material, so it stays air for the rest of
+/// the batch: a cutting extent strictly inside it meets no material of the chunk.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AirSpan {
+    lo: f32,
+    hi: f32,
+}
+
+impl AirSpan {
+    /// No known air.
+    pub(crate) const NONE: Self = Self { lo: 0.0, hi: 0.0 };
+
+    /// Whether `[lo, hi]` lies strictly inside the air (then no material interval of the
+    /// chunk meets it, by the closed comparisons of [`ChunkBound::meets`]).
+    #[inline]
+    pub(crate) fn contains(&self, (lo, hi): (f64, f64)) -> bool {
+        f64::from(self.lo) < lo && hi < f64::from(self.hi)
+    }
+
+    /// The whole line, to be narrowed ray by ray around `ext` ([`Self::narrow`]).
+    #[inline]
+    pub(crate) fn around(_ext: (f64, f64)) -> Self {
+        Self {
+            lo: f32::NEG_INFINITY,
+            hi: f32::INFINITY,
+        }
+    }
+
+    /// Narrows the air to the gap of `segs` around `ext`; false when some material
+    /// interval meets `ext` (the chunk has no common air around it).
+    #[inline]
+    pub(crate) fn narrow(&mut self, segs: &[[f32; 2]], (lo, hi): (f64, f64)) -> bool {
+        for s in segs {
+            if f64::from(s[1]) < lo {
+                self.lo = self.lo.max(s[1]);
+            } else if f64::from(s[0]) > hi {
+                self.hi = self.hi.min(s[0]);
+            } else {
+                return false;
+            }
+        }
+        true
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

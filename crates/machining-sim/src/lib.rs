@@ -60,12 +60,14 @@ pub mod impeller_design;
 pub mod measure;
 pub mod merge;
 pub mod motion;
+mod reach;
 pub mod removal;
 pub mod simulate;
 pub mod stock_shape;
 pub mod surface_mesh;
 pub mod synthetic;
 pub mod tool_solid;
+mod witness;
 
 pub use crosscheck::{crosscheck_overcut, CrossCheckPoint, Envelopes};
 pub use design::{BoxDesign, CylinderDesign, DesignModel, SurfaceGrid, TriangleMesh, UnionDesign};

@@ -25,9 +25,11 @@
 //! part's extent; memory: the row buckets (one `u32` per placement and row touched) and the
 //! hit list (allocation-free kernel except when a two-interval ray splits into three).
 
-use crate::cull::{ChunkBound, TileBounds, CHUNK, TILE};
+use crate::cull::{AirSpan, ChunkBound, TileBounds, CHUNK, TILE};
 use crate::dexel::{GridGeometry, Segments, TriDexel};
+use crate::reach::Reach;
 use crate::tool_solid::{Piece, RayLocal, RevolvedSolid};
+use crate::witness::Witness;
 use cam_core::Cutter;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -116,6 +118,39 @@ impl Range2 {
     fn has(&self, i: usize) -> bool {
         i >= self.i0 && i <= self.i1
     }
+
+    /// The range shrunk to the `cull::TILE`² tiles whose material bound meets `extent`
+    /// (an interval along the rays containing the part's points on every ray of the tile,
+    /// given the tile's coordinate ranges `(ua, ub)`, `(va, vb)`); `None` when no tile does.
+    /// `(u0, v0)`: coordinates of ray (0, 0). O(tiles of the range).
+    fn shrink(
+        &self,
+        tiles: &TileBounds,
+        (u0, v0): (f64, f64),
+        cell: f64,
+        extent: impl Fn((f64, f64), (f64, f64)) -> Option<(f64, f64)>,
+    ) -> Option<Self> {
+        let Range2 { i0, i1, j0, j1 } = *self;
+        let (mut a0, mut a1, mut b0, mut b1) = (usize::MAX, 0, usize::MAX, 0);
+        for tj in j0 / TILE..=j1 / TILE {
+            let (ja, jb) = ((tj * TILE).max(j0), (tj * TILE + TILE - 1).min(j1));
+            let vs = (v0 + ja as f64 * cell, v0 + jb as f64 * cell);
+            for ti in i0 / TILE..=i1 / TILE {
+                let (ia, ib) = ((ti * TILE).max(i0), (ti * TILE + TILE - 1).min(i1));
+                let us = (u0 + ia as f64 * cell, u0 + ib as f64 * cell);
+                if extent(us, vs).is_some_and(|e| tiles.get(ti, tj).meets(e)) {
+                    (a0, a1) = (a0.min(ia), a1.max(ib));
+                    (b0, b1) = (b0.min(ja), b1.max(jb));
+                }
+            }
+        }
+        (a0 <= a1).then_some(Range2 {
+            i0: a0,
+            i1: a1,
+            j0: b0,
+            j1: b1,
+        })
+    }
 }
 
 /// Clips a piece of a solid placed at (tip, axis) to the box `[lo, hi]` inflated by the
@@ -197,10 +232,6 @@ fn merge_box(acc: &mut Option<([f64; 3], [f64; 3])>, b: ([f64; 3], [f64; 3])) {
 
 struct Prep {
     cut_box: Option<([f64; 3], [f64; 3])>,
-    /// Largest radius of the clipped cutting pieces (mm).
-    cut_radius: f64,
-    /// Height span of the clipped cutting pieces along the axis (mm).
-    cut_span: (f64, f64),
     coll_box: Option<([f64; 3], [f64; 3])>,
     /// Largest radius of the clipped collision pieces (mm).
     coll_radius: f64,
@@ -238,14 +269,10 @@ fn prepare(
     for pl in batch {
         let body = &bodies[pl.tool];
         let mut cut_box = None;
-        let mut cut_radius: f64 = 0.0;
-        let mut cut_span = (f64::INFINITY, f64::NEG_INFINITY);
         if !pl.rapid {
             for p in body.cutting.pieces() {
                 if let Some(c) = clip_piece(p, &pl.tip, &pl.axis, &lo, &hi) {
                     merge_box(&mut cut_box, piece_box(&c, &pl.tip, &pl.axis));
-                    cut_radius = cut_radius.max(c.max_radius());
-                    cut_span = (cut_span.0.min(c.heights().0), cut_span.1.max(c.heights().1));
                 }
             }
         }
@@ -284,8 +311,6 @@ fn prepare(
         }
         preps.push(Prep {
             cut_box,
-            cut_radius,
-            cut_span,
             coll_box,
             coll_radius,
             coll_span,
@@ -432,40 +457,23 @@ impl Footprint {
     /// ray whose material meets the part's extent lies in a tile whose bound meets the
     /// part's extent over the whole tile (a superset, see [`Self::extent_over`]).
     /// `(u0, v0)`: coordinates of ray (0, 0). O(tiles of the range).
-    fn shrink(mut self, tiles: &TileBounds, (u0, v0): (f64, f64), cell: f64) -> Option<Self> {
-        let Range2 { i0, i1, j0, j1 } = self.range;
-        let (mut a0, mut a1, mut b0, mut b1) = (usize::MAX, 0, usize::MAX, 0);
-        for tj in j0 / TILE..=j1 / TILE {
-            let (ja, jb) = ((tj * TILE).max(j0), (tj * TILE + TILE - 1).min(j1));
-            let (va, vb) = (v0 + ja as f64 * cell, v0 + jb as f64 * cell);
-            let row = axis_window(
-                0.5 * (va + vb),
-                self.tip[1],
-                self.axis[1],
-                self.r + 0.5 * (vb - va) + CULL_SLACK_MM,
-                self.span,
-            );
-            if row.0 > row.1 {
-                continue;
-            }
-            for ti in i0 / TILE..=i1 / TILE {
-                let (ia, ib) = ((ti * TILE).max(i0), (ti * TILE + TILE - 1).min(i1));
-                let ext = self.extent_over(u0 + ia as f64 * cell, u0 + ib as f64 * cell, row);
-                if ext.is_some_and(|e| tiles.get(ti, tj).meets(e)) {
-                    (a0, a1) = (a0.min(ia), a1.max(ib));
-                    (b0, b1) = (b0.min(ja), b1.max(jb));
+    fn shrink(mut self, tiles: &TileBounds, origin: (f64, f64), cell: f64) -> Option<Self> {
+        self.range = self
+            .range
+            .shrink(tiles, origin, cell, |(ua, ub), (va, vb)| {
+                let row = axis_window(
+                    0.5 * (va + vb),
+                    self.tip[1],
+                    self.axis[1],
+                    self.r + 0.5 * (vb - va) + CULL_SLACK_MM,
+                    self.span,
+                );
+                if row.0 > row.1 {
+                    return None;
                 }
-            }
-        }
-        (a0 <= a1).then(|| {
-            self.range = Range2 {
-                i0: a0,
-                i1: a1,
-                j0: b0,
-                j1: b1,
-            };
-            self
-        })
+                self.extent_over(ua, ub, row)
+            })?;
+        Some(self)
     }
 
     /// The part's extent along the rays of the columns with coordinates in `[ua, ub]` (row
@@ -513,7 +521,47 @@ impl Footprint {
     }
 }
 
-/// Per-ray work shared by both implementations: collision overlaps of the clipped
+/// Collision overlaps of the clipped non-cutting pieces with one ray's material, kept in
+/// `best` (deepest per part slot).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn collide_ray(
+    ray: &Segments,
+    rl: &RayLocal,
+    pl: &Placement,
+    pieces: &[(Piece, PartKind)],
+    k: usize,
+    (d, ua, va): (usize, usize, usize),
+    (u, v): (f64, f64),
+    collision_tol: f64,
+    best: &mut [Option<StockHit>; 3],
+) {
+    for (piece, kind) in pieces {
+        if let Some((s, e)) = piece.ray_interval(rl) {
+            let (s, e) = (s + pl.tip[d], e + pl.tip[d]);
+            let ov = ray.overlap(s, e);
+            let slot = match kind {
+                PartKind::Shank => 0,
+                PartKind::Holder => 1,
+                PartKind::RapidMove => 2,
+            };
+            if ov > collision_tol && best[slot].is_none_or(|h| h.depth < ov) {
+                let mut point = [0.0; 3];
+                point[ua] = u;
+                point[va] = v;
+                point[d] = 0.5 * (s + e);
+                best[slot] = Some(StockHit {
+                    placement: k,
+                    part: *kind,
+                    depth: ov,
+                    point,
+                });
+            }
+        }
+    }
+}
+
+/// Per-ray work of [`apply_batch_reference`]: collision overlaps of the clipped
 /// non-cutting pieces (kept in `best`, deepest per part slot) and removal by the cutting
 /// part. Returns the length removed.
 #[allow(clippy::too_many_arguments)]
@@ -532,29 +580,17 @@ fn ray_work(
     best: &mut [Option<StockHit>; 3],
 ) -> f64 {
     if let Some(pieces) = pieces {
-        for (piece, kind) in pieces {
-            if let Some((s, e)) = piece.ray_interval(rl) {
-                let (s, e) = (s + pl.tip[d], e + pl.tip[d]);
-                let ov = ray.overlap(s, e);
-                let slot = match kind {
-                    PartKind::Shank => 0,
-                    PartKind::Holder => 1,
-                    PartKind::RapidMove => 2,
-                };
-                if ov > collision_tol && best[slot].is_none_or(|h| h.depth < ov) {
-                    let mut point = [0.0; 3];
-                    point[ua] = u;
-                    point[va] = v;
-                    point[d] = 0.5 * (s + e);
-                    best[slot] = Some(StockHit {
-                        placement: k,
-                        part: *kind,
-                        depth: ov,
-                        point,
-                    });
-                }
-            }
-        }
+        collide_ray(
+            ray,
+            rl,
+            pl,
+            pieces,
+            k,
+            (d, ua, va),
+            (u, v),
+            collision_tol,
+            best,
+        );
     }
     if cut {
         if let Some((s, e)) = body.cutting.ray_hull(rl) {
@@ -584,6 +620,8 @@ fn ray_work(
 ///   span) and its coordinate along the ray within `R·sqrt(1 − a_d²)` of `tip_d + h·a_d`;
 ///   material outside that extent is untouched by subtraction and overlap. The unclipped
 ///   rest of the tool lies outside the stock box, where no ray holds material.
+///   For the cutting part the extent follows its profile piece by piece
+///   ([`crate::reach`]).
 /// * the same test runs on groups of rays first: the extent over a group's column (and row)
 ///   range contains every member's extent, and the group's material bound
 ///   (the private `cull` module) contains every member's material, also later in the batch since
@@ -592,6 +630,13 @@ fn ray_work(
 ///   before it is bucketed into rows, and on a row whole `cull::CHUNK`s of rays
 ///   are skipped. On the default job at 0.1 mm this skips 94 % of the rays the band visits
 ///   (26.6·10⁹ → 1.6·10⁹ ray visits; removal 102 s → 31 s on two cores).
+/// * a chunk whose rays all hold no material inside the cutting part's extent over the
+///   chunk is skipped too: each chunk keeps an interval of common air (`cull::AirSpan`,
+///   valid for the rest of the batch since air only grows), and a cutter moving through a
+///   channel between walls stays inside it.
+/// * a ray whose cutter interval lay in a gap of its material keeps a witness
+///   ([`crate::witness`]): while the witness point stays inside the cutter and the gap's
+///   ends stay outside it, the placement removes nothing there, without an intersection.
 ///
 /// Every bound is widened by [`CULL_SLACK_MM`]. Cost per placement: O(rays of the band
 /// inside the box) bound checks plus one ray–solid intersection per ray whose material
@@ -605,29 +650,29 @@ pub fn apply_batch(
 ) -> BatchOutcome {
     let cell = stock.cell();
     let Prepared { coll_pieces, preps } = prepare(stock, bodies, batch, check_collisions);
+    let margin = witness_margin(stock);
     let mut outcome = BatchOutcome::default();
     for grid in stock.grids_mut().iter_mut() {
         let d = grid.dir();
-        let (ua, va) = ((d + 1) % 3, (d + 2) % 3);
         let (_, nv) = grid.size();
         let geo = grid.geometry();
         let tiles = TileBounds::new(grid);
         let (u0, v0) = grid.ray_uv(0, 0);
-        let feet: Vec<(Option<Footprint>, Option<Footprint>)> = batch
+        let feet: Vec<(Option<CutFootprint>, Option<Footprint>)> = batch
             .par_iter()
             .zip(&preps)
             .map(|(pl, p)| {
-                let foot = |bx, radius, span| {
-                    Footprint::new(&geo, bx, radius, span, pl)?.shrink(&tiles, (u0, v0), cell)
-                };
-                (
-                    foot(&p.cut_box, p.cut_radius, p.cut_span),
-                    foot(&p.coll_box, p.coll_radius, p.coll_span),
-                )
+                let cut = p.cut_box.as_ref().and_then(|bx| {
+                    let reach = Reach::new(&bodies[pl.tool].cutting, &pl.tip, &pl.axis, d);
+                    CutFootprint::new(&geo, bx, reach)?.shrink(&tiles, (u0, v0), cell)
+                });
+                let coll = Footprint::new(&geo, &p.coll_box, p.coll_radius, p.coll_span, pl)
+                    .and_then(|f| f.shrink(&tiles, (u0, v0), cell));
+                (cut, coll)
             })
             .collect();
         // Placements per row, in batch order (CSR).
-        let span = |f: &(Option<Footprint>, Option<Footprint>)| -> Option<(usize, usize)> {
+        let span = |f: &(Option<CutFootprint>, Option<Footprint>)| -> Option<(usize, usize)> {
             match (f.0.map(|a| a.range), f.1.map(|b| b.range)) {
                 (None, None) => None,
                 (Some(a), None) | (None, Some(a)) => Some((a.j0, a.j1)),
@@ -656,104 +701,23 @@ pub fn apply_batch(
                 }
             }
         }
+        let ctx = RowContext {
+            geo,
+            cell,
+            origin: (u0, v0),
+            bodies,
+            batch,
+            preps: &preps,
+            coll_pieces: &coll_pieces,
+            feet: &feet,
+            collision_tol,
+            margin,
+        };
         let (removed, hits) = grid
             .rows_mut()
             .enumerate()
-            .map_init(Vec::new, |bounds: &mut Vec<ChunkBound>, (j, row)| {
-                let v = v0 + j as f64 * cell;
-                let mut removed = 0.0;
-                let mut hits: Vec<StockHit> = Vec::new();
-                bounds.clear();
-                bounds.resize(row.len().div_ceil(CHUNK), ChunkBound::STALE);
-                for &k in &order[offsets[j]..offsets[j + 1]] {
-                    let k = k as usize;
-                    let pl = &batch[k];
-                    let (cut, coll) = &feet[k];
-                    let cut_cols = cut.as_ref().and_then(|f| f.columns(&geo, j, v));
-                    let coll_cols = coll.as_ref().and_then(|f| f.columns(&geo, j, v));
-                    let cut_row = cut.map_or((1.0, 0.0), |f| f.row_window(v));
-                    let coll_row = coll.map_or((1.0, 0.0), |f| f.row_window(v));
-                    let cut_cols = cut_cols.and_then(|c| cut.as_ref()?.narrow(&geo, c, cut_row));
-                    let coll_cols =
-                        coll_cols.and_then(|c| coll.as_ref()?.narrow(&geo, c, coll_row));
-                    let (ia, ib) = match (cut_cols, coll_cols) {
-                        (None, None) => continue,
-                        (Some(a), None) | (None, Some(a)) => a,
-                        (Some(a), Some(b)) => (a.0.min(b.0), a.1.max(b.1)),
-                    };
-                    let body = &bodies[pl.tool];
-                    let pieces = &coll_pieces[preps[k].coll.clone()];
-                    let dv = v - pl.tip[va];
-                    let mut best: [Option<StockHit>; 3] = [None; 3];
-                    // Whether a part can meet the chunk's material on columns `ca..=cb`.
-                    let chunk_meets = |cols: Option<(usize, usize)>,
-                                       f: &Option<Footprint>,
-                                       window: (f64, f64),
-                                       (ca, cb): (usize, usize),
-                                       b: &ChunkBound| {
-                        let (Some((x0, x1)), Some(f)) = (cols, f) else {
-                            return false;
-                        };
-                        let (a, e) = (x0.max(ca), x1.min(cb));
-                        a <= e
-                            && f.extent_over(u0 + a as f64 * cell, u0 + e as f64 * cell, window)
-                                .is_some_and(|ext| b.meets(ext))
-                    };
-                    for c in ia / CHUNK..=ib / CHUNK {
-                        let (ca, cb) = ((c * CHUNK).max(ia), (c * CHUNK + CHUNK - 1).min(ib));
-                        let Some(b) = bounds.get_mut(c) else {
-                            continue;
-                        };
-                        if b.stale {
-                            *b = ChunkBound::of(&row[c * CHUNK..row.len().min(c * CHUNK + CHUNK)]);
-                        }
-                        let chunk_cut = chunk_meets(cut_cols, cut, cut_row, (ca, cb), b);
-                        let chunk_coll = chunk_meets(coll_cols, coll, coll_row, (ca, cb), b);
-                        if !(chunk_cut || chunk_coll) {
-                            continue;
-                        }
-                        let mut changed = false;
-                        for (i, ray) in row.iter_mut().enumerate().take(cb + 1).skip(ca) {
-                            let segs = ray.as_slice();
-                            if segs.is_empty() {
-                                continue;
-                            }
-                            let u = u0 + i as f64 * cell;
-                            let in_coll = chunk_coll
-                                && coll_cols.is_some_and(|c| i >= c.0 && i <= c.1)
-                                && coll.is_some_and(|f| f.meets(segs, u, coll_row));
-                            let in_cut = chunk_cut
-                                && cut_cols.is_some_and(|c| i >= c.0 && i <= c.1)
-                                && cut.is_some_and(|f| f.meets(segs, u, cut_row));
-                            if !(in_coll || in_cut) {
-                                continue;
-                            }
-                            let rl = RayLocal::new(d, u - pl.tip[ua], dv, &pl.axis);
-                            let r = ray_work(
-                                ray,
-                                &rl,
-                                pl,
-                                body,
-                                in_coll.then_some(pieces),
-                                in_cut,
-                                k,
-                                (d, ua, va),
-                                (u, v),
-                                collision_tol,
-                                &mut best,
-                            );
-                            changed |= r > 0.0;
-                            removed += r;
-                        }
-                        if changed {
-                            if let Some(b) = bounds.get_mut(c) {
-                                b.stale = true;
-                            }
-                        }
-                    }
-                    hits.extend(best.into_iter().flatten());
-                }
-                (removed, hits)
+            .map_init(RowScratch::default, |scratch, (j, row)| {
+                ctx.row(scratch, j, row, &order[offsets[j]..offsets[j + 1]])
             })
             .reduce(
                 || (0.0, Vec::new()),
@@ -767,6 +731,244 @@ pub fn apply_batch(
         outcome.hits.extend(hits);
     }
     outcome
+}
+
+/// Margin (mm) of the witnesses' point classifications ([`crate::witness`]): 10⁻⁴ mm plus
+/// four `f32` epsilons of the largest coordinate of the stock box, far above the rounding
+/// of a computed chord (≈ 10⁻¹³ mm; 10⁻⁷ mm at grazing incidence; 10⁻⁶ mm for a torus) and
+/// above the rounding of its ends to `f32` (half an ulp, 6·10⁻⁵ mm at 1000 mm).
+fn witness_margin(stock: &TriDexel) -> f64 {
+    let big = stock
+        .min()
+        .iter()
+        .chain(stock.max().iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    1e-4 + 4.0 * f64::from(f32::EPSILON) * big
+}
+
+/// Where the cutting part of one placement can remove material on one grid: its box's ray
+/// index range (shrunk to the tiles it can reach) and its reach along the rays.
+#[derive(Debug, Clone, Copy)]
+struct CutFootprint {
+    range: Range2,
+    reach: Reach,
+}
+
+impl CutFootprint {
+    fn new(grid: &GridGeometry, (blo, bhi): &([f64; 3], [f64; 3]), reach: Reach) -> Option<Self> {
+        let d = grid.dir();
+        let (ua, va) = ((d + 1) % 3, (d + 2) % 3);
+        let (i0, i1) = grid.index_range(blo[ua], bhi[ua], false)?;
+        let (j0, j1) = grid.index_range(blo[va], bhi[va], true)?;
+        Some(Self {
+            range: Range2 { i0, i1, j0, j1 },
+            reach,
+        })
+    }
+
+    /// The footprint with its ray range shrunk to the tiles whose material bound meets the
+    /// reach over the tile (exact: the reach over a tile contains the reach of each of its
+    /// rays). O(tiles of the range).
+    fn shrink(mut self, tiles: &TileBounds, origin: (f64, f64), cell: f64) -> Option<Self> {
+        self.range = self
+            .range
+            .shrink(tiles, origin, cell, |us, vs| self.reach.extent(us, vs))?;
+        Some(self)
+    }
+}
+
+/// Per-row scratch of [`apply_batch`], reused between rows.
+#[derive(Debug, Default)]
+struct RowScratch {
+    bounds: Vec<ChunkBound>,
+    air: Vec<AirSpan>,
+    witness: Vec<Witness>,
+}
+
+/// What every row of one grid shares in [`apply_batch`].
+struct RowContext<'a> {
+    geo: GridGeometry,
+    cell: f64,
+    origin: (f64, f64),
+    bodies: &'a [ToolBody],
+    batch: &'a [Placement],
+    preps: &'a [Prep],
+    coll_pieces: &'a [(Piece, PartKind)],
+    feet: &'a [(Option<CutFootprint>, Option<Footprint>)],
+    collision_tol: f64,
+    /// Margin of the witnesses' point classifications (mm, [`witness_margin`]).
+    margin: f64,
+}
+
+/// Whether some material interval of `segs` meets `[lo, hi]` (closed).
+#[inline]
+fn meets_material(segs: &[[f32; 2]], (lo, hi): (f64, f64)) -> bool {
+    segs.iter()
+        .any(|s| f64::from(s[1]) >= lo && f64::from(s[0]) <= hi)
+}
+
+impl RowContext<'_> {
+    /// Applies the placements `order` (batch indices, in order) to row `j`; returns the
+    /// length removed and the collision hits.
+    #[inline]
+    fn row(
+        &self,
+        scratch: &mut RowScratch,
+        j: usize,
+        row: &mut [Segments],
+        order: &[u32],
+    ) -> (f64, Vec<StockHit>) {
+        let geo = &self.geo;
+        let d = geo.dir();
+        let (ua, va) = ((d + 1) % 3, (d + 2) % 3);
+        let cell = self.cell;
+        let (u0, v0) = self.origin;
+        let v = v0 + j as f64 * cell;
+        let mut removed = 0.0;
+        let mut hits: Vec<StockHit> = Vec::new();
+        let chunks = row.len().div_ceil(CHUNK);
+        scratch.bounds.clear();
+        scratch.bounds.resize(chunks, ChunkBound::STALE);
+        scratch.air.clear();
+        scratch.air.resize(chunks, AirSpan::NONE);
+        scratch.witness.clear();
+        scratch.witness.resize(row.len(), Witness::NONE);
+        for &k in order {
+            let k = k as usize;
+            let pl = &self.batch[k];
+            let (cut, coll) = &self.feet[k];
+            let row_reach = cut
+                .as_ref()
+                .filter(|f| f.range.has_row(j))
+                .and_then(|f| f.reach.row(v));
+            let cut_cols = cut.as_ref().zip(row_reach.as_ref()).and_then(|(f, r)| {
+                let (a, e) = geo.index_range(r.span.0, r.span.1, false)?;
+                let (a, e) = (a.max(f.range.i0), e.min(f.range.i1));
+                (a <= e).then_some((a, e))
+            });
+            let coll_cols = coll.as_ref().and_then(|f| f.columns(geo, j, v));
+            let coll_row = coll.map_or((1.0, 0.0), |f| f.row_window(v));
+            let coll_cols = coll_cols.and_then(|c| coll.as_ref()?.narrow(geo, c, coll_row));
+            let (ia, ib) = match (cut_cols, coll_cols) {
+                (None, None) => continue,
+                (Some(a), None) | (None, Some(a)) => a,
+                (Some(a), Some(b)) => (a.0.min(b.0), a.1.max(b.1)),
+            };
+            let body = &self.bodies[pl.tool];
+            let pieces = &self.coll_pieces[self.preps[k].coll.clone()];
+            let dv = v - pl.tip[va];
+
+            let mut best: [Option<StockHit>; 3] = [None; 3];
+            let in_cols =
+                |c: Option<(usize, usize)>, i: usize| c.is_some_and(|c| i >= c.0 && i <= c.1);
+            for c in ia / CHUNK..=ib / CHUNK {
+                let (ca, cb) = ((c * CHUNK).max(ia), (c * CHUNK + CHUNK - 1).min(ib));
+                let (ra, rb) = (c * CHUNK, row.len().min(c * CHUNK + CHUNK) - 1);
+                let Some(b) = scratch.bounds.get_mut(c) else {
+                    continue;
+                };
+                if b.stale {
+                    *b = ChunkBound::of(&row[ra..=rb]);
+                }
+                // The cutting part's extent over the chunk's columns it can reach.
+                let cut_ext = cut_cols.and_then(|(x0, x1)| {
+                    let (a, e) = (x0.max(ca), x1.min(cb));
+                    if a > e {
+                        return None;
+                    }
+                    let us = (u0 + a as f64 * cell, u0 + e as f64 * cell);
+                    row_reach.as_ref()?.extent(us).filter(|x| b.meets(*x))
+                });
+                let chunk_coll = coll_cols.is_some_and(|(x0, x1)| {
+                    let (a, e) = (x0.max(ca), x1.min(cb));
+                    a <= e
+                        && coll.as_ref().is_some_and(|f| {
+                            f.extent_over(u0 + a as f64 * cell, u0 + e as f64 * cell, coll_row)
+                                .is_some_and(|ext| b.meets(ext))
+                        })
+                });
+                let cut_ext = cut_ext.filter(|x| !scratch.air[c].contains(*x));
+                if cut_ext.is_none() && !chunk_coll {
+                    continue;
+                }
+                // Common air of the chunk around the cutting part's extent, rebuilt while
+                // the rays are visited (valid when no ray of the chunk meets the extent).
+                let mut air = cut_ext.map(AirSpan::around);
+                let mut changed = false;
+                for (i, ray) in row.iter_mut().enumerate().take(rb + 1).skip(ra) {
+                    let segs = ray.as_slice();
+                    if let (Some(a), Some(x)) = (air.as_mut(), cut_ext) {
+                        if !a.narrow(segs, x) {
+                            air = None;
+                        }
+                    }
+                    if i < ca || i > cb || segs.is_empty() {
+                        continue;
+                    }
+                    let u = u0 + i as f64 * cell;
+                    let in_coll = chunk_coll
+                        && in_cols(coll_cols, i)
+                        && coll.is_some_and(|f| f.meets(segs, u, coll_row));
+                    let in_cut = cut_ext.is_some_and(|x| meets_material(segs, x))
+                        && in_cols(cut_cols, i)
+                        && row_reach.as_ref().is_some_and(|r| {
+                            r.extent((u, u)).is_some_and(|x| meets_material(segs, x))
+                        });
+                    if !(in_coll || in_cut) {
+                        continue;
+                    }
+
+                    let rl = RayLocal::new(d, u - pl.tip[ua], dv, &pl.axis);
+                    if in_coll {
+                        collide_ray(
+                            ray,
+                            &rl,
+                            pl,
+                            pieces,
+                            k,
+                            (d, ua, va),
+                            (u, v),
+                            self.collision_tol,
+                            &mut best,
+                        );
+                    }
+                    if in_cut {
+                        let w = &mut scratch.witness[i];
+                        if w.holds(&rl, pl.tip[d], &body.cutting, self.margin) {
+                            continue;
+                        }
+                        let r = match body.cutting.ray_hull(&rl) {
+                            Some((s, e)) => {
+                                let (s, e) = (s + pl.tip[d], e + pl.tip[d]);
+                                let r = ray.subtract(s, e);
+                                *w = Witness::after_cut(ray.as_slice(), s, e);
+                                r
+                            }
+                            None => {
+                                *w = Witness::NONE;
+                                0.0
+                            }
+                        };
+
+                        changed |= r > 0.0;
+                        removed += r;
+                    }
+                }
+
+                if let Some(a) = air {
+                    scratch.air[c] = a;
+                }
+                if changed {
+                    if let Some(b) = scratch.bounds.get_mut(c) {
+                        b.stale = true;
+                    }
+                }
+            }
+
+            hits.extend(best.into_iter().flatten());
+        }
+        (removed, hits)
+    }
 }
 
 /// The reference semantics of [`apply_batch`], without culling or parallelism: placements

@@ -543,6 +543,57 @@ impl RevolvedSolid {
         out
     }
 
+    /// Whether the point at height `h` and squared radial distance `rho_sq` lies farther than
+    /// `margin` from every piece (so from the solid): beyond the piece's slab, or beyond its
+    /// side (frustum: the side line moved out by `margin·(1 + k²/2) ≥ margin·√(1 + k²)`,
+    /// `k` the slope; ball: radius plus `margin`; torus: its outer cylinder). No square root.
+    /// O(pieces).
+    pub fn outside_by(&self, h: f64, rho_sq: f64, margin: f64) -> bool {
+        self.pieces.iter().all(|p| {
+            let (h0, h1) = p.heights();
+            if h < h0 - margin || h > h1 + margin {
+                return true;
+            }
+            let lim = match *p {
+                Piece::Frustum { r0, r1, .. } => {
+                    let k = if h1 > h0 { (r1 - r0) / (h1 - h0) } else { 0.0 };
+                    (r0 + k * (h - h0)).max(0.0) + margin * (1.0 + 0.5 * k * k)
+                }
+                Piece::Sphere { hc, radius, .. } => {
+                    let r = radius + margin;
+                    return (h - hc) * (h - hc) + rho_sq > r * r;
+                }
+                Piece::Torus { major, minor, .. } => major + minor + margin,
+            };
+            rho_sq > lim * lim
+        })
+    }
+
+    /// Whether the point at height `h` and squared radial distance `rho_sq` lies inside one
+    /// piece at a distance larger than `margin` from every face of that piece (a sufficient
+    /// condition for lying inside the solid by `margin`; a torus piece never qualifies).
+    /// O(pieces).
+    pub fn inside_by(&self, h: f64, rho_sq: f64, margin: f64) -> bool {
+        self.pieces.iter().any(|p| {
+            let (h0, h1) = p.heights();
+            if h < h0 + margin || h > h1 - margin {
+                return false;
+            }
+            match *p {
+                Piece::Frustum { r0, r1, .. } => {
+                    let k = (r1 - r0) / (h1 - h0);
+                    let lim = r0 + k * (h - h0) - margin * (1.0 + 0.5 * k * k);
+                    lim > 0.0 && rho_sq < lim * lim
+                }
+                Piece::Sphere { hc, radius, .. } => {
+                    let lim = radius - margin;
+                    lim > 0.0 && (h - hc) * (h - hc) + rho_sq < lim * lim
+                }
+                Piece::Torus { .. } => false,
+            }
+        })
+    }
+
     /// Whether a point at height `h` and radial distance `rho` lies inside the solid.
     pub fn contains_local(&self, h: f64, rho: f64) -> bool {
         self.pieces.iter().any(|p| {

@@ -4,7 +4,7 @@
 //! volumes equal up to the order of the floating-point sum (relative 10⁻¹²).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use cam_core::{MoveKind, Point3, UnitVector3, Vector3};
+use cam_core::{Cutter, CutterShape, HolderSegment, MoveKind, Point3, UnitVector3, Vector3};
 use machining_sim::removal::{apply_batch, apply_batch_reference, Placement, StockHit, ToolBody};
 use machining_sim::synthetic::{workload_cutter, zigzag_path};
 use machining_sim::{BoxStock, RevolvedStock, StockShape, TriDexel};
@@ -86,9 +86,9 @@ fn assert_same_stock(a: &TriDexel, b: &TriDexel) {
     }
 }
 
-fn check(shape: &dyn StockShape, cell: f64, radius: f64, top: f64, batch: usize) {
+fn check(cutter: &Cutter, shape: &dyn StockShape, cell: f64, radius: f64, top: f64, batch: usize) {
     let stock0 = TriDexel::from_shape(shape, cell).unwrap();
-    let bodies = vec![ToolBody::new(&workload_cutter())];
+    let bodies = vec![ToolBody::new(cutter)];
     let pls = placements(radius, top);
     assert!(pls.len() >= 400);
     let (mut fast, mut slow) = (stock0.clone(), stock0.clone());
@@ -119,21 +119,54 @@ fn check(shape: &dyn StockShape, cell: f64, radius: f64, top: f64, batch: usize)
     assert!(stock0.volume() - fast.volume() > 1.0);
 }
 
-#[test]
-fn culled_parallel_removal_is_bit_identical_on_a_revolved_blank() {
-    let blank = RevolvedStock::new(vec![
+/// A Ø28 × 12 mm blank with a conical shoulder.
+fn revolved_blank() -> RevolvedStock {
+    RevolvedStock::new(vec![
         (0.0, 0.0),
         (0.0, 12.0),
         (8.0, 12.0),
         (14.0, 6.0),
         (14.0, 0.0),
     ])
-    .unwrap();
-    check(&blank, 0.2, 10.0, 14.0, 37);
+    .unwrap()
+}
+
+#[test]
+fn culled_parallel_removal_is_bit_identical_on_a_revolved_blank() {
+    let blank = revolved_blank();
+    check(&workload_cutter(), &blank, 0.2, 10.0, 14.0, 37);
 }
 
 #[test]
 fn culled_parallel_removal_is_bit_identical_on_a_block() {
     let block = BoxStock::new([-10.0, -10.0, 0.0], [10.0, 10.0, 30.0]).unwrap();
-    check(&block, 0.25, 9.0, 30.0, 4096);
+    check(&workload_cutter(), &block, 0.25, 9.0, 30.0, 4096);
+}
+
+/// The same on every cutting profile (the per-ray skips rest on the convexity of the
+/// cutting part: flat end, ball end, bull nose with its torus, tapered flat end), the
+/// placements revisiting the same rays many times in one batch.
+#[test]
+fn culled_parallel_removal_is_bit_identical_for_every_cutting_profile() {
+    let blank = revolved_blank();
+    for shape in [
+        CutterShape::FlatEnd { radius: 2.0 },
+        CutterShape::BallEnd { radius: 2.0 },
+        CutterShape::BullNose {
+            radius: 2.0,
+            corner_radius: 0.6,
+        },
+        CutterShape::TaperedFlatEnd {
+            tip_radius: 0.8,
+            half_angle: 4f64.to_radians(),
+        },
+    ] {
+        let mut cutter = Cutter::new("t", shape, 25.0, 3.0, 50.0).unwrap();
+        cutter.holder = vec![HolderSegment {
+            bottom_radius: 20.0,
+            top_radius: 20.0,
+            length: 40.0,
+        }];
+        check(&cutter, &blank, 0.2, 10.0, 14.0, 211);
+    }
 }
