@@ -400,6 +400,12 @@ fn plan_pass(
         us.reverse();
     }
     let contact = |u: f64| contact_at(ctx, blade, side, (u, line.v_at(u)), v_max, st);
+    // How far the ball centre `c` keeps from the hub beyond the ball radius and the hub
+    // allowance (negative: the ball would cut below the hub allowance).
+    let hub_gap = |c: &Vector3<f64>| {
+        ctx.clearance.hub_signed_distance(&Point3::from(*c))
+            - (st.ball_radius + st.hub_allowance_mm)
+    };
     // Contacts with chord refinement.
     let mut contacts: Vec<Result<Contact, (f64, &'static str)>> = Vec::new();
     let first = contact(us[0]).map_err(|e| (us[0], e));
@@ -407,7 +413,7 @@ fn plan_pass(
     for w in us.windows(2) {
         let b = contact(w[1]).map_err(|e| (w[1], e));
         let a = *contacts.last().unwrap_or(&b);
-        refine_between(&contact, &a, &b, st, 0, &mut contacts);
+        refine_between(&contact, &hub_gap, &a, &b, st, 0, &mut contacts);
         contacts.push(b);
     }
     // Axes along the pass.
@@ -488,10 +494,13 @@ fn plan_pass(
 /// Inserts contacts between `a` and `b` (depth-first, in order) while the chord between
 /// their ball centres strays from the offset curve halfway by more than `chord_mm` toward
 /// the side (where the straight move would cut into it), by more than the scallop height
-/// away from it (where it would only leave material), or the normal turns more than
-/// `max_axis_step`.
+/// away from it (where it would only leave material), dips more than `chord_mm` below the
+/// hub's offset by the ball radius and hub allowance (`hub_gap` < −`chord_mm` at the
+/// chord's midpoint: where the balls ride along the hub, a chord over a hub that bulges
+/// toward it cuts into the hub), or the normal turns more than `max_axis_step`.
 fn refine_between(
     contact: &impl Fn(f64) -> Result<Contact, &'static str>,
+    hub_gap: &impl Fn(&Vector3<f64>) -> f64,
     a: &Result<Contact, (f64, &'static str)>,
     b: &Result<Contact, (f64, &'static str)>,
     st: &PointSettings,
@@ -525,16 +534,17 @@ fn refine_between(
                 st.chord_mm.max(CHORD_SCALLOP_SHARE * st.scallop_mm)
             };
             let turn = ca.frame.n.angle(&cb.frame.n);
-            e.norm() > limit || turn > st.max_axis_step
+            let into_hub = hub_gap(&((a0 + b0) * 0.5)) < -st.chord_mm;
+            e.norm() > limit || turn > st.max_axis_step || into_hub
         }
         Err(_) => true,
     };
     if !needs {
         return;
     }
-    refine_between(contact, a, &m, st, depth + 1, out);
+    refine_between(contact, hub_gap, a, &m, st, depth + 1, out);
     out.push(m);
-    refine_between(contact, &m, b, st, depth + 1, out);
+    refine_between(contact, hub_gap, &m, b, st, depth + 1, out);
 }
 
 /// Whether the motion `a → b` can be made: directly when the whole tool keeps the floors
