@@ -3,6 +3,7 @@
 
 use super::axes::Axes;
 use super::operation::ChannelRoughing;
+use super::plan2d::Region;
 use cam_core::CutterShape;
 use cam_plan::{DesignClearance, PlanError};
 use nalgebra::Vector3;
@@ -18,6 +19,9 @@ pub(super) const FIT_BISECTIONS: usize = 6;
 /// the query that decides where the cutter fits (module docs, step 4).
 pub(super) struct FitQuery<'a> {
     pub(super) cutter: DesignClearance<'a>,
+    /// The whole tool (cutter, shank and holder) against the blades alone: postures keep
+    /// `fit_min` from the blades with all of it (module docs of [`super::posture`]).
+    pub(super) tool: DesignClearance<'a>,
     pub(super) shape: CutterShape,
     /// Radius of a ball end (ball or tapered ball): its centre touching the level at `p`
     /// with normal `n` is `p + r·n` whatever the axis, so a centre closer than `r + fit_min`
@@ -124,20 +128,37 @@ impl ChannelRoughing {
 }
 
 /// The lanes of a trimmed area (module docs, step 4): maximal runs `lo..hi` of consecutive
-/// grid sections with the same number of fitting intervals, each interval `k` of such a run
-/// overlapping its neighbour's in `y`, as `(lo, hi, k)`; runs of fewer than 2 sections are
-/// left out (their area counts as unmachinable). O(sections · intervals).
-pub(super) fn lanes(sections: &[Vec<(f64, f64)>]) -> Vec<(usize, usize, usize)> {
-    let joins = |a: &[(f64, f64)], b: &[(f64, f64)]| {
+/// grid sections of `field` with the same number of fitting intervals, each interval `k` of
+/// such a run joining its neighbour's, as `(lo, hi, k)`; runs of fewer than 2 sections are
+/// left out (their area counts as unmachinable). Two intervals join when they overlap in `y`,
+/// or in `y` measured from the field's left boundary, or from its right one: a band that
+/// follows a boundary sloping in the developed plane (a narrow strip beside a blade,
+/// 0.7 mm wide where the boundary moves 1 mm between sections, at the splitter nose of
+/// impeller-11+11-freeform) shifts between sections by more than its width and would
+/// otherwise break into lanes of one section. Postures and motions between the sections are
+/// certified when the lane is located, so a join never admits an uncertified cut.
+/// O(sections · intervals).
+pub(super) fn lanes(sections: &[Vec<(f64, f64)>], field: &Region) -> Vec<(usize, usize, usize)> {
+    let overlap = |a: (f64, f64), b: (f64, f64), da: f64, db: f64| {
+        a.0 - da <= b.1 - db && b.0 - db <= a.1 - da
+    };
+    let joins = |i: usize| {
+        let (a, b) = (&sections[i - 1], &sections[i]);
+        let (dl, dr) = (
+            field.left[i] - field.left[i - 1],
+            field.right[i] - field.right[i - 1],
+        );
         !a.is_empty()
             && a.len() == b.len()
-            && a.iter().zip(b).all(|(x, y)| x.0 <= y.1 && y.0 <= x.1)
+            && a.iter().zip(b).all(|(&x, &y)| {
+                overlap(x, y, 0.0, 0.0) || overlap(x, y, 0.0, dl) || overlap(x, y, 0.0, dr)
+            })
     };
     let mut out = Vec::new();
     let mut lo = 0;
     while lo < sections.len() {
         let mut hi = lo + 1;
-        while hi < sections.len() && joins(&sections[hi - 1], &sections[hi]) {
+        while hi < sections.len() && joins(hi) {
             hi += 1;
         }
         if hi - lo >= 2 {
@@ -146,4 +167,32 @@ pub(super) fn lanes(sections: &[Vec<(f64, f64)>]) -> Vec<(usize, usize, usize)> 
         lo = hi;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 0.7 mm band beside a boundary that moves 1 mm per section is one lane (it used to
+    /// break into lanes of one section, dropped), while a band that jumps across the area
+    /// between two sections is not joined to the one before.
+    #[test]
+    fn a_band_following_a_sloped_boundary_is_one_lane() {
+        let n = 6;
+        let field = Region {
+            s: (0..n).map(|i| i as f64).collect(),
+            left: (0..n).map(|i| i as f64).collect(),
+            right: (0..n).map(|i| 10.0 + i as f64).collect(),
+        };
+        let band: Vec<Vec<(f64, f64)>> = (0..n)
+            .map(|i| vec![(field.left[i] + 0.3, field.left[i] + 1.0)])
+            .collect();
+        assert_eq!(lanes(&band, &field), vec![(0, n, 0)]);
+        let mut jump = band.clone();
+        for x in jump.iter_mut().skip(3) {
+            x[0].0 += 5.0;
+            x[0].1 += 5.0;
+        }
+        assert_eq!(lanes(&jump, &field), vec![(0, 3, 0), (3, n, 0)]);
+    }
 }

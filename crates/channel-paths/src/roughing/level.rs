@@ -7,6 +7,7 @@ use super::fit::{lanes, FitQuery, FIT_SCAN_MAX_MM};
 use super::operation::ChannelRoughing;
 use super::plan2d::{self, Path2, Region};
 use super::sides::{Bound, BOUNDARY_SAMPLES};
+use super::triangle;
 use cam_core::CutterShape;
 use cam_plan::{PlanContext, PlanError};
 use impeller_model::levels::{offset_surface_on_level, DepthLevel};
@@ -34,10 +35,13 @@ pub(super) struct AreaPlan {
     pub(super) level: usize,
     /// Index of the area's [`Field`] in its level.
     pub(super) field: usize,
+    /// Triangle paths as planned (inlet → outlet; ordered and linked when located).
     pub(super) tri: Vec<Path2>,
+    /// Isoparametric baseline paths over the lane (inlet → outlet).
     pub(super) iso: Vec<Path2>,
-    pub(super) links: Vec<Path2>,
     pub(super) region: Region,
+    /// The path interval of the lane's level (mm).
+    pub(super) step: f64,
 }
 
 pub(super) struct LevelPlan {
@@ -52,6 +56,8 @@ pub(super) struct LevelPlan {
     pub(super) area_mm2: f64,
     /// Developed area of the planned lanes (mm²).
     pub(super) planned_mm2: f64,
+    /// Largest spacing of path points along the flow (mm); links are put on the level at it.
+    pub(super) spacing: f64,
 }
 
 impl ChannelRoughing {
@@ -211,25 +217,24 @@ impl ChannelRoughing {
                 sections.push(self.fit_intervals(fit, &axes, i, scan, fit_min)?);
             }
             let area_place = format!("level {j}, area {} / {}", bounds[a].label, bounds[b].label);
-            for (lo, hi, lane) in lanes(&sections) {
+            for (lo, hi, lane) in lanes(&sections, &field.region) {
                 let region = Region {
                     s: field.region.s[lo..hi].to_vec(),
                     left: sections[lo..hi].iter().map(|x| x[lane].0).collect(),
                     right: sections[lo..hi].iter().map(|x| x[lane].1).collect(),
                 };
                 planned_mm2 += trapezoid(&region.s, |i| region.right[i] - region.left[i]);
-                let tri = plan2d::triangle(&region, step)
+                let tri = triangle::triangle(&region, step)
                     .map_err(|e| self.geo(&area_place, e.to_string()))?;
                 let iso = plan2d::isoparametric(&region, step)
                     .map_err(|e| self.geo(&area_place, e.to_string()))?;
-                let (tri, links) = plan2d::link(tri, self.params.linking);
                 areas.push(AreaPlan {
                     level: j,
                     field: fields.len(),
                     tri,
                     iso,
-                    links,
                     region,
+                    step,
                 });
             }
             fields.push(field);
@@ -270,6 +275,7 @@ impl ChannelRoughing {
             channel_iso,
             area_mm2,
             planned_mm2,
+            spacing,
         })
     }
 }

@@ -19,14 +19,17 @@
 
 mod axes;
 mod fit;
+mod joins;
 mod level;
 mod locate;
 pub mod operation;
+pub mod ordering;
 pub mod plan2d;
 mod plot;
 mod posture;
 mod scallop;
 mod sides;
+pub mod triangle;
 
 pub use operation::{
     build_channel_roughing, ChannelRoughing, ChannelRoughingParams, CHANNEL_ROUGHING,

@@ -99,10 +99,11 @@
 //! checks in the worst case. Levels run in parallel (rayon).
 
 use super::fit::FitQuery;
+use super::joins::{self, LevelChunks};
 use super::level::LevelPlan;
-use super::locate::LevelCl;
-use super::plan2d::Linking;
-use cam_core::{CutterLocation, CutterShape, ToolPath};
+use super::locate::{LevelCl, Locator};
+use super::ordering::Linking;
+use cam_core::{CutterShape, ToolPath};
 use cam_plan::{
     ClearanceOptions, DesignClearance, Metrics, Operation, OperationSpec, PartSet, PlanContext,
     PlanError, PlannedOperation,
@@ -150,6 +151,10 @@ pub struct ChannelRoughingParams {
     /// Points averaged when smoothing the axes along a path (1 = none).
     #[serde(default = "default_smoothing")]
     pub axis_smoothing: usize,
+    /// Feed (mm/min) of the retracts that cut nothing (module docs of `joins`); default: the
+    /// process row's `rapid_mm_per_min`.
+    #[serde(default)]
+    pub link_feed_mm_per_min: Option<f64>,
 }
 
 /// The operation.
@@ -175,6 +180,16 @@ pub fn build_channel_roughing(spec: &OperationSpec) -> Result<Box<dyn Operation>
             &spec.name,
             "max_tilt_deg",
             "must be in [0, 90)",
+        ));
+    }
+    if params
+        .link_feed_mm_per_min
+        .is_some_and(|f| !(f.is_finite() && f > 0.0))
+    {
+        return Err(PlanError::param(
+            &spec.name,
+            "link_feed_mm_per_min",
+            "must be finite and > 0",
         ));
     }
     if params.axis_smoothing == 0 {
@@ -291,7 +306,16 @@ impl ChannelRoughing {
         let mut cutter_tool = ctx.tool.clone();
         cutter_tool.cutter.overall_length = cutter_tool.cutter.flute_length;
         cutter_tool.cutter.holder.clear();
+        let blades_only = ctx.clearance.with_options(ClearanceOptions {
+            parts: PartSet {
+                hub: false,
+                blades: true,
+                shroud: false,
+            },
+            ..ClearanceOptions::default()
+        });
         let fit = FitQuery {
+            tool: blades_only.clone(),
             cutter: DesignClearance::with_mesh(
                 imp,
                 ctx.clearance.mesh().clone(),
@@ -314,14 +338,14 @@ impl ChannelRoughing {
             },
         };
         let fit_min = ctx.process.blade_allowance_mm - 0.5 * ctx.tolerances.machining_tol;
-        let blades_only = ctx.clearance.with_options(ClearanceOptions {
-            parts: PartSet {
-                hub: false,
-                blades: true,
-                shroud: false,
-            },
-            ..ClearanceOptions::default()
-        });
+        let loc = Locator {
+            op: self,
+            ctx,
+            fit: &fit,
+            fit_min,
+            doc,
+            blades_only: &blades_only,
+        };
         // Each level planned, located and measured; a level whose measured scallop exceeds
         // the target is planned again with its path interval narrowed (module docs, step 3).
         let target = self.params.scallop_mm;
@@ -342,8 +366,7 @@ impl ChannelRoughing {
                 let mut replans = 0;
                 loop {
                     let lp = self.plan_level(ctx, j, level, bounds, &fit, fit_min, scale)?;
-                    let lc =
-                        self.locate_level(ctx, &lp, &lp.bounds, &blades_only, &fit, fit_min, doc)?;
+                    let lc = self.locate_level(&loc, &lp, &lp.bounds)?;
                     if lc.max_scallop <= target || replans == SCALLOP_REPLANS {
                         return Ok((lp, lc, replans));
                     }
@@ -364,88 +387,99 @@ impl ChannelRoughing {
             replanned_levels += usize::from(replans > 0);
         }
 
-        // One channel's path, levels shroud → hub, areas in order, linked over the safety
-        // surface between areas.
-        let mut path = ToolPath::new(self.name.clone(), self.tool.clone());
-        let mut last: Option<CutterLocation> = None;
-        let mut tri_len = 0.0;
-        let mut iso_len = 0.0;
-        let mut channel_iso_len = 0.0;
-        let mut min_clear = f64::INFINITY;
-        let mut max_scallop: f64 = 0.0;
-        let mut n_paths = 0usize;
-        let mut skipped_cutter = 0usize;
-        let mut skipped_tool = 0usize;
-        let mut split = 0usize;
-        let mut bridged = 0usize;
+        // One channel's path: the chunks of every level joined, levels shroud → hub (module
+        // docs of `joins`).
+        let mut sum = Sums {
+            min_clear: f64::INFINITY,
+            ..Sums::default()
+        };
+        for lc in &per_level {
+            sum.add(lc);
+        }
         let area_mm2: f64 = levels.iter().map(|l| l.area_mm2).sum();
         let planned_mm2: f64 = levels.iter().map(|l| l.planned_mm2).sum();
-        // The most any paths spaced like the triangle paths can save against the lanes'
-        // isoparametric baseline (module docs): Σ ∫w ds over Σ w_max·L of every lane.
-        let (width_area, box_area) = levels
+        let chunks: Vec<LevelChunks> = levels
             .iter()
-            .flat_map(|l| &l.areas)
-            .map(|a| {
-                let r = &a.region;
-                let len = r.s.last().zip(r.s.first()).map_or(0.0, |(b, a)| b - a);
-                (r.width_integral(), r.max_width().max(0.0) * len)
+            .zip(&per_level)
+            .map(|(lp, lc)| LevelChunks {
+                chunks: lc.chunks.clone(),
+                step: lp
+                    .areas
+                    .iter()
+                    .map(|a| a.step)
+                    .fold(f64::INFINITY, f64::min),
             })
-            .fold((0.0, 0.0), |(x, y), (a, b)| (x + a, y + b));
-        for lc in &per_level {
-            tri_len += lc.tri_len;
-            iso_len += lc.iso_len;
-            channel_iso_len += lc.channel_iso_len;
-            min_clear = min_clear.min(lc.min_blade_clearance);
-            max_scallop = max_scallop.max(lc.max_scallop);
-            n_paths += lc.paths;
-            skipped_cutter += lc.skipped_cutter;
-            skipped_tool += lc.skipped_tool;
-            split += lc.split_motions;
-            bridged += lc.bridge_postures;
-            for area in &lc.moves {
-                let Some(first) = area.first() else { continue };
-                if let Some(prev) = last {
-                    path.moves.extend(ctx.link(&prev, &first.cl, doc)?);
-                    path.moves.extend(area.iter().skip(1).copied());
-                } else {
-                    path.moves.extend(area.iter().copied());
-                }
-                last = area.last().map(|m| m.cl);
-            }
-        }
+            .collect();
+        let joined = joins::join(ctx, &chunks, doc, self.params.linking == Linking::ZigZag)?;
+        let mut path = ToolPath::new(self.name.clone(), self.tool.clone());
+        path.moves = joined.moves;
         ctx.close(&mut path, doc)?;
+        let link_feed = self
+            .params
+            .link_feed_mm_per_min
+            .unwrap_or(ctx.process.rapid_mm_per_min);
+        let (fast_retracts, slow_retracts) = joins::retract_feeds(ctx, &mut path.moves, link_feed);
         let count = imp.main().count();
         let order = cam_plan::order::angular_sequence(count, 0);
         let paths = cam_plan::pattern::copy_to(&path, imp.main().pitch_rad(), &order);
         let k = count as f64;
         let mut metrics = Metrics::new();
         metrics
-            .number("triangle_path_length_mm", tri_len * k)
-            .number("isoparametric_path_length_mm", iso_len * k)
-            .number("saving_ratio", saving(tri_len, iso_len))
-            .number("isoparametric_channel_path_length_mm", channel_iso_len * k)
+            .number("triangle_path_length_mm", sum.tri_len * k)
+            .number("isoparametric_path_length_mm", sum.iso_len * k)
+            .number("saving_ratio", saving(sum.tri_len, sum.iso_len))
+            .number(
+                "saving_ratio_count_bound",
+                saving(sum.count_len, sum.baseline_count_len),
+            )
+            .number(
+                "saving_ratio_with_links",
+                saving(sum.lane_feed_len, sum.iso_lane_feed_len),
+            )
+            .number("lane_feed_length_mm", sum.lane_feed_len * k)
+            .number(
+                "isoparametric_lane_feed_length_mm",
+                sum.iso_lane_feed_len * k,
+            )
+            .number(
+                "isoparametric_channel_path_length_mm",
+                sum.channel_iso_len * k,
+            )
             .number(
                 "saving_ratio_whole_channel",
-                saving(tri_len, channel_iso_len),
+                saving(sum.tri_len, sum.channel_iso_len),
             )
-            .number("saving_ratio_width_bound", saving(width_area, box_area))
-            .number("max_scallop_mm", max_scallop)
+            .number("in_lane_link_length_mm", sum.lane_link_len * k)
+            .number("level_link_length_mm", sum.level_link_len * k)
+            .count("in_lane_links", sum.lane_links * count)
+            .count("in_lane_breaks", sum.lane_breaks * count)
+            .count("retracts_per_channel", joined.retracts + 1)
+            .count("level_links_per_channel", sum.level_links)
+            .count("step_downs_per_channel", joined.step_downs)
+            .count("retracts_at_link_feed", fast_retracts * count)
+            .count("retracts_at_cutting_feed", slow_retracts * count)
+            .count("dropped_short_pieces", sum.dropped * count)
+            .count("kept_short_pieces", sum.short_kept * count)
+            .number("max_scallop_mm", sum.max_scallop)
             .number("scallop_target_mm", self.params.scallop_mm)
             .count("scallop_replanned_levels", replanned_levels)
             .count("levels", n_levels)
-            .count("paths", n_paths * count)
-            .number("min_blade_clearance_mm", min_clear)
+            .count("paths", sum.paths * count)
+            .number("min_blade_clearance_mm", sum.min_clear)
             .number("level_area_mm2", area_mm2 * k)
             .number(
                 "unmachinable_area_mm2",
                 (area_mm2 - planned_mm2).max(0.0) * k,
             )
-            .count("skipped_locations", (skipped_cutter + skipped_tool) * count)
-            .count("skipped_cutter_blocked", skipped_cutter * count)
-            .count("skipped_shank_or_holder", skipped_tool * count)
-            .count("split_motions", split * count)
-            .count("bridge_postures", bridged * count);
-        let plots = self.plot(&levels);
+            .count(
+                "skipped_locations",
+                (sum.skipped_cutter + sum.skipped_tool) * count,
+            )
+            .count("skipped_cutter_blocked", sum.skipped_cutter * count)
+            .count("skipped_shank_or_holder", sum.skipped_tool * count)
+            .count("split_motions", sum.split * count)
+            .count("bridge_postures", sum.bridged * count);
+        let plots = self.plot(&levels, &per_level);
         let offsets = levels
             .iter()
             .flat_map(|l| l.bounds.iter().map(|b| b.offset.abs()))
@@ -456,19 +490,90 @@ impl ChannelRoughing {
             paths,
             metrics,
             plots,
-            notes: vec![format!(
-                "{n_levels} levels of ≤ {doc} mm; {} bounding sides per level (ruled over \
-                 each level's span band, offset {:.3}–{:.3} mm); the cutter does not fit with \
-                 {:.3} mm from the blades on {:.0} of {:.0} mm² of the levels (all channels), \
-                 left unplanned",
-                levels.first().map_or(0, |l| l.bounds.len()),
-                offsets.0,
-                offsets.1,
-                fit_min,
-                (area_mm2 - planned_mm2).max(0.0) * k,
-                area_mm2 * k,
-            )],
+            notes: vec![
+                format!(
+                    "{n_levels} levels of ≤ {doc} mm; {} bounding sides per level (ruled over \
+                     each level's span band, offset {:.3}–{:.3} mm); the cutter does not fit \
+                     with {:.3} mm from the blades on {:.0} of {:.0} mm² of the levels (all \
+                     channels), left unplanned",
+                    levels.first().map_or(0, |l| l.bounds.len()),
+                    offsets.0,
+                    offsets.1,
+                    fit_min,
+                    (area_mm2 - planned_mm2).max(0.0) * k,
+                    area_mm2 * k,
+                ),
+                format!(
+                    "links: per channel {} links between paths on the level at the cutting \
+                     feed (they may cut: they cross the lane at the level), {} joins between \
+                     lanes on a level at the cutting feed and {} step downs to the next level \
+                     at the plunge feed (each certified clear of the design by the roughing \
+                     allowance); {} retracts over the safety surface, of which {} along the \
+                     tool axis clear of the blank at {:.0} mm/min (they cut nothing) and {} at \
+                     the cutting feed; approaches rapid down to the blank, then at the plunge \
+                     feed",
+                    sum.lane_links,
+                    sum.level_links,
+                    joined.step_downs,
+                    joined.retracts + 1,
+                    fast_retracts,
+                    link_feed,
+                    slow_retracts,
+                ),
+            ],
         })
+    }
+}
+
+/// The level measurements summed over the levels of one channel.
+#[derive(Debug, Default)]
+struct Sums {
+    tri_len: f64,
+    iso_len: f64,
+    channel_iso_len: f64,
+    lane_feed_len: f64,
+    iso_lane_feed_len: f64,
+    count_len: f64,
+    baseline_count_len: f64,
+    lane_link_len: f64,
+    lane_links: usize,
+    lane_breaks: usize,
+    level_links: usize,
+    level_link_len: f64,
+    dropped: usize,
+    short_kept: usize,
+    min_clear: f64,
+    max_scallop: f64,
+    paths: usize,
+    skipped_cutter: usize,
+    skipped_tool: usize,
+    split: usize,
+    bridged: usize,
+}
+
+impl Sums {
+    fn add(&mut self, lc: &LevelCl) {
+        self.tri_len += lc.tri_len;
+        self.iso_len += lc.iso_len;
+        self.channel_iso_len += lc.channel_iso_len;
+        self.lane_feed_len += lc.lane_feed_len;
+        self.iso_lane_feed_len += lc.iso_lane_feed_len;
+        self.count_len += lc.count_len;
+        self.baseline_count_len += lc.baseline_count_len;
+        self.lane_link_len += lc.lane_link_len;
+        self.lane_links += lc.lane_links;
+        self.lane_breaks += lc.lane_breaks;
+        self.level_links += lc.level_links;
+        self.level_link_len += lc.level_link_len;
+        self.dropped += lc.dropped_pieces;
+        self.short_kept += lc.short_pieces_kept;
+        self.min_clear = self.min_clear.min(lc.min_blade_clearance);
+        self.max_scallop = self.max_scallop.max(lc.max_scallop);
+        self.paths += lc.paths;
+        self.skipped_cutter += lc.skipped_cutter;
+        self.skipped_tool += lc.skipped_tool;
+        self.split += lc.split_motions;
+        self.bridged += lc.bridge_postures;
     }
 }
 
