@@ -35,7 +35,7 @@ impl FitQuery<'_> {
     pub(super) fn ball_fits(&self, p: &Vector3<f64>, n: &Vector3<f64>, fit_min: f64) -> bool {
         self.ball.is_none_or(|r| {
             let c = cam_plan::Point3::from(p + n * r);
-            self.cutter.blade_signed_distance(&c).0 - r >= fit_min
+            self.cutter.blade_distance_at_least(&c, r + fit_min)
         })
     }
 }

@@ -12,8 +12,12 @@ use cam_core::CutterShape;
 use cam_plan::{PlanContext, PlanError};
 use impeller_model::levels::{offset_surface_on_level, DepthLevel};
 
-/// Largest spacing of path points along the flow (mm) when the chord rule allows more.
-pub(super) const MAX_POINT_SPACING_MM: f64 = 1.0;
+/// Largest spacing of path points (and of the grid sections where the cutter's fit is
+/// sampled) along the flow, in radii of the cutter's end (ball or tool radius), when the
+/// chord rule allows more: 1 mm for the fixtures' R1.5 ends, as it was, 2 mm for an R3 end
+/// on a design twice that size (the NASA HECC impeller's channels), where 1 mm points only
+/// doubled the postures and motion checks of the same cut.
+pub(super) const MAX_POINT_SPACING_RADII: f64 = 2.0 / 3.0;
 
 /// Boundary of an area on one level, tabulated on the area's s grid.
 pub(super) struct Tab {
@@ -155,7 +159,7 @@ impl ChannelRoughing {
         let step = self.interval(ctx, &level)? * step_scale;
         let spacing = (8.0 * min_radius(&level) * ctx.tolerances.chord_tol)
             .sqrt()
-            .min(MAX_POINT_SPACING_MM);
+            .min(MAX_POINT_SPACING_RADII * end_radius(&ctx.tool.cutter.shape));
         // Areas (paper 003): without splitter one; with, upstream of its leading edge and
         // the two sub-channels.
         let s_lo = curves[0][0].0.max(curves[1][0].0);
@@ -286,6 +290,20 @@ pub(super) fn unreachable_shape() -> Result<f64, cam_core::ContactError> {
         value: f64::NAN,
         reason: "channel roughing needs a ball-end, tapered ball-end or bull-nose cutter",
     })
+}
+
+/// The radius of the cutter's end: the ball's for ball and tapered ball ends, the tool's for
+/// a bull nose.
+pub(super) fn end_radius(shape: &CutterShape) -> f64 {
+    match *shape {
+        CutterShape::BallEnd { radius }
+        | CutterShape::BullNose { radius, .. }
+        | CutterShape::TaperedBallEnd {
+            ball_radius: radius,
+            ..
+        } => radius,
+        _ => 0.0,
+    }
 }
 
 pub(super) fn min_radius(level: &DepthLevel) -> f64 {

@@ -27,6 +27,32 @@ use cam_plan::{DesignClearance, PlanContext, PlanError};
 use impeller_model::levels::DepthLevel;
 use nalgebra::Vector3;
 
+/// Largest turn (rad) of the first axis tried from one path point's posture to the next's.
+pub(super) const AXIS_RATE_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
+
+/// `a` turned toward `b` (unit vectors) by at most `max` (rad), on their great circle.
+fn turned_toward(a: &Vector3<f64>, b: &Vector3<f64>, max: f64) -> Vector3<f64> {
+    let angle = a.dot(b).clamp(-1.0, 1.0).acos();
+    if angle <= max {
+        return *b;
+    }
+    let perp = b - a * a.dot(b);
+    match perp.try_normalize(1e-12) {
+        Some(e) => a * max.cos() + e * max.sin(),
+        None => *b,
+    }
+}
+
+/// The blade clearance metric is exact up to this far (mm) above the blade allowance kept
+/// (`fit_min`) and reads this value beyond it (a lower bound). Capped as the posture checks
+/// ask, the query bounds a tool sample by the blade side meshes where they are farther than
+/// the cap; uncapped, it takes the exact blade distance everywhere, which above the shroud
+/// beyond a blade's corner is the shroud distance (`impeller_model::query::blade_solid_distance`
+/// bounds the clipped solid by `max(d_p, d_s, d_shroud)` there) and read a cutter flank 3.4 mm
+/// from both blade sides, 1.75 mm above the shroud at the trailing edge, as 0.06 mm inside
+/// the blade (impeller-11+11-freeform, `min_blade_clearance_mm = −0.058` before).
+pub(super) const BLADE_METRIC_BAND_MM: f64 = 1.0;
+
 /// A located piece of a planned path shorter than this many path intervals (in the plane)
 /// is dropped when the level's scallop stays within the target without it (module docs).
 pub(super) const SHORT_PIECE_INTERVALS: f64 = 2.0;
@@ -138,12 +164,22 @@ impl Locator<'_> {
             .collect();
         let smooth = smooth_axes(&raw, self.op.params.axis_smoothing);
         let mut found: Vec<Option<Posture>> = Vec::with_capacity(path.len());
+        let mut prev: Option<Vector3<f64>> = None;
         for (&q, a) in path.iter().zip(&smooth) {
+            // The axis follows the smoothed one from the previous posture's, turning at most
+            // AXIS_RATE_RAD per point (a fallback axis is left gradually, not at once).
+            let first = match prev {
+                Some(p) => turned_toward(&p, a, AXIS_RATE_RAD),
+                None => *a,
+            };
             match self
                 .op
-                .posture(self.ctx, self.fit, self.fit_min, axes, q, Some(*a))?
+                .posture(self.ctx, self.fit, self.fit_min, axes, q, Some(first))?
             {
-                Ok(p) => found.push(Some(p)),
+                Ok(p) => {
+                    prev = Some(p.0.axis.into_inner());
+                    found.push(Some(p))
+                }
                 Err(why) => {
                     // No certified posture: the point is left uncut (the path is split
                     // there; the measured scallop shows the residue).
@@ -151,6 +187,7 @@ impl Locator<'_> {
                         Blocked::Cutter => out.skipped_cutter += 1,
                         Blocked::ShankOrHolder => out.skipped_tool += 1,
                     }
+                    prev = None;
                     found.push(None);
                 }
             }
@@ -509,10 +546,14 @@ impl ChannelRoughing {
                 out.tri_len += polyline_len(r.postures.iter().map(|p| p.0.tip.coords));
                 for (cl, c) in &r.postures {
                     // The nearest part is a blade: that is the blade clearance; otherwise
-                    // ask the blades alone.
+                    // the blades alone, asked as the posture was certified (exact below
+                    // the cap, [`BLADE_METRIC_BAND_MM`] above the allowance kept).
                     let blade_clear = match c.design_part {
                         cam_plan::DesignPart::Blade { .. } => c.distance_mm,
-                        _ => loc.blades_only.clearance(cl).distance_mm,
+                        _ => {
+                            let cap = loc.fit_min + BLADE_METRIC_BAND_MM;
+                            loc.blades_only.clearance_capped(cl, cap).distance_mm
+                        }
                     };
                     out.min_blade_clearance = out.min_blade_clearance.min(blade_clear);
                 }

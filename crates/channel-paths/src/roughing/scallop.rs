@@ -55,15 +55,7 @@ impl ScallopProbe {
         runs: &[Vec<CutterLocation>],
         cap: f64,
     ) -> Self {
-        let reach = match *shape {
-            CutterShape::BallEnd { radius }
-            | CutterShape::BullNose { radius, .. }
-            | CutterShape::TaperedBallEnd {
-                ball_radius: radius,
-                ..
-            } => radius,
-            _ => 0.0,
-        };
+        let reach = super::level::end_radius(shape);
         // Densify consecutive locations to `reach / SCALLOP_DENSIFY`: the union of discrete
         // cutters under-reads the swept one between them, so that a point at lateral distance
         // `d` from the path is reached only as if `√(d² + (a/2)²)` away for spacing `a`. At a
