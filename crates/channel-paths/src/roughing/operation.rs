@@ -80,17 +80,21 @@
 //! blades' offset sides from inlet to outlet, as many as the channel's widest section needs,
 //! kept where they run inside a planned lane, [`plan2d::clip_to_regions`]; with a splitter
 //! it differs from the per-lane baseline both ways: denser upstream of the splitter, none
-//! where a path runs into the splitter or an unmachinable strip), `saving_ratio_width_bound`
-//! (what the lanes' shape allows: paths at a constant interval `d` are as many at a section as
-//! its width `w(s)` needs, `∫ w ds / d` in length, while the baseline runs `w_max / d` paths
-//! the whole length `L` of the lane, so no such path set saves more than
-//! `1 − Σ ∫ w ds / Σ w_max·L` over the lanes, up to the rounding of path counts and the
-//! paths' slant; a lane that narrows little toward the inlet leaves little to save),
+//! where a path runs into the splitter or an unmachinable strip), `saving_ratio_count_bound`
+//! (what the lanes' shape allows: paths at a constant interval `d` are `⌈w/d⌉ + 1` at a
+//! section of width `w(s)`, the two boundary paths included, while the baseline runs
+//! `⌈w_max/d⌉ + 1` paths the whole length `L` of the lane, so no such path set saves more than
+//! `1 − Σ ∫ (⌈w/d⌉ + 1) ds / Σ (⌈w_max/d⌉ + 1)·L` over the lanes, up to the paths' slant; a
+//! lane that narrows little toward the inlet leaves little to save), `saving_ratio_with_links`
+//! (the in-lane feed with the links between paths against the baseline planned, ordered and
+//! linked by the same code; see [`super::ordering`] and [`super::locate`]),
 //! `max_scallop_mm` (measured over the machinable region: rays along the level normal from a
 //! grid of points of every lane to the first cutter position of the level, the cutters taken
 //! at the emitted locations of every lane of the level densified to a sixteenth of the ball
-//! radius along each cut, within 0.002 mm of the swept cutter at 0.5 mm scallops), `levels`, `paths`, `min_blade_clearance_mm` (clearance query against the true
-//! blades), `level_area_mm2` and `unmachinable_area_mm2` (developed areas over all levels and
+//! radius along each cut, within 0.002 mm of the swept cutter at 0.5 mm scallops), `levels`,
+//! `paths`, `min_blade_clearance_mm` (the whole tool against the blades alone, asked as the
+//! postures are certified: exact up to [`super::locate::BLADE_METRIC_BAND_MM`] above the
+//! allowance), `level_area_mm2` and `unmachinable_area_mm2` (developed areas over all levels and
 //! channels, trapezoidal on the area grids), the skip, split and bridge counts above.
 //!
 //! Cost: per level O(sections · (width / scan + 12) · candidates) cutter queries for the fit
