@@ -117,13 +117,22 @@ pub(super) struct LevelCl {
 
 /// A located piece of a planned path: consecutive postures joined by certified motions, with
 /// their planar points.
-#[derive(Clone)]
+#[derive(Clone, Default)]
 struct Run {
     q: Path2,
     postures: Vec<Posture>,
 }
 
 impl Run {
+    /// Ends the run at a gap: kept in `runs` when it holds a motion (two postures or more),
+    /// else dropped; `self` starts empty.
+    fn end_into(&mut self, runs: &mut Vec<Run>) {
+        let run = std::mem::take(self);
+        if run.postures.len() >= 2 {
+            runs.push(run);
+        }
+    }
+
     fn reversed(&self) -> Self {
         Self {
             q: self.q.iter().rev().copied().collect(),
@@ -196,25 +205,11 @@ impl Locator<'_> {
         // between them), through planned intermediate postures where needed; when that fails
         // the path is split there.
         let mut runs: Vec<Run> = Vec::new();
-        let mut cur = Run {
-            q: Vec::new(),
-            postures: Vec::new(),
-        };
+        let mut cur = Run::default();
         let mut mids: Vec<([f64; 2], Posture)> = Vec::new();
         for k in 0..found.len() {
             let Some(b) = found[k] else {
-                if cur.postures.len() >= 2 {
-                    runs.push(std::mem::replace(
-                        &mut cur,
-                        Run {
-                            q: Vec::new(),
-                            postures: Vec::new(),
-                        },
-                    ));
-                } else {
-                    cur.q.clear();
-                    cur.postures.clear();
-                }
+                cur.end_into(&mut runs);
                 continue;
             };
             if let (Some(a), Some(&qa)) = (cur.postures.last().copied(), cur.q.last()) {
@@ -238,18 +233,7 @@ impl Locator<'_> {
                     }
                 } else {
                     out.split_motions += 1;
-                    if cur.postures.len() >= 2 {
-                        runs.push(std::mem::replace(
-                            &mut cur,
-                            Run {
-                                q: Vec::new(),
-                                postures: Vec::new(),
-                            },
-                        ));
-                    } else {
-                        cur.q.clear();
-                        cur.postures.clear();
-                    }
+                    cur.end_into(&mut runs);
                 }
             }
             cur.q.push(path[k]);
