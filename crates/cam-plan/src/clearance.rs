@@ -1038,6 +1038,13 @@ impl<'a> DesignClearance<'a> {
         self.blade_signed_distance_below(p, f64::INFINITY).0
     }
 
+    /// Whether the nearest blade is at least `d` from `p`: [`Self::blade_signed_distance`]
+    /// `≥ d`, with the instances the blade meshes keep farther than `d` left unprojected (the
+    /// same answer for the cost of the mesh bounds wherever no blade comes near).
+    pub fn blade_distance_at_least(&self, p: &Point3, d: f64) -> bool {
+        self.blade_signed_distance_below(p, d).0 .0 >= d
+    }
+
     /// [`Self::blade_signed_distance`] where only distances below `floor` matter. The
     /// candidate instances are projected on nearest in polar angle first; an instance whose
     /// whole-sides mesh (turned into the reference blade's frame) keeps `p` at least
@@ -1224,17 +1231,22 @@ impl<'a> DesignClearance<'a> {
     ///
     /// The lever arm is split by tool part: the shank and holder (with the shroud samples
     /// above the flutes) reach `R`, the cutter samples only `R_f` (highest sample plus the
-    /// widest sample radius), typically a fifth of `R`. The upper parts are checked first
-    /// over the whole motion: when both ends keep them `floor + D_u/2` clear
-    /// (`D_u = |Δtip| + θ·R`), the bound `(c₀ + c₁ − D_u)/2 ≥ floor` holds for them on `[0, 1]`,
-    /// and the bisection measures the cutter alone with `D_f = |Δtip| + θ·R_f` (the ends'
-    /// whole-tool clearances bound the cutter's from below). Otherwise the whole tool is
-    /// bisected with `D_u`, as above.
+    /// widest sample radius), typically a fifth of `R`. The upper parts are measured first at
+    /// both ends (capped where they settle the whole motion): when both keep them
+    /// `floor + D_u/2` clear (`D_u = |Δtip| + θ·R`), the bound `(u₀ + u₁ − D_u)/2 ≥ floor` holds
+    /// for them on `[0, 1]`. Otherwise the upper parts are bisected on their own, from their
+    /// end clearances `u₀, u₁` with `D_u`, each midpoint measuring only them (frusta against
+    /// the meshes: no blade projection). The cutter is bisected on its own with
+    /// `D_f = |Δtip| + θ·R_f` from the ends' whole-tool clearances (which bound the cutter's
+    /// from below). The whole tool is clear where both parts are, so the two bisections
+    /// certify the motion as one bisection of the whole tool with `D_u` would, with fewer
+    /// and cheaper queries: a cutter running beside a blade no longer pays for the holder's
+    /// lever arm.
     ///
     /// Cost: 2 queries when the ends are clear by more than `D/2`; about
     /// `log₂(D/tol_mm)` more per place where the motion comes within `D/2` of the design,
     /// at most `max_queries` (then the motion counts as not clear, at the last midpoint);
-    /// two capped shank/holder queries more when the cutter's `D_f` is the one bisected.
+    /// two capped shank/holder queries more when the whole tool does not settle at once.
     pub fn segment_clearance(
         &self,
         a: &CutterLocation,
@@ -1277,51 +1289,118 @@ impl<'a> DesignClearance<'a> {
         let floor = min_clearance_mm - tol_mm.max(0.0);
         let (shift, turn) = ((b.tip - a.tip).norm(), a.axis.angle(&b.axis));
         let whole = shift + turn * self.reach_mm;
-        // The shank and holder over the whole motion: clear when both ends keep them
-        // `floor + whole/2` away; then only the cutter samples are bisected, with their own
-        // lever arm.
-        let upper_clear = 0.5 * (ca + cb - whole) < floor && {
-            let need = floor + 0.5 * whole;
+        if 0.5 * (ca + cb - whole) >= floor {
+            return Ok(());
+        }
+        // The upper parts at both ends, exact below `need` (where they settle on [0, 1]).
+        let need = floor + 0.5 * whole;
+        let upper_at = |cl: &CutterLocation, c: f64| {
+            let mut best = NO_CLEARANCE;
             let only_upper = Want {
                 cap: need,
-                fail_below: need,
+                fail_below: f64::NEG_INFINITY,
                 upper: true,
             };
-            [a, b].iter().all(|cl| {
-                let mut best = NO_CLEARANCE;
-                !self.upper_and_frusta(cl, only_upper, &mut best) && best.distance_mm >= need
-            })
+            self.upper_and_frusta(cl, only_upper, &mut best);
+            // The whole tool's clearance bounds the upper parts' from below too.
+            best.distance_mm.min(need).max(c)
         };
-        let (span, upper) = if upper_clear {
-            (shift + turn * self.flute_reach_mm, false)
-        } else {
-            (whole, true)
-        };
-        let mut stack = vec![(0.0, ca, 1.0, cb)];
+        let (ua, ub) = (upper_at(a, ca), upper_at(b, cb));
         let mut queries = 0;
+        if ua < need || ub < need {
+            // The upper parts bisected on their own with the holder's lever arm.
+            self.bisect(
+                (ua, ub),
+                whole,
+                floor,
+                min_clearance_mm,
+                (max_queries, &mut queries),
+                |s, cap| {
+                    let mut best = NO_CLEARANCE;
+                    let want = Want {
+                        cap,
+                        fail_below: min_clearance_mm,
+                        upper: true,
+                    };
+                    self.upper_and_frusta(&at(s), want, &mut best);
+                    best.distance_mm.min(cap)
+                },
+            )?;
+        }
+        // The cutter with its own lever arm, from its own clearances at the ends when the
+        // whole tool's (the upper parts' where they are the nearer) do not settle it: exact
+        // below `floor + D_f/2`, where it settles on [0, 1].
+        let flute = shift + turn * self.flute_reach_mm;
+        let (ka, kb) = if 0.5 * (ca + cb - flute) >= floor {
+            (ca, cb)
+        } else {
+            let settle = floor + 0.5 * flute;
+            let cutter_at = |cl: &CutterLocation, c: f64| {
+                if c >= settle {
+                    return c;
+                }
+                self.evaluate(
+                    cl,
+                    Want {
+                        cap: settle,
+                        fail_below: f64::NEG_INFINITY,
+                        upper: false,
+                    },
+                )
+                .distance_mm
+                .max(c)
+            };
+            (cutter_at(a, ca), cutter_at(b, cb))
+        };
+        self.bisect(
+            (ka, kb),
+            flute,
+            floor,
+            min_clearance_mm,
+            (max_queries, &mut queries),
+            |s, cap| {
+                self.evaluate(
+                    &at(s),
+                    Want {
+                        cap,
+                        fail_below: min_clearance_mm,
+                        upper: false,
+                    },
+                )
+                .distance_mm
+            },
+        )
+    }
+
+    /// Certified bisection of one part's clearance over `s ∈ [0, 1]` (see
+    /// [`Self::segment_clearance_between`]): end values `(c0, c1)`, displacement `span` over
+    /// the whole motion, accepted where `(c₀ + c₁ − span·Δs)/2 ≥ floor`; `measure(s, cap)`
+    /// gives the part's clearance at `s`, exact below `cap`. `Err(s)` at a midpoint below
+    /// `min_clearance` or when the shared query budget `(max, used)` runs out.
+    fn bisect(
+        &self,
+        (c0, c1): (f64, f64),
+        span: f64,
+        floor: f64,
+        min_clearance: f64,
+        (max_queries, queries): (usize, &mut usize),
+        measure: impl Fn(f64, f64) -> f64,
+    ) -> Result<(), f64> {
+        let mut stack = vec![(0.0, c0, 1.0, c1)];
         while let Some((s0, c0, s1, c1)) = stack.pop() {
             if 0.5 * (c0 + c1 - span * (s1 - s0)) >= floor {
                 continue;
             }
             let sm = 0.5 * (s0 + s1);
-            if queries >= max_queries {
+            if *queries >= max_queries {
                 return Err(sm);
             }
             // The midpoint's clearance matters only up to the value that settles both
             // halves; above it, that value itself is the bound the halves need.
             let settle = 2.0 * floor - c0.min(c1) + 0.5 * span * (s1 - s0);
-            let cm = self
-                .evaluate(
-                    &at(sm),
-                    Want {
-                        cap: settle.max(min_clearance_mm),
-                        fail_below: min_clearance_mm,
-                        upper,
-                    },
-                )
-                .distance_mm;
-            queries += 1;
-            if cm < min_clearance_mm {
+            let cm = measure(sm, settle.max(min_clearance));
+            *queries += 1;
+            if cm < min_clearance {
                 return Err(sm);
             }
             stack.push((sm, cm, s1, c1));

@@ -461,6 +461,41 @@ impl Linker {
         d
     }
 
+    /// Whether a retract from `from` to `to` along `from`'s tool axis (the tool keeping its
+    /// axis) sweeps no stock, for a tool whose radius never shrinks from the tip up
+    /// (`profile = (h_top, r_top)` from [`widening_profile`]). Moved by `t` along its own
+    /// axis, such a tool covers nothing its start posture does not, except the cylinder of
+    /// radius `r_top` from `h_top` to `h_top + t` above the tip (the argument of
+    /// [`Linker::exit_direction`]); the start posture's own volume holds no stock where the
+    /// tool was just cutting. So the retract cuts nothing when that cylinder lies outside the
+    /// blank: its axis is probed every 1 mm, and each probe must keep `r_top + 1 mm` from the
+    /// blank's bounding capped cylinder (above its top or beyond its largest radius). `false`
+    /// without a blank, or when `to` is not along the axis. O(t) tests.
+    pub fn retract_sweeps_no_stock(
+        &self,
+        from: &CutterLocation,
+        to: &Point3,
+        (h_top, r_top): (f64, f64),
+    ) -> bool {
+        let Some(blank) = &self.blank else {
+            return false;
+        };
+        let a = from.axis.into_inner();
+        let d = to - from.tip;
+        let t = d.dot(&a);
+        if !(t >= 0.0 && (d - a * t).norm() <= SAME_POSTURE_MM * (1.0 + t)) {
+            return false;
+        }
+        let (z_top, r_max) = (blank.z_range().1, blank.max_radius());
+        let step = 1.0;
+        let margin = r_top + step;
+        let n = (t / step).ceil() as usize;
+        (0..=n).all(|i| {
+            let c = from.tip + a * (h_top + t * i as f64 / n.max(1) as f64);
+            c.z - margin > z_top || c.x.hypot(c.y) - margin > r_max
+        })
+    }
+
     /// Whether the retract of `cl` along its own axis to the safety surface is certified by
     /// the shape of the tool alone: for a tool whose radius never shrinks from the tip up
     /// ([`LinkCheck::profile`] = `(h_top, r_top)`), the tool moved by `t` along its axis

@@ -621,6 +621,32 @@ fn retract_along_the_axis_of_a_widening_tool_is_certified_by_its_shape() {
 }
 
 #[test]
+fn a_retract_along_the_axis_sweeps_no_stock_when_the_cylinder_above_the_holder_is_outside_the_blank(
+) {
+    // T5 in the channel: a retract along its axis covers nothing beyond the tool's own
+    // volume but the cylinder above its holder (115 mm above the tip, 13.5 mm radius), which
+    // stays above the 43 mm high blank; a short tool (a 12 mm assembly) whose top stays inside
+    // the blank, a move off the axis and a linker without blank are not certified.
+    let imp = impeller();
+    let surface = SafetySurface::around_stock(imp.stock(), 10.0).unwrap();
+    let linker = Linker::with_blank(surface, imp.stock());
+    let t = t5();
+    let q = query(&t);
+    let (p, n) = hub_point_mid_channel(&q);
+    let cl = CutterLocation::new(p + n * 0.3, n).unwrap();
+    let out = linker.exit_point(&cl, &n).unwrap();
+    let profile = cam_plan::linking::widening_profile(&t.cutter).unwrap();
+    assert!(linker.retract_sweeps_no_stock(&cl, &out.tip, profile));
+    let short = tool(CutterShape::BallEnd { radius: 0.5 }, 2.0, 0.5, 12.0, &[]);
+    let short_profile = cam_plan::linking::widening_profile(&short.cutter).unwrap();
+    assert!(short_profile.0 <= 12.0 + 1e-9);
+    assert!(!linker.retract_sweeps_no_stock(&cl, &out.tip, short_profile));
+    let sideways = out.tip + Vector3::new(n.y, -n.x, 0.0).normalize() * 2.0;
+    assert!(!linker.retract_sweeps_no_stock(&cl, &sideways, profile));
+    assert!(!Linker::new(surface).retract_sweeps_no_stock(&cl, &out.tip, profile));
+}
+
+#[test]
 fn retract_leaves_along_a_clear_direction_when_the_axis_would_cut_a_blade() {
     // A necked ball end (ball R1 on a R0.4 neck: its radius shrinks above the ball, so the
     // shape certifies nothing) leaning across the channel: the lean is raised until the ball

@@ -400,6 +400,15 @@ fn pruned_blade_distance_is_the_exhaustive_one() {
             "{p:?}: {fast} ({part:?}) vs {reference} ({reference_part:?})"
         );
         near += usize::from(reference.abs() < 1.0);
+        // The threshold form (instances the mesh keeps farther than `d` not projected on)
+        // answers as the exhaustive distance does, thresholds around the distance included.
+        for d in [reference - 0.05, reference + 0.05, 0.3, 1.5] {
+            assert_eq!(
+                q.blade_distance_at_least(&p, d),
+                reference >= d,
+                "{p:?}: at least {d}? exhaustive {reference}"
+            );
+        }
     }
     assert!(near >= 100, "only {near} points within 1 mm of a blade");
 }
