@@ -72,6 +72,8 @@ pub struct PointFinishingParams {
     /// Blade rows finished (default: both rows the impeller has).
     #[serde(default)]
     pub rows: Option<Vec<RowName>>,
+    // The axis keys of `point::AxisParams`, spelled out: serde cannot flatten a struct into
+    // one with `deny_unknown_fields`, and a misspelt key must stay an error.
     /// Preferred tilt of the axis from the side (deg; default the taper half angle + 8°).
     #[serde(default)]
     pub tilt_deg: Option<f64>,

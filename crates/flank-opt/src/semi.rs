@@ -72,6 +72,8 @@ pub struct SemiParams {
     /// `point`.
     #[serde(default = "default_method")]
     pub method: MethodChoice,
+    // The axis keys of `point::AxisParams`, spelled out: serde cannot flatten a struct into
+    // one with `deny_unknown_fields`, and a misspelt key must stay an error.
     /// Preferred tilt of the point-milling axis from the side (deg; see
     /// [`AxisParams`]).
     #[serde(default)]
