@@ -6,7 +6,8 @@ use cam_core::{
     Cutter, CutterLocation, CutterShape, HolderSegment, Move, MoveKind, Point3, ToolPath,
 };
 use machining_sim::{
-    cut, simulate, BoxDesign, BoxStock, CollisionTarget, PartKind, SimOptions, TriDexel,
+    cut, simulate, BoxDesign, BoxStock, CollisionTarget, DesignModel, PartKind, SimOptions,
+    TriDexel,
 };
 
 fn vertical(x: f64, y: f64, z: f64) -> CutterLocation {
@@ -401,4 +402,39 @@ fn contour_around_a_cylinder_design_finds_the_radial_gouge() {
             );
         }
     }
+}
+
+/// A design model whose face choice misreads the depth below the entered face by 5 mm (as a
+/// model can where faces meet at a sharp edge). The overcut read at a cut end point is capped
+/// by the way back to the entry point on that face, so the plate's 0.3 mm gouge still reads
+/// 0.3 mm within a cell, not 5.3 mm.
+#[test]
+fn an_inflated_face_depth_is_capped_by_the_way_back_to_the_entry() {
+    struct Inflated(BoxDesign);
+    impl DesignModel for Inflated {
+        fn signed_distance(&self, p: &Point3) -> f64 {
+            self.0.signed_distance(p)
+        }
+        fn surface_grids(&self) -> Vec<machining_sim::SurfaceGrid> {
+            self.0.surface_grids()
+        }
+        fn triangle_mesh(&self) -> machining_sim::TriangleMesh {
+            self.0.triangle_mesh()
+        }
+        fn depth_below(&self, p: &Point3, _entry: &Point3) -> f64 {
+            -self.0.signed_distance(p) + 5.0
+        }
+    }
+    let h = 0.2;
+    let design = Inflated(BoxDesign {
+        min: [-1.0, -10.0, 0.0],
+        max: [1.0, 10.0, 15.0],
+        sample_spacing: 0.25,
+    });
+    let (_, ops) = plate_case_with_ops(h, 0.3);
+    let block = BoxStock::new([-1.0, -10.0, 0.0], [5.0, 10.0, 15.0]).unwrap();
+    let mut stock = TriDexel::from_shape(&block, h).unwrap();
+    let rep = simulate(&mut stock, &design, &ops, &SimOptions::default()).unwrap();
+    let e = rep.max_overcut.clone().unwrap();
+    assert!((e.value_mm - 0.3).abs() < h, "{e:?}");
 }
