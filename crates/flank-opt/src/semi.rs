@@ -525,6 +525,15 @@ impl FlankSemiFinishing {
     }
 }
 
+/// The points `points` moved by `lift` along their tool axes `axes`.
+fn along_axes(points: &[Vector3], axes: &[Vector3], lift: f64) -> Vec<Vector3> {
+    points
+        .iter()
+        .zip(axes)
+        .map(|(c, ax)| c + ax * lift)
+        .collect()
+}
+
 /// The flank pass of one strip (module docs, steps 2–3): stations along the strip at
 /// `passes_along` even rulings plus the chord refinement, lifted along the axes where the
 /// side below the strip (keeping `allowance − strip_tol`) or the hub under the balls would
@@ -590,16 +599,8 @@ pub fn strip_pass(
     let tol = strip_tol;
     let family = SphereFamily::from_shape(&shape, cutter.flute_length)?;
     let fits = |lift: f64| -> Result<bool, FlankError> {
-        let c: Vec<Vector3> = centres
-            .iter()
-            .zip(&axes)
-            .map(|(c, ax)| c + ax * lift)
-            .collect();
-        let t: Vec<Vector3> = tops
-            .iter()
-            .zip(&axes)
-            .map(|(c, ax)| c + ax * lift)
-            .collect();
+        let c = along_axes(&centres, &axes, lift);
+        let t = along_axes(&tops, &axes, lift);
         // The ball against the hub body (exact: its centre's distance), wherever the
         // closest hub point below it is not the nearest part of the hub body (over the
         // inlet corner of the hub).
@@ -642,16 +643,8 @@ pub fn strip_pass(
         }
         lift = hi;
     }
-    let c: Vec<Vector3> = centres
-        .iter()
-        .zip(&axes)
-        .map(|(c, ax)| c + ax * lift)
-        .collect();
-    let t: Vec<Vector3> = tops
-        .iter()
-        .zip(&axes)
-        .map(|(c, ax)| c + ax * lift)
-        .collect();
+    let c = along_axes(&centres, &axes, lift);
+    let t = along_axes(&tops, &axes, lift);
     let (g0, g1) = guides_through(&c, &t)?;
     let env = SweptEnvelope::new(family, g0, g1, r, EnvelopeOptions::default())?;
     // The guides interpolate the stations at uniform parameters: station i at i/(m − 1).

@@ -138,6 +138,32 @@ pub fn write_tilted_tips(
     write_moves(w, mw, op_name, OutputMode::TcpAngles, &moves, prefix)
 }
 
+/// The spindle's direction code: `M3` clockwise, `M4` counter-clockwise, `M5` stopped.
+pub fn spindle_code(sp: Option<Spindle>) -> &'static str {
+    match sp {
+        Some(s) if !s.clockwise => "M4",
+        Some(_) => "M3",
+        None => "M5",
+    }
+}
+
+/// An error naming the operation unless its simultaneous moves are tool-centre-point angles
+/// (`how` says how the dialect switches TCP on, e.g. `M128`).
+pub fn require_tcp_angles(
+    dialect: &'static str,
+    mode: OutputMode,
+    op_name: &str,
+    how: &str,
+) -> Result<(), GcodeError> {
+    if mode == OutputMode::TcpAngles {
+        return Ok(());
+    }
+    Err(GcodeError::Unsupported {
+        dialect,
+        what: format!("{mode:?} output (operation `{op_name}`); use TCP ({how})"),
+    })
+}
+
 /// `M3`/`M4` with `S`, or `M5`.
 pub fn spindle_words(
     sp: Option<Spindle>,
@@ -145,11 +171,7 @@ pub fn spindle_words(
     at: At<'_>,
 ) -> Result<String, GcodeError> {
     Ok(match sp {
-        Some(s) => format!(
-            "S{} {}",
-            num(fmt, s.rpm, "S", at)?,
-            if s.clockwise { "M3" } else { "M4" }
-        ),
+        Some(s) => format!("S{} {}", num(fmt, s.rpm, "S", at)?, spindle_code(sp)),
         None => "M5".to_string(),
     })
 }

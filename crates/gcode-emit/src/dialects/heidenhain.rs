@@ -18,8 +18,8 @@
 //!   through M116/M128, not `G93`.
 
 use super::common::{
-    footer, header, iso_style, op_comment, preposition_rotary, retract_block, write_moves,
-    write_tilted_tips,
+    footer, header, iso_style, op_comment, preposition_rotary, require_tcp_angles, retract_block,
+    spindle_code, write_moves, write_tilted_tips,
 };
 use crate::dialect::{
     num, program_name, sanitize, At, BlockWriter, Dialect, MotionStyle, MotionWriter,
@@ -89,24 +89,12 @@ impl Dialect for HeidenhainIso {
                     num(NumberFormat::trimmed(0), sp.rpm, "S", at)?
                 ));
             }
-            w.block(match op.tool.spindle {
-                Some(sp) if !sp.clockwise => "M4",
-                Some(_) => "M3",
-                None => "M5",
-            });
+            w.block(spindle_code(op.tool.spindle));
             w.block(o.coolant_codes.code(op.tool.coolant));
             mw.forget_positions();
             match &op.motion {
                 Motion::Simultaneous { mode, moves } => {
-                    if *mode != OutputMode::TcpAngles {
-                        return Err(GcodeError::Unsupported {
-                            dialect: self.name(),
-                            what: format!(
-                                "{mode:?} output (operation `{}`); use TCP (M128)",
-                                op.name
-                            ),
-                        });
-                    }
+                    require_tcp_angles(self.name(), *mode, &op.name, "M128")?;
                     let Some(first) = moves.first() else { continue };
                     preposition_rotary(&mut w, style, *mode, first, at)?;
                     w.block("M128");

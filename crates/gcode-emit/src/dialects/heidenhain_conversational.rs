@@ -21,7 +21,7 @@
 //! - The datum is the active preset (no work offset word).
 //! - Joint (inverse-time) output is not offered, as in the ISO form.
 
-use super::common::{op_comment, rotary_words, tip_move};
+use super::common::{op_comment, require_tcp_angles, rotary_words, spindle_code, tip_move};
 use crate::dialect::{num, program_name, sanitize, At, Dialect};
 use crate::program::{Feed, Motion, NcMove, NcProgram, OutputMode, ProgramOptions};
 use crate::tilted_plane::TiltedPlane;
@@ -197,24 +197,12 @@ impl Dialect for HeidenhainConversational {
                 None => String::new(),
             };
             lines.line(&format!("TOOL CALL {} Z{s}", op.tool.number));
-            lines.line(match op.tool.spindle {
-                Some(sp) if !sp.clockwise => "M4",
-                Some(_) => "M3",
-                None => "M5",
-            });
+            lines.line(spindle_code(op.tool.spindle));
             lines.line(o.coolant_codes.code(op.tool.coolant));
             lw.forget_positions();
             match &op.motion {
                 Motion::Simultaneous { mode, moves } => {
-                    if *mode != OutputMode::TcpAngles {
-                        return Err(GcodeError::Unsupported {
-                            dialect: self.name(),
-                            what: format!(
-                                "{mode:?} output (operation `{}`); use TCP (FUNCTION TCPM)",
-                                op.name
-                            ),
-                        });
-                    }
+                    require_tcp_angles(self.name(), *mode, &op.name, "FUNCTION TCPM")?;
                     let Some(first) = moves.first() else { continue };
                     if !first.rotary.is_empty() {
                         lines.line(&format!(
