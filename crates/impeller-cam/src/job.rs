@@ -124,7 +124,8 @@ pub struct StockStart {
     /// `"blank"` (the impeller file's blank, default) or `"turned"`: the blank after the
     /// turning steps of a turn-mill process plan (paper 003, Table 1, steps 1–3: facing,
     /// rough and finish turning of the outside contour), i.e. faced at the design's top and
-    /// turned to the shroud contour plus `turning_allowance_mm`
+    /// turned to the shroud contour over the blades' axial extent and to the hub beyond it,
+    /// plus `turning_allowance_mm`
     /// (`impeller_model::Impeller::turned_stock`).
     pub start: StockStartKind,
     /// Material the turning leaves over the shroud contour and the top (mm, ≥ 0; default 0:

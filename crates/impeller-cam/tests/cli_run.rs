@@ -3,6 +3,8 @@
 //! checked reverse-motion smoothing, and user errors.
 #![allow(clippy::unwrap_used, clippy::panic)] // test helpers
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
@@ -10,11 +12,8 @@ fn cli() -> Command {
     Command::new(env!("CARGO_BIN_EXE_impeller-cam"))
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("impeller-cam-run-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn scratch(name: &str) -> common::Scratch {
+    common::scratch("impeller-cam-run", name)
 }
 
 fn repo() -> PathBuf {

@@ -2,6 +2,8 @@
 //! top-ring CL file (a five-axis cut in the blank above the shroud contour: outside the design).
 #![allow(clippy::unwrap_used)] // test helpers
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -13,11 +15,8 @@ fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("impeller-cam-vp-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn scratch(name: &str) -> common::Scratch {
+    common::scratch("impeller-cam-vp", name)
 }
 
 #[test]

@@ -7,6 +7,8 @@
 //! of the kind's own keys name the file, line and key.
 #![allow(clippy::unwrap_used, clippy::panic)] // test code
 
+mod common;
+
 use cam_core::{CutterLocation, Move, Point3, ToolPath, Vector3};
 use cam_plan::{
     order, params, pattern, Builder, Metrics, Operation, OperationSpec, PlanContext, PlanError,
@@ -184,15 +186,8 @@ fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// A fresh directory of its own for each call: tests run in parallel threads of one
-/// process, so the process id alone would let two tests share (and race on) a folder.
-fn scratch(name: &str) -> PathBuf {
-    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let d = std::env::temp_dir().join(format!("impeller-cam-fw-{}-{n}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn scratch(name: &str) -> common::Scratch {
+    common::scratch("impeller-cam-fw", name)
 }
 
 fn job_text(ops: &str) -> String {

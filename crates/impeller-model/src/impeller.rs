@@ -1,6 +1,6 @@
 //! The impeller: hub, shroud, main blade row, optional splitter row, fillet radius and blank.
 
-use crate::blade::{Blade, BladeSet};
+use crate::blade::{Blade, BladeEdge, BladeSet};
 use crate::error::ModelError;
 use crate::revolved::RevolvedSurface;
 use crate::stock::Stock;
@@ -148,8 +148,9 @@ impl Impeller {
     }
 
     /// The blank faced at the design's top and turned to the shroud contour plus
-    /// `allowance_mm` ([`Stock::turned`], 256 contour samples): the stock five-axis milling
-    /// starts from after the turning steps of a turn-mill process plan.
+    /// `allowance_mm` over the blades' axial extent and to the hub beyond it
+    /// ([`Stock::turned_to_hub_beyond_blades`], 256 contour samples): the stock five-axis
+    /// milling starts from after the turning steps of a turn-mill process plan.
     pub fn turned_stock(&self, allowance_mm: f64) -> Result<Stock, ModelError> {
         let h = self.hub.meridional();
         let s = self.shroud.meridional();
@@ -157,7 +158,41 @@ impl Impeller {
             .into_iter()
             .chain([s.point_at_fraction(0.0).x, s.point_at_fraction(1.0).x])
             .fold(f64::NEG_INFINITY, f64::max);
-        Stock::turned(&self.stock, s, top, allowance_mm, 256)
+        Stock::turned_to_hub_beyond_blades(
+            &self.stock,
+            s,
+            h,
+            self.blade_z_range_mm(),
+            top,
+            allowance_mm,
+            256,
+        )
+    }
+
+    /// The axial extent (z_min, z_max) of every blade (main and splitter; both sides and the
+    /// faces of blunt edges), from the faces' control points: their convex hull holds the surface (positive weights), so
+    /// the range holds the blades, and it is the same for every blade of a row (rotation
+    /// about Z keeps z).
+    pub fn blade_z_range_mm(&self) -> (f64, f64) {
+        let mut sets = vec![self.main.blade()];
+        if let Some(s) = &self.splitter {
+            sets.push(s.blade());
+        }
+        let mut range = (f64::INFINITY, f64::NEG_INFINITY);
+        for b in sets {
+            let edges = [BladeEdge::Leading, BladeEdge::Trailing]
+                .into_iter()
+                .filter_map(|e| b.edge_face(e).ok().flatten());
+            for face in [b.pressure().clone(), b.suction().clone()]
+                .into_iter()
+                .chain(edges)
+            {
+                for p in face.control_points() {
+                    range = (range.0.min(p.z), range.1.max(p.z));
+                }
+            }
+        }
+        range
     }
 
     /// Every blade in +θ order: main 0, splitter 0, main 1, splitter 1, ... (main only when

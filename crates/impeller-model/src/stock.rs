@@ -195,11 +195,217 @@ impl Stock {
         Self::from_profile(profile)
     }
 
+    /// The turned blank ([`Stock::turned`]) also turned down to the hub where there are no
+    /// blades: outside the blades' axial extent `blade_z_mm` widened by the allowance, the
+    /// outer radius is capped by the hub's `E(z) = max r(hub at height z) + allowance`, the
+    /// smallest solid of revolution holding the hub there. This is what turning can reach on
+    /// an axial rotor (the hub before and after the blade row) and at a centrifugal
+    /// impeller's eye (the hub's nose above the leading edges); it leaves no ring of stock
+    /// that only a shank could meet.
+    ///
+    /// The result is `R(z) = min(R_turned(z), E(z))`, exact for the two piecewise-linear
+    /// profiles (their breakpoints and crossings are all breakpoints), so it is never larger
+    /// than [`Stock::turned`]'s and still holds every design point that one holds: within the
+    /// widened blade band `E` is not applied; over a ramp of [`HUB_RAMP_MM`] beyond each band
+    /// edge `E` runs linearly from the turned radius down to the largest hub radius over the
+    /// ramp; elsewhere `E` interpolates the hub's sampled polyline (its vertices pushed
+    /// outward by the contour's chord sag, as in [`Stock::turned`]) at every vertex height,
+    /// taking the largest of the polyline's crossings at a height, which lies on or above the
+    /// hub between vertices because the largest of linear pieces is convex. Below the hub's
+    /// lowest point `E` keeps the hub's end radius (the back plate), above its highest the
+    /// hub's end radius there.
+    ///
+    /// Cost O(samples · 8) contour evaluations plus O(samples²) for the crossings of the
+    /// hub polyline at each height.
+    pub fn turned_to_hub_beyond_blades(
+        blank: &Stock,
+        shroud: &crate::MeridionalCurve,
+        hub: &crate::MeridionalCurve,
+        blade_z_mm: (f64, f64),
+        top_z_mm: f64,
+        allowance_mm: f64,
+        samples: usize,
+    ) -> Result<Self, ModelError> {
+        let turned = Self::turned(blank, shroud, top_z_mm, allowance_mm, samples)?;
+        let (b0, b1) = (
+            blade_z_mm.0.min(blade_z_mm.1),
+            blade_z_mm.0.max(blade_z_mm.1),
+        );
+        if !(b0.is_finite() && b1.is_finite()) {
+            return Err(ModelError::invalid(
+                "stock",
+                "the blades' axial extent is not finite",
+            ));
+        }
+        let (band0, band1) = (b0 - allowance_mm, b1 + allowance_mm);
+        let (z0, z1) = turned.z_range();
+        let hub_pts = raised_polyline(hub, samples.max(8), allowance_mm);
+        // The largest hub radius at height z (the crossings of the raised polyline), or the
+        // radius of its end beyond its axial extent.
+        let (lo, hi) = hub_pts
+            .iter()
+            .fold((hub_pts[0], hub_pts[0]), |(lo, hi), p| {
+                (
+                    if p[0] < lo[0] { *p } else { lo },
+                    if p[0] > hi[0] { *p } else { hi },
+                )
+            });
+        let hub_r = |z: f64| -> f64 {
+            if z <= lo[0] {
+                return lo[1];
+            }
+            if z >= hi[0] {
+                return hi[1];
+            }
+            let mut best = f64::NEG_INFINITY;
+            for w in hub_pts.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                let (za, zb) = (a[0].min(b[0]), a[0].max(b[0]));
+                if z < za || z > zb {
+                    continue;
+                }
+                let r = if zb - za <= 1e-12 {
+                    a[1].max(b[1])
+                } else {
+                    a[1] + (z - a[0]) / (b[0] - a[0]) * (b[1] - a[1])
+                };
+                best = best.max(r);
+            }
+            best
+        };
+        // The largest hub radius over [za, zb]: at the ends and at the vertices between.
+        let hub_max = |za: f64, zb: f64| -> f64 {
+            hub_pts
+                .iter()
+                .filter(|p| p[0] > za && p[0] < zb)
+                .map(|p| p[1])
+                .fold(hub_r(za).max(hub_r(zb)), f64::max)
+        };
+        let big = turned.max_radius().max(hub_max(z0, z1)) + 1.0;
+        // E's breakpoints (z, value), increasing z.
+        let mut e: Vec<[f64; 2]> = Vec::new();
+        let below_end = band0 - HUB_RAMP_MM;
+        if below_end > z0 {
+            e.push([z0, hub_r(z0)]);
+            e.extend(
+                hub_pts
+                    .iter()
+                    .filter(|p| p[0] > z0 && p[0] < below_end)
+                    .map(|p| [p[0], hub_r(p[0])]),
+            );
+            e.push([below_end, hub_max(below_end, band0)]);
+        }
+        e.push([band0, big]);
+        e.push([band1, big]);
+        let above_start = band1 + HUB_RAMP_MM;
+        if above_start < z1 {
+            e.push([above_start, hub_max(band1, above_start)]);
+            e.extend(
+                hub_pts
+                    .iter()
+                    .filter(|p| p[0] > above_start && p[0] < z1)
+                    .map(|p| [p[0], hub_r(p[0])]),
+            );
+            e.push([z1, hub_r(z1)]);
+        }
+        e.sort_by(|a, b| a[0].total_cmp(&b[0]));
+        e.dedup_by(|a, b| {
+            if (a[0] - b[0]).abs() < 1e-9 {
+                b[1] = b[1].max(a[1]);
+                true
+            } else {
+                false
+            }
+        });
+        let e_at = |z: f64| interpolate(&e, z);
+        let t_at = |z: f64| turned.radius_at(z).unwrap_or(0.0);
+        let mut zs: Vec<f64> = turned.profile_zr.iter().map(|p| p[0]).collect();
+        zs.extend(e.iter().map(|p| p[0]).filter(|z| *z > z0 && *z < z1));
+        zs.sort_by(f64::total_cmp);
+        zs.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        // The ends are the turned stock's, exactly.
+        if let Some(first) = zs.first_mut() {
+            *first = z0;
+        }
+        if let Some(last) = zs.last_mut() {
+            *last = z1;
+        }
+        let mut profile: Vec<[f64; 2]> = Vec::with_capacity(2 * zs.len());
+        for (k, &z) in zs.iter().enumerate() {
+            if k > 0 {
+                // The crossing of the two linear pieces inside (zs[k-1], z), if any.
+                let za = zs[k - 1];
+                let (da, db) = (t_at(za) - e_at(za), t_at(z) - e_at(z));
+                if da * db < 0.0 {
+                    let zc = za + (z - za) * da / (da - db);
+                    if zc - za > 1e-9 && z - zc > 1e-9 {
+                        profile.push([zc, t_at(zc).min(e_at(zc)).max(0.0)]);
+                    }
+                }
+            }
+            profile.push([z, t_at(z).min(e_at(z)).max(0.0)]);
+        }
+        Self::from_profile(profile)
+    }
+
     /// Whether the point (x, y, z) lies in the blank.
     pub fn contains(&self, p: &nalgebra::Vector3<f64>) -> bool {
         self.radius_at(p.z)
             .is_some_and(|r| (p.x * p.x + p.y * p.y).sqrt() <= r)
     }
+}
+
+/// Width (mm) of the ramp over which [`Stock::turned_to_hub_beyond_blades`] brings the
+/// turned radius down to the hub's beyond the blades' axial extent.
+pub const HUB_RAMP_MM: f64 = 1.0;
+
+/// The contour sampled at `n + 1` points, each pushed outward (+r) by the larger chord sag
+/// of its two chords (7 points per chord) plus `allowance_mm`: a polyline on or outside the
+/// contour.
+fn raised_polyline(c: &crate::MeridionalCurve, n: usize, allowance_mm: f64) -> Vec<[f64; 2]> {
+    let mut pts: Vec<[f64; 2]> = (0..=n)
+        .map(|k| {
+            let p = c.point_at_fraction(k as f64 / n as f64);
+            [p.x, p.y]
+        })
+        .collect();
+    let mut sag = vec![0.0f64; n + 1];
+    for k in 1..=n {
+        let (f0, f1) = ((k - 1) as f64 / n as f64, k as f64 / n as f64);
+        let (a, b) = (pts[k - 1], pts[k]);
+        let ab = [b[0] - a[0], b[1] - a[1]];
+        let len2 = (ab[0] * ab[0] + ab[1] * ab[1]).max(1e-300);
+        let mut worst: f64 = 0.0;
+        for j in 1..8 {
+            let q = c.point_at_fraction(f0 + (f1 - f0) * j as f64 / 8.0);
+            // Radial distance of q above the chord at q's height, or its distance to the
+            // chord where the chord is (nearly) radial.
+            let t = ((q.x - a[0]) * ab[0] + (q.y - a[1]) * ab[1]) / len2;
+            let t = t.clamp(0.0, 1.0);
+            let d = ((q.x - a[0] - t * ab[0]).powi(2) + (q.y - a[1] - t * ab[1]).powi(2)).sqrt();
+            worst = worst.max(d);
+        }
+        sag[k - 1] = sag[k - 1].max(worst);
+        sag[k] = sag[k].max(worst);
+    }
+    for (p, g) in pts.iter_mut().zip(&sag) {
+        p[1] += g + allowance_mm;
+    }
+    pts
+}
+
+/// Linear interpolation of `(z, v)` points sorted by z, the end values beyond them.
+fn interpolate(pts: &[[f64; 2]], z: f64) -> f64 {
+    let n = pts.len();
+    if z <= pts[0][0] {
+        return pts[0][1];
+    }
+    if z >= pts[n - 1][0] {
+        return pts[n - 1][1];
+    }
+    let k = pts.partition_point(|p| p[0] <= z).clamp(1, n - 1);
+    let (a, b) = (pts[k - 1], pts[k]);
+    a[1] + (z - a[0]) / (b[0] - a[0]) * (b[1] - a[1])
 }
 
 #[cfg(test)]
@@ -246,5 +452,95 @@ mod tests {
         // Never beyond the blank.
         assert!(a.radius_at(5.0).unwrap() <= 39.5 + 1e-12);
         assert!(Stock::turned(&blank, &c, 43.0, -1.0, 64).is_err());
+    }
+
+    fn line(a: [f64; 2], b: [f64; 2]) -> crate::MeridionalCurve {
+        let curve = nurbs::NurbsCurve::new(
+            1,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![
+                nalgebra::Vector2::new(a[0], a[1]),
+                nalgebra::Vector2::new(b[0], b[1]),
+            ],
+            None,
+        )
+        .unwrap();
+        crate::MeridionalCurve::new(curve).unwrap()
+    }
+
+    #[test]
+    fn turned_to_hub_beyond_an_axial_rows_blades() {
+        // An axial rotor: hub r 30 → 34 and casing r 50 from z 0 to 40, blades over z 10–30.
+        let (hub, shroud) = (
+            line([0.0, 30.0], [40.0, 34.0]),
+            line([0.0, 50.0], [40.0, 50.0]),
+        );
+        let blank = Stock::cylinder(110.0, 40.0).unwrap();
+        let a = 0.5;
+        let t = Stock::turned(&blank, &shroud, 40.0, a, 64).unwrap();
+        let s =
+            Stock::turned_to_hub_beyond_blades(&blank, &shroud, &hub, (10.0, 30.0), 40.0, a, 64)
+                .unwrap();
+        assert_eq!(s.z_range(), t.z_range());
+        let hub_r = |z: f64| 30.0 + 4.0 * z / 40.0;
+        for k in 0..=800 {
+            let z = s.z_range().0 + (s.z_range().1 - s.z_range().0) * k as f64 / 800.0;
+            let (rs, rt) = (s.radius_at(z).unwrap(), t.radius_at(z).unwrap());
+            // Never more than the turned blank; the hub (+ allowance) always inside.
+            assert!(rs <= rt + 1e-12, "z {z}: {rs} > turned {rt}");
+            assert!(
+                rs >= hub_r(z.min(40.0)) + a - 1e-9,
+                "z {z}: {rs} below the hub"
+            );
+            // The blades' band keeps the casing radius; beyond the ramp, the hub's.
+            if (10.0 - a..=30.0 + a).contains(&z) {
+                assert!((rs - rt).abs() < 1e-12, "z {z}: band cut to {rs}");
+            }
+            // (one hub sample, 0.625 mm, next to the ramp interpolates to its larger end)
+            if z < 10.0 - a - HUB_RAMP_MM - 0.7 || z > 30.0 + a + HUB_RAMP_MM + 0.7 {
+                assert!(
+                    rs - (hub_r(z.min(40.0)) + a) < 1e-6,
+                    "z {z}: {rs} left above the hub"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn turned_to_hub_keeps_a_centrifugal_blank_where_blades_span_it() {
+        // impeller-8+8's contours: the blades span z 0–43, so nothing changes but the
+        // faced eye above the leading edge when the band stops below it.
+        let shroud = crate::MeridionalCurve::quarter_ellipse([43.0, 22.0], [11.0, 38.5]).unwrap();
+        let hub = crate::MeridionalCurve::quarter_ellipse([43.0, 8.0], [0.0, 38.5]).unwrap();
+        let blank = Stock::cylinder(79.0, 44.0).unwrap();
+        let t = Stock::turned(&blank, &shroud, 43.0, 0.0, 256).unwrap();
+        let full =
+            Stock::turned_to_hub_beyond_blades(&blank, &shroud, &hub, (0.0, 43.0), 43.0, 0.0, 256)
+                .unwrap();
+        for k in 0..=400 {
+            let z = 43.0 * k as f64 / 400.0;
+            assert!((full.radius_at(z).unwrap() - t.radius_at(z).unwrap()).abs() < 1e-9);
+        }
+        // Blades ending at z 38: above 39 the stock is the hub's nose (r ≤ ~13.1 at z 39).
+        let eye =
+            Stock::turned_to_hub_beyond_blades(&blank, &shroud, &hub, (0.0, 38.0), 43.0, 0.0, 256)
+                .unwrap();
+        let nose = |z: f64| {
+            // hub: z = 43 cos φ, r = 38.5 - 30.5 cos φ... sampled by closest point instead
+            (0..=4000)
+                .map(|j| hub.point_at_fraction(j as f64 / 4000.0))
+                .filter(|p| (p.x - z).abs() < 0.05)
+                .map(|p| p.y)
+                .fold(0.0f64, f64::max)
+        };
+        for z in [39.5, 41.0, 42.5] {
+            let r = eye.radius_at(z).unwrap();
+            assert!(
+                r >= nose(z) - 0.01 && r <= nose(z) + 0.2,
+                "z {z}: {r} vs hub {}",
+                nose(z)
+            );
+            assert!(r < t.radius_at(z).unwrap() - 5.0);
+        }
     }
 }

@@ -84,6 +84,7 @@ fn inputs_are_checked_before_anything_runs() {
         "{e}"
     );
     std::fs::remove_dir_all(&d).unwrap();
+    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -429,6 +430,7 @@ fn tool_file_errors_name_the_tool_file() {
         err.contains("job.toml:1: tools") && err.contains("missing.toml"),
         "{err}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `coolant` in a process row: flood, mist, through or off (default off); anything else is
