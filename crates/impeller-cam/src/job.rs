@@ -172,6 +172,9 @@ pub struct VerificationSpec {
     pub enabled: bool,
     /// Dexel spacing (mm).
     pub resolution_mm: f64,
+    /// How many of the deepest dexel overcut samples are re-measured on the exact swept
+    /// envelopes of the tool paths (`machining_sim::crosscheck_overcut`; 0: none).
+    pub crosscheck: usize,
     /// Keep the program when verification finds defects (`run --allow-defects`; not a
     /// job-file key).
     #[serde(skip)]
@@ -183,6 +186,7 @@ impl Default for VerificationSpec {
         Self {
             enabled: true,
             resolution_mm: 0.1,
+            crosscheck: 20,
             allow_defects: false,
         }
     }

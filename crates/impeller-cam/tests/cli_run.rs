@@ -84,6 +84,19 @@ fn default_job_is_the_impeller_8_8_fixture_job() {
     assert_eq!(r["verification"]["collisions"], 0);
     assert!(r["verification"]["defects"].as_array().unwrap().is_empty());
     assert_eq!(r["verdict"]["status"], "pass");
+    // The deepest dexel overcut readings re-measured on the exact swept envelopes: each
+    // within the simulation's error bound of its dexel reading (limit − machining_tol).
+    let v = &r["verification"];
+    let bound = v["overcut_limit_mm"].as_f64().unwrap() - 0.01;
+    let cc = &v["details"]["overcut_crosscheck"];
+    assert_eq!(cc["samples"], 20, "{cc}");
+    for p in cc["points"].as_array().unwrap() {
+        let (d, e) = (
+            p["dexel_overcut_mm"].as_f64().unwrap(),
+            p["envelope_overcut_mm"].as_f64().unwrap(),
+        );
+        assert!((d - e).abs() <= bound, "{p}");
+    }
     let last = stderr.lines().last().unwrap_or_default();
     assert!(
         last.contains("program.ngc, verification PASS (overcut") && last.contains("<= limit"),

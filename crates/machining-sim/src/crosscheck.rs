@@ -20,10 +20,43 @@ use cam_core::{
 };
 use serde::{Deserialize, Serialize};
 
-/// The swept envelopes of a set of tool paths.
+/// The swept envelopes of a set of tool paths, each with an axis-aligned box that holds it
+/// (the box of its guide points, which holds the linear guides, grown by more than the
+/// largest member sphere of the cutter reaches beyond them).
 #[derive(Debug, Clone)]
 pub struct Envelopes {
-    envelopes: Vec<SweptEnvelope>,
+    envelopes: Vec<(SweptEnvelope, [f64; 6])>,
+}
+
+/// The box of the tips and flute tops of `cls`, grown by `pad`.
+fn box_of(cls: &[CutterLocation], flute: f64, pad: f64) -> [f64; 6] {
+    let mut b = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for c in cls {
+        for q in [c.tip.coords, c.tip.coords + c.axis.into_inner() * flute] {
+            for k in 0..3 {
+                b[k] = b[k].min(q[k] - pad);
+                b[k + 3] = b[k + 3].max(q[k] + pad);
+            }
+        }
+    }
+    b
+}
+
+/// Distance from `p` to the box `b` (0 inside).
+fn box_distance(b: &[f64; 6], p: &Point3) -> f64 {
+    let mut d2 = 0.0;
+    for k in 0..3 {
+        let e = (b[k] - p[k]).max(p[k] - b[k + 3]).max(0.0);
+        d2 += e * e;
+    }
+    d2.sqrt()
 }
 
 fn envelope_of(cutter: &Cutter, cls: &[CutterLocation]) -> Result<SweptEnvelope, SimError> {
@@ -51,13 +84,40 @@ fn envelope_of(cutter: &Cutter, cls: &[CutterLocation]) -> Result<SweptEnvelope,
 impl Envelopes {
     /// One envelope per run of cutting moves of every operation.
     pub fn new(ops: &[(Cutter, ToolPath)]) -> Result<Self, SimError> {
+        Self::new_where(ops, |_| true)
+    }
+
+    /// The envelopes of the runs whose box holds at least one of `points`: enough for the
+    /// depth `max(0, −d)` of those points (a run whose box does not hold a point cannot hold
+    /// it), at the cost of building only those envelopes. The distance of a point outside
+    /// every kept box is not that of the whole union.
+    pub fn around(ops: &[(Cutter, ToolPath)], points: &[Point3]) -> Result<Self, SimError> {
+        Self::new_where(ops, |b| points.iter().any(|p| box_distance(b, p) == 0.0))
+    }
+
+    fn new_where(
+        ops: &[(Cutter, ToolPath)],
+        keep: impl Fn(&[f64; 6]) -> bool,
+    ) -> Result<Self, SimError> {
         let mut envelopes = Vec::new();
         for (cutter, path) in ops {
             let mut run: Vec<CutterLocation> = Vec::new();
+            // A member tangent to a cone of half angle α at radius R sits R·tan α above that
+            // height with radius R / cos α, so it reaches R (tan α + 1 / cos α) ≤ 2.42 R beyond
+            // the guide point for α ≤ 45°.
+            let pad = 2.5 * cutter.max_cutting_radius() + 1.0;
+            let l = cutter.flute_length;
+            let mut close = |run: &[CutterLocation]| -> Result<(), SimError> {
+                let b = box_of(run, l, pad);
+                if keep(&b) {
+                    envelopes.push((envelope_of(cutter, run)?, b));
+                }
+                Ok(())
+            };
             for (k, mv) in path.moves.iter().enumerate() {
                 if mv.kind == MoveKind::Rapid {
                     if !run.is_empty() {
-                        envelopes.push(envelope_of(cutter, &run)?);
+                        close(&run)?;
                         run.clear();
                     }
                     continue;
@@ -68,18 +128,33 @@ impl Envelopes {
                 run.push(mv.cl);
             }
             if !run.is_empty() {
-                envelopes.push(envelope_of(cutter, &run)?);
+                close(&run)?;
             }
         }
         Ok(Self { envelopes })
     }
 
-    /// Signed distance from `p` to the union of the envelopes (negative inside).
+    /// Signed distance from `p` to the union of the envelopes (negative inside). Envelopes
+    /// whose box is farther from `p` than the best distance found so far are skipped: their
+    /// distance is at least the box's. Exact as the envelopes' own query; cost O(envelopes)
+    /// box tests plus one envelope query per envelope whose box is near `p`.
     pub fn signed_distance(&self, p: &Point3) -> Result<f64, SimError> {
+        let mut near: Vec<(f64, usize)> = self
+            .envelopes
+            .iter()
+            .enumerate()
+            .map(|(i, (_, b))| (box_distance(b, p), i))
+            .collect();
+        near.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut best = f64::INFINITY;
-        for e in &self.envelopes {
+        for (d_box, i) in near {
+            if d_box >= best {
+                break;
+            }
             best = best.min(
-                e.signed_distance(p, None)
+                self.envelopes[i]
+                    .0
+                    .signed_distance(p, None)
                     .map_err(SimError::Envelope)?
                     .distance,
             );
@@ -105,13 +180,13 @@ pub struct CrossCheckPoint {
     pub envelope_overcut_mm: f64,
 }
 
-/// Cross-checks the `max_points` samples of `report` with the largest dexel overcut.
+/// Cross-checks the `max_points` samples of `report` with the largest dexel overcut, building
+/// only the envelopes of runs that can reach them ([`Envelopes::around`]).
 pub fn crosscheck_overcut(
     report: &Report,
     ops: &[(Cutter, ToolPath)],
     max_points: usize,
 ) -> Result<Vec<CrossCheckPoint>, SimError> {
-    let env = Envelopes::new(ops)?;
     let mut cands: Vec<(f64, usize, usize)> = Vec::new();
     for (m, map) in report.maps.iter().enumerate() {
         for (k, v) in map.overcut_mm.iter().enumerate() {
@@ -122,6 +197,14 @@ pub fn crosscheck_overcut(
     }
     cands.sort_by(|a, b| b.0.total_cmp(&a.0));
     cands.truncate(max_points);
+    let points: Vec<Point3> = cands
+        .iter()
+        .map(|&(_, m, k)| {
+            let p = report.maps[m].points[k];
+            Point3::new(p[0], p[1], p[2])
+        })
+        .collect();
+    let env = Envelopes::around(ops, &points)?;
     let mut out = Vec::with_capacity(cands.len());
     for (v, m, k) in cands {
         let map = &report.maps[m];
