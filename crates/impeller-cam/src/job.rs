@@ -539,6 +539,11 @@ fn toml_error(file: &Path, text: &str, e: &toml::de::Error) -> CliError {
         return CliError::Message(format!("{}: {message}", file.display()));
     };
     let line = line_at(text, span.start);
+    if message == "duplicate key" {
+        if let Some(hint) = duplicate_table_hint(text, line) {
+            return CliError::Message(format!("{}:{line}: {hint}", file.display()));
+        }
+    }
     // The key: the dotted path at the error's position, completed by the key serde names
     // (an unknown or missing field) when that one is not already its last element.
     let mut key = path_at(text, span.start).unwrap_or_default();
@@ -555,6 +560,45 @@ fn toml_error(file: &Path, text: &str, e: &toml::de::Error) -> CliError {
     } else {
         CliError::Message(format!("{}:{line}: {key}: {message}", file.display()))
     }
+}
+
+/// What a `duplicate key` at a table header on `line` means: the same `[a.b]` table twice,
+/// most often a row table written under a singular name (`[operation.process]` after each
+/// `[[operations]]`, which TOML reads as one top-level `operation` table defined again),
+/// with the array-of-tables spelling the job format uses when there is one.
+fn duplicate_table_hint(text: &str, line: usize) -> Option<String> {
+    let header = text.lines().nth(line.checked_sub(1)?)?.trim();
+    let name = header
+        .strip_prefix('[')?
+        .split(']')
+        .next()?
+        .trim()
+        .trim_start_matches('[')
+        .trim();
+    if name.is_empty() {
+        return None;
+    }
+    let first = name.split('.').next().unwrap_or(name).trim();
+    let first_line = text
+        .lines()
+        .position(|l| {
+            let l = l.trim();
+            l.starts_with('[')
+                && l.trim_start_matches('[').split(']').next().map(str::trim) == Some(name)
+        })
+        .map_or(0, |k| k + 1);
+    let mut hint = format!(
+        "the table `[{name}]` is defined again (first at line {first_line}): TOML allows a \
+         table once"
+    );
+    const ROWS: [&str; 3] = ["operations", "tools", "cl_files"];
+    if let Some(row) = ROWS.iter().find(|r| **r == format!("{first}s")) {
+        let rest = name.strip_prefix(first).unwrap_or("");
+        hint.push_str(&format!(
+            "; the table of each `[[{row}]]` entry is written `[{row}{rest}]` (not `[{name}]`)"
+        ));
+    }
+    Some(hint)
 }
 
 fn check_positive(

@@ -44,6 +44,57 @@ pub fn clear_run_outputs(out: &Path) -> Result<Vec<PathBuf>, CliError> {
     Ok(removed)
 }
 
+/// Refuses an output folder that holds entries a run does not write (see [`run_outputs`]),
+/// unless `force`: a run into a folder of other work (`--out .` in a project folder, a
+/// mistyped path) would otherwise mix its outputs with files it does not own. Nothing is
+/// read or changed; a missing folder is fine. The error names the folder, up to three of
+/// the entries and how many there are, and the two ways on.
+pub fn check_owned(out: &Path, force: bool) -> Result<(), CliError> {
+    if force {
+        return Ok(());
+    }
+    let entries = match std::fs::read_dir(out) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(source) => {
+            return Err(CliError::Io {
+                path: out.display().to_string(),
+                source,
+            })
+        }
+    };
+    let owned = run_outputs(out);
+    let mut foreign: Vec<String> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| !owned.contains(p))
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    if foreign.is_empty() {
+        return Ok(());
+    }
+    foreign.sort();
+    let n = foreign.len();
+    let shown = foreign
+        .iter()
+        .take(3)
+        .map(|f| format!("`{f}`"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let more = if n > 3 {
+        format!(" and {} more", n - 3)
+    } else {
+        String::new()
+    };
+    Err(CliError::Message(format!(
+        "--out {}: the folder holds {n} entr{} a run does not write ({shown}{more}); give an \
+         empty or new folder, or --force to write the run's files beside them (they are left \
+         untouched)",
+        out.display(),
+        if n == 1 { "y" } else { "ies" }
+    )))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -77,6 +128,35 @@ mod tests {
             extensions.contains(&"program.mpf".to_string()) && extensions.len() >= 4,
             "{extensions:?}"
         );
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A folder of other work is refused before a run (issue 35: a run owns its folder, and
+    /// refuses one holding other files unless --force); a folder of run outputs only, an empty
+    /// or a missing one is fine.
+    #[test]
+    fn a_folder_of_other_files_is_refused_unless_forced() {
+        let d = std::env::temp_dir().join(format!("impeller-cam-owned-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        assert!(check_owned(&d, false).is_ok(), "missing folder");
+        std::fs::create_dir_all(&d).unwrap();
+        assert!(check_owned(&d, false).is_ok(), "empty folder");
+        for f in ["program.mpf", "report.html", "toolpath.cls"] {
+            std::fs::write(d.join(f), "x").unwrap();
+        }
+        assert!(check_owned(&d, false).is_ok(), "run outputs only");
+        for f in ["Cargo.toml", "a.txt", "b.txt", "c.txt"] {
+            std::fs::write(d.join(f), "x").unwrap();
+        }
+        std::fs::create_dir_all(d.join("src")).unwrap();
+        let e = check_owned(&d, false).unwrap_err().to_string();
+        assert!(
+            e.contains(
+                "holds 5 entries a run does not write (`Cargo.toml`, `a.txt`, `b.txt` and 2 more)"
+            ) && e.contains("--force"),
+            "{e}"
+        );
+        assert!(check_owned(&d, true).is_ok());
         std::fs::remove_dir_all(&d).unwrap();
     }
 }

@@ -487,7 +487,7 @@ fn ring_job(name: &str, cl: &str) -> PathBuf {
 
 /// [`ring_job`] with `extra` appended to the job file (e.g. a `[post]` table).
 fn ring_job_with(name: &str, cl: &str, extra: &str) -> PathBuf {
-    let dir = scratch(name);
+    let dir = scratch(name).keep();
     std::fs::write(dir.join("ring.cls"), cl).unwrap();
     let imp = repo().join("fixtures/impeller-8+8/impeller.toml");
     let machine = repo().join("fixtures/machines/xyzac-trt.toml");
@@ -676,8 +676,8 @@ fn an_unknown_dialect_is_refused_before_anything_runs() {
 }
 
 /// A run owns its output folder: a Sinumerik run into a folder a LinuxCNC run used leaves
-/// no `program.ngc` beside its `program.mpf` (it used to keep the old program); other files
-/// stay.
+/// no `program.ngc` beside its `program.mpf` (it used to keep the old program); a folder with
+/// other files is refused unless `--force`, and then they stay.
 #[test]
 fn a_run_removes_the_earlier_runs_program_of_another_dialect() {
     let job = ring_job("stale", &ring_cl());
@@ -687,7 +687,27 @@ fn a_run_removes_the_earlier_runs_program_of_another_dialect() {
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("program.ngc"), "G0 X0\n").unwrap();
     std::fs::write(out.join("mine.txt"), "keep").unwrap();
+    // A folder holding a file a run does not write is refused before anything runs ...
     let st = run_into(&job, &out);
+    assert_eq!(st.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("holds 1 entry a run does not write (`mine.txt`)") && err.contains("--force"),
+        "{err}"
+    );
+    assert!(
+        out.join("program.ngc").is_file(),
+        "nothing removed when refused"
+    );
+    // ... and with --force the run writes beside it.
+    let st = cli()
+        .arg("run")
+        .arg(&job)
+        .arg("--out")
+        .arg(&out)
+        .arg("--force")
+        .output()
+        .unwrap();
     assert!(
         st.status.success(),
         "{:?}: {}",

@@ -22,6 +22,10 @@ pub struct Args {
     /// still printed. Bars are drawn only when stderr is a terminal.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Write into an output folder that also holds files a run does not write (they are
+    /// left untouched); without it such a folder is refused before anything runs.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// What `impeller-cam run` ended with.
@@ -40,6 +44,7 @@ pub fn run(args: Args) -> Result<Outcome, CliError> {
         Some(p) => Job::from_file(p)?,
         None => Job::default_job()?,
     };
+    crate::outputs::check_owned(&args.out, args.force)?;
     job.verification.allow_defects = args.allow_defects;
     job.quiet = args.quiet;
     let report = crate::pipeline::run_job(&job, &args.out)?;

@@ -447,3 +447,27 @@ fn the_process_row_gives_the_coolant() {
     let err = err_of(&text);
     assert_at(&err, &text, "water", "operations[0].process.coolant");
 }
+
+/// `[operation.process]` under each `[[operations]]` (a singular typo) is one top-level table
+/// defined twice: the error says so and gives the spelling of the row's table; it used to say
+/// only `dir/job.toml:N: duplicate key`.
+#[test]
+fn a_row_table_under_a_singular_name_is_explained() {
+    let op = OP.replace("[operations.process]", "[operation.process]");
+    let text = format!("{TOOL}{op}{}", op.replace("name = \"a\"", "name = \"b\""));
+    let e = err_of(&text);
+    let second = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.contains("[operation.process]"))
+        .nth(1)
+        .unwrap()
+        .0
+        + 1;
+    let want = format!(
+        "dir/job.toml:{second}: the table `[operation.process]` is defined again (first at line {})",
+        line(&text, "[operation.process]")
+    );
+    assert!(e.starts_with(&want), "{e}");
+    assert!(e.contains("written `[operations.process]`"), "{e}");
+}

@@ -11,6 +11,16 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 #[derive(Debug)]
 pub struct Scratch(PathBuf);
 
+impl Scratch {
+    /// The folder's path, the folder kept after the test (for helpers that hand a file in
+    /// it back by path and cannot hold the guard).
+    pub fn keep(self) -> PathBuf {
+        let p = self.0.clone();
+        std::mem::forget(self);
+        p
+    }
+}
+
 impl std::ops::Deref for Scratch {
     type Target = PathBuf;
     fn deref(&self) -> &PathBuf {
