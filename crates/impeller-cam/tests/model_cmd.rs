@@ -56,15 +56,27 @@ fn user_errors_exit_1_with_one_line() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// `--fit-tol` sets the import fit tolerance: a tolerance below what the sample's data allow
+/// `--fit-tol` sets the import fit tolerance: a tolerance below what an export's data allow
 /// is a one-line error naming the section, data point and distance; the default succeeds; a
 /// parametric impeller refuses the option.
 #[test]
 fn fit_tol_option() {
-    let sample = format!(
-        "{}/../impeller-model/tests/data/tg-cylindrical/sample.inf",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    // NASA Rotor 37's TurboGrid export (the shared design data beside the repository; the
+    // small samples of impeller-model's tests either fit exactly or swing out of the
+    // impeller between sparse sections and are refused for that).
+    let Some(sample) = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .map(|a| a.join("shared/data/pyturbogrid-rotor37/BladeGen.inf"))
+        .find(|p| p.is_file())
+    else {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "CI=true but the shared design exports are missing"
+        );
+        eprintln!("skipping fit_tol_option: no shared/data beside the repository");
+        return;
+    };
+    let sample = sample.display().to_string();
     let ok = cli()
         .args(["model", &sample, "--json", "--fit-tol", "0.01"])
         .output()

@@ -244,3 +244,33 @@ fn own_hard_export_imports_within_tolerance() {
     let te = |s: &nurbs::NurbsSurface| s.point(1.0, 0.5);
     assert!((te(&b.pressure) - te(&b.suction)).norm() < 0.05);
 }
+
+/// The archive's as-manufactured tables (`cold_with_fillets`, with the design-intent hub and
+/// shroud) fit their points within 0.1 mm, but the splitter's pressure side swings out to
+/// r ≈ 2.7 m between its sections (fillet flares in some of them): the import refuses it,
+/// naming the blade side and how far it goes (it used to import with a blade tip Ø5621 mm).
+#[test]
+fn a_fit_that_swings_out_of_the_impeller_is_refused() {
+    use impeller_model::import::{import_raw, read_raw_with, LengthUnit, TableOptions};
+    let Some(data) = import_common::shared_data_or_skip("a_fit_that_swings_out") else {
+        return;
+    };
+    let hecc = data.join("nasa-hecc");
+    let opts = ImportOptions {
+        fit_tol_mm: 0.1,
+        tables: TableOptions {
+            unit: Some(LengthUnit::Inch),
+            blade_count: Some(15),
+            hub_file: Some(hecc.join("HECCvanedCoordinates_flowpathCoordinates_hub.txt")),
+            shroud_file: Some(hecc.join("HECCvanedCoordinates_flowpathCoordinates_shroud.txt")),
+            ..TableOptions::default()
+        },
+        ..ImportOptions::default()
+    };
+    let raw = read_raw_with(&hecc.join("cold_with_fillets"), &opts).unwrap();
+    let e = import_raw(&raw, &opts).unwrap_err().to_string();
+    assert!(
+        e.contains("blade \"splitter\" pressure side: the fitted surface leaves the impeller"),
+        "{e}"
+    );
+}

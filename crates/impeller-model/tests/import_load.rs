@@ -29,8 +29,18 @@ fn fixture_autoblade_loads() {
 fn exports_load_by_extension() {
     let imp = impeller_model::load(import_common::sample("sample-6+6.rtzt")).unwrap();
     assert_eq!(imp.summary().splitter_blade_count, 6);
-    let imp = impeller_model::load(import_common::sample("tg-cylindrical/sample.inf")).unwrap();
-    assert_eq!(imp.summary().splitter_blade_count, 6);
+    // The cylindrical TurboGrid sample is read (its coordinates converted), but its
+    // splitter's fitted suction side swings to z = 252 mm at mid-span near the trailing edge
+    // of this 42 mm impeller (three sparse sections; the fit meets every point within
+    // tolerance): the import refuses it by name instead of returning that surface.
+    let e = impeller_model::load(import_common::sample("tg-cylindrical/sample.inf"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tg-cylindrical/sample.inf")
+            && e.contains("blade \"splitter 1\" suction side: the fitted surface leaves"),
+        "{e}"
+    );
     if import_common::skip_without_shared_data() {
         return;
     }

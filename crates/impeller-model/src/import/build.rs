@@ -252,6 +252,73 @@ pub fn check_tolerance(fitted: &FittedImpeller) -> Result<(), ImportError> {
     }
 }
 
+/// Fails when a fitted blade side leaves the impeller's meridional extent by more than a
+/// fifth of that extent: the fit passes through every data point within tolerance, but
+/// sections too irregular for one surface (a fillet flare in one section, leading edges
+/// that jump between sections) can make it swing far between or beyond them. Each side is
+/// sampled on a 161 × 33 grid (u × v) over its whole domain (span extension included) against the
+/// hub and shroud curves sampled at 201 points: the extent is `E = max(R, Z₁ − Z₀)` with `R`
+/// their largest radius and `[Z₀, Z₁]` their axial range; a side point must have
+/// `r ≤ R + E/5` and `Z₀ − E/5 ≤ z ≤ Z₁ + E/5`. Cost 2·161·33 evaluations per blade.
+pub fn check_extent(fitted: &FittedImpeller) -> Result<(), ImportError> {
+    let (mut r_max, mut z0, mut z1) = (0.0f64, f64::INFINITY, f64::NEG_INFINITY);
+    for c in [&fitted.hub, &fitted.shroud] {
+        let (a, b) = c.domain();
+        for k in 0..=200 {
+            let p = c.point(a + (b - a) * k as f64 / 200.0);
+            r_max = r_max.max(p[1]);
+            z0 = z0.min(p[0]);
+            z1 = z1.max(p[0]);
+        }
+    }
+    let e = r_max.max(z1 - z0);
+    let slack = e / 5.0;
+    for b in &fitted.blades {
+        for (side, s) in [("pressure", &b.pressure), ("suction", &b.suction)] {
+            let ((u0, u1), (v0, v1)) = s.domain();
+            let mut worst: Option<(f64, nalgebra::Vector3<f64>, f64, f64)> = None;
+            for i in 0..=160 {
+                for j in 0..=32 {
+                    let (u, v) = (
+                        u0 + (u1 - u0) * i as f64 / 160.0,
+                        v0 + (v1 - v0) * j as f64 / 32.0,
+                    );
+                    let p = s.point(u, v);
+                    let r = (p.x * p.x + p.y * p.y).sqrt();
+                    let out = (r - r_max - slack)
+                        .max(z0 - slack - p.z)
+                        .max(p.z - z1 - slack);
+                    let outside = !out.is_finite() || out > 0.0;
+                    if outside && worst.is_none_or(|(w, ..)| out > w || !out.is_finite()) {
+                        worst = Some((out, p, u, v));
+                    }
+                }
+            }
+            if let Some((_, p, u, v)) = worst {
+                return Err(ImportError::Geometry {
+                    file: fitted.source.clone(),
+                    entity: format!("blade {:?} {side} side", b.name),
+                    reason: format!(
+                        "the fitted surface leaves the impeller: at (u, v) = ({u:.3}, \
+                         {v:.3}) it reaches ({:.1}, {:.1}, {:.1}) mm (r = {:.1} mm), while hub and shroud span r ≤ {:.1} mm and \
+                         z {:.1} to {:.1} mm (more than a fifth of that extent beyond them): \
+                         its sections are too irregular for one surface through all of them \
+                         (a fillet flare in some sections, edges that jump between sections)",
+                        p.x,
+                        p.y,
+                        p.z,
+                        (p.x * p.x + p.y * p.y).sqrt(),
+                        r_max,
+                        z0,
+                        z1
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// A length for a message: 4 decimals from 1 µm up, else 3 significant digits.
 fn short_mm(x: f64) -> String {
     if x.abs() >= 1e-3 {
@@ -266,6 +333,7 @@ pub fn import_raw(raw: &RawImpeller, opts: &ImportOptions) -> Result<Imported, I
     let prepared = prepare(raw, opts.trim_margin)?;
     let fitted = fit(&prepared, opts.fit_tol_mm, opts.span_extension)?;
     check_tolerance(&fitted)?;
+    check_extent(&fitted)?;
     let impeller = assemble(&fitted, opts)?;
     Ok(Imported { impeller, fitted })
 }
