@@ -263,12 +263,13 @@ fn find_fixtures(dir: &Path, filter: Option<&str>) -> Result<Vec<FixtureJob>, St
 }
 
 /// The `[import] file` of a fixture's `impeller.toml` when it cannot be found in any folder
-/// above the fixture (how the importer resolves it).
+/// above the fixture (how the importer resolves it): an export file or a folder of section
+/// tables (the NASA HECC archive).
 fn missing_import(dir: &Path) -> Option<String> {
     let text = std::fs::read_to_string(dir.join("impeller.toml")).ok()?;
     let v: toml::Value = toml::from_str(&text).ok()?;
     let file = v.get("import")?.get("file")?.as_str()?.to_string();
-    let found = dir.ancestors().any(|a| a.join(&file).is_file());
+    let found = dir.ancestors().any(|a| a.join(&file).exists());
     (!found).then_some(file)
 }
 
