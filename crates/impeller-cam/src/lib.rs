@@ -25,6 +25,7 @@ pub mod setup;
 pub mod surface_groups;
 pub mod travel;
 pub mod verdict;
+pub mod view3d;
 
 pub use error::CliError;
 pub use job::Job;

@@ -131,6 +131,7 @@ fn run_stages(job: &Job, out: &Path, registry: &Registry) -> Result<Report, CliE
     let impeller = model(job)?;
     report.impeller = serde_json::to_value(impeller.summary()).map_err(msg)?;
     report.set_geometry_plots(&impeller);
+    report.view.set_part(&impeller);
     report.timings_ms.insert("model_ms".into(), ms(t));
 
     let t = stage(&progress, "planning operations");
@@ -144,6 +145,7 @@ fn run_stages(job: &Job, out: &Path, registry: &Registry) -> Result<Report, CliE
     for op in &operations {
         report.operations.push(op.report());
         report.add_operation_plots(&impeller, op);
+        report.view.add_operation(op);
     }
     report.timings_ms.insert("plan_ms".into(), ms(t));
 
@@ -1088,6 +1090,7 @@ pub fn verify(
         }),
     });
     report.add_map_plots(&rep.maps);
+    crate::view3d::add_verification(&mut report.view, &stock, &rep, job, limit);
     Ok(())
 }
 

@@ -200,6 +200,9 @@ pub struct Report {
     /// The setup sheet's section ([`crate::setup`]), also written as `setup.html`.
     #[serde(skip)]
     pub setup: String,
+    /// The interactive 3D view's scene ([`crate::view3d`]).
+    #[serde(skip)]
+    pub view: crate::view3d::Scene,
     #[serde(skip)]
     plots: Vec<String>,
     #[serde(skip)]
@@ -222,6 +225,7 @@ impl Report {
             timings_ms: BTreeMap::new(),
             notes: Vec::new(),
             setup: String::new(),
+            view: crate::view3d::Scene::default(),
             plots: Vec::new(),
             post_plots: Vec::new(),
             operation_plots: Vec::new(),
@@ -515,14 +519,16 @@ impl Report {
             "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{0} — impeller-cam report</title>\
              <style>body{{font-family:sans-serif;max-width:1200px;margin:2em auto}}\
              table{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}\
-             th{{background:#f3f3f3}}td:first-child{{text-align:left}}</style></head><body>\
+             th{{background:#f3f3f3}}td:first-child{{text-align:left}}{2}</style></head><body>\
              <h1>{0}</h1><p>impeller-cam {1}</p>",
             esc(&self.job),
-            esc(&self.version)
+            esc(&self.version),
+            crate::view3d::CSS
         );
         if let Some(v) = &self.verdict {
             verdict_html(&mut h, v, &self.post.program);
         }
+        h.push_str(&self.view.html());
         h.push_str(&self.setup);
         h.push_str("<h2>Impeller</h2>");
         table_of_object(&mut h, &self.impeller);
