@@ -4,7 +4,9 @@
 // script imported through a blob URL): no network.
 //
 // URL hash (for links and screenshots): #view3d (the view alone, full window), move=K
-// (slider at global move K), focus=overall|tool|marker:N, part=0|1, stock=0|1, links=0|1.
+// (slider at global move K), focus=overall|tool|op:NAME (its middle move, beside the
+// tool)|marker:N|marker:KIND (the first overcut/residual/collision marker), part=0|1,
+// stock=0|1, shroud=0|1, links=0|1, upto=0|1 (paths up to the current move only).
 // After its first frame the view sets on #view3d: data-drawn="1", data-frames,
 // data-first-frame-ms (since navigation start), data-move, data-nonblank (fraction of
 // sampled canvas pixels unlike the background), data-colours (distinct colours among them,
@@ -265,7 +267,8 @@
       const list = document.createElement('ol');
       list.style.paddingLeft = '18px';
       panel.appendChild(list);
-      const size = Math.max(box.getSize(new THREE.Vector3()).length() * 0.006, 0.2);
+      // Unit spheres scaled before each frame to about 7 px radius (see redraw).
+      const size = 1;
       const colours = { overcut: 0xd90d0d, residual: 0x2040c0, collision: 0x9900cc };
       data.markers.forEach((m, k) => {
         const p = new THREE.Vector3(m.point[0] - centre[0], m.point[1] - centre[1], m.point[2] - centre[2]);
@@ -352,18 +355,40 @@
     function goToMarker(k) {
       const mk = markers[k];
       if (!mk) return;
-      if (mk.m.move !== null) setMove(mk.m.move);
-      look(mk.p, 25);
+      if (mk.m.move === null) { look(mk.p, 25); return; }
+      setMove(mk.m.move);
+      viewAlong(mk.p, axisAt(mk.m.move));
+    }
+    function axisAt(g) {
+      const o = opOf(g);
+      const i = g - o.op.first_move;
+      return new THREE.Vector3(o.ax[3 * i], o.ax[3 * i + 1], o.ax[3 * i + 2]).normalize();
+    }
+    // Looks at `target` down the tool axis `a`, 25 degrees off it (the tool reached there, so
+    // the line of sight along it is mostly clear), 18 mm away (below a holder), from the
+    // first of eight sides around the axis whose line of sight no visible surface blocks.
+    function viewAlong(target, a) {
+      const side = new THREE.Vector3().crossVectors(a, new THREE.Vector3(0, 0, 1));
+      if (side.lengthSq() < 1e-6) side.set(1, 0, 0);
+      side.normalize();
+      const off = THREE.MathUtils.degToRad(25), distance = 18;
+      const solids = [part, stock].filter((m) => m && m.visible);
+      const ray = new THREE.Raycaster();
+      const at = (k) => a.clone().multiplyScalar(Math.cos(off))
+        .addScaledVector(side.clone().applyAxisAngle(a, k * Math.PI / 4), Math.sin(off));
+      let dir = null;
+      for (let k = 0; k < 8 && !dir; k++) {
+        const d = at(k);
+        ray.set(target.clone().addScaledVector(d, 0.5), d);
+        ray.far = distance;
+        if (!ray.intersectObjects(solids).length) dir = d;
+      }
+      look(target, distance, dir || at(0));
     }
     function focusTool() {
       const o = opOf(current);
       const i = current - o.op.first_move;
-      const a = new THREE.Vector3(o.ax[3 * i], o.ax[3 * i + 1], o.ax[3 * i + 2]).normalize();
-      // Look from the side of the tool, a little from above.
-      const side = new THREE.Vector3().crossVectors(a, new THREE.Vector3(0, 0, 1));
-      if (side.lengthSq() < 1e-6) side.set(1, 0, 0);
-      look(new THREE.Vector3(o.tips[3 * i], o.tips[3 * i + 1], o.tips[3 * i + 2]), 30,
-        side.normalize().addScaledVector(a, 0.6));
+      viewAlong(new THREE.Vector3(o.tips[3 * i], o.tips[3 * i + 1], o.tips[3 * i + 2]), axisAt(current));
     }
     renderer.domElement.addEventListener('click', (e) => {
       const r = renderer.domElement.getBoundingClientRect();
@@ -393,6 +418,10 @@
           const p = new Uint8Array(4);
           gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, p);
           clearPixel = [p[0], p[1], p[2]];
+        }
+        const pxAngle = THREE.MathUtils.degToRad(camera.fov) / Math.max(container.clientHeight, 1);
+        for (const mk of markers) {
+          mk.mesh.scale.setScalar(7 * pxAngle * camera.position.distanceTo(mk.p));
         }
         renderer.render(scene, camera);
         frames++;
@@ -429,7 +458,16 @@
     setMove(params.move !== undefined ? Number(params.move) : 0);
     const focus = params.focus || 'overall';
     if (focus === 'tool') focusTool();
-    else if (focus.startsWith('marker:')) goToMarker(Number(focus.slice(7)));
+    else if (focus.startsWith('op:')) {
+      // The middle move of the named operation, seen beside the tool.
+      const o = ops.find((q) => q.op.name === focus.slice(3));
+      if (o && params.move === undefined) setMove(o.op.first_move + Math.floor(o.n / 2));
+      focusTool();
+    } else if (focus.startsWith('marker:')) {
+      const key = focus.slice(7);
+      const k = /^[0-9]+$/.test(key) ? Number(key) : data.markers.findIndex((m) => m.kind === key);
+      goToMarker(k);
+    }
     redraw();
   }
   main().catch((e) => recordError((e && (e.stack || e.message)) || e));

@@ -66,6 +66,12 @@ pub struct Job {
     pub post: PostSpec,
     /// No progress on stderr (`run --quiet`; not a job-file key).
     pub quiet: bool,
+    /// Also write the machined stock's surface as `stock.stl` (`run --export-stock`; not a
+    /// job-file key).
+    pub export_stock: bool,
+    /// Also write the tool paths as `toolpaths.gltf` (`run --export-paths`; not a job-file
+    /// key).
+    pub export_paths: bool,
     /// The tools (inline `[[tools]]` or a tool file).
     pub tools: Vec<Tool>,
     /// The operations in machining order (kinds checked against the registry the job was
@@ -1046,6 +1052,8 @@ impl Job {
             verification: v,
             post: raw.post,
             quiet: false,
+            export_stock: false,
+            export_paths: false,
             tools,
             operations,
             coolant,

@@ -14,6 +14,7 @@
 pub mod cmd;
 pub mod cycle;
 pub mod error;
+pub mod gltf;
 pub mod job;
 pub mod outputs;
 pub mod pipeline;

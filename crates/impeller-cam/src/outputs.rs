@@ -7,10 +7,12 @@
 use crate::error::CliError;
 use std::path::{Path, PathBuf};
 
-/// Files of a run other than the program: CL data, verification maps, reports.
-const RUN_FILES: [&str; 5] = [
+/// Files of a run other than the program: CL data, verification maps, exports, reports.
+const RUN_FILES: [&str; 7] = [
     "toolpath.cls",
     "verification_maps.json",
+    "stock.stl",
+    "toolpaths.gltf",
     "report.json",
     "report.html",
     "setup.html",

@@ -147,6 +147,10 @@ fn run_stages(job: &Job, out: &Path, registry: &Registry) -> Result<Report, CliE
         report.add_operation_plots(&impeller, op);
         report.view.add_operation(op);
     }
+    if job.export_paths {
+        let doc = crate::gltf::toolpaths(&operations).to_string();
+        gcode_emit::write_atomic(&out.join("toolpaths.gltf"), doc.as_bytes()).map_err(msg)?;
+    }
     report.timings_ms.insert("plan_ms".into(), ms(t));
 
     let t = stage(&progress, "post-processing");
@@ -1090,6 +1094,13 @@ pub fn verify(
         }),
     });
     report.add_map_plots(&rep.maps);
+    if job.export_stock {
+        // The lattice of `impeller-cam verify`'s stock.stl.
+        let stride = (0.3 / job.verification.resolution_mm).round().max(1.0) as usize;
+        let mesh = machining_sim::extract_surface(&stock, stride);
+        machining_sim::write_stl(&mesh, &out.join("stock.stl"), "impeller-cam run stock")
+            .map_err(msg)?;
+    }
     crate::view3d::add_verification(&mut report.view, &stock, &rep, job, limit);
     Ok(())
 }

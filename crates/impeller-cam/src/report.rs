@@ -3,7 +3,7 @@
 
 use crate::error::CliError;
 use crate::pipeline::JobOperation;
-use crate::plot::{heat_map, line_chart, Series};
+use crate::plot::{heat_map, human_label, line_chart, Scale, Series};
 use cam_core::MoveKind;
 use cam_plan::{PlotKind, PlotSeries};
 use impeller_model::{Impeller, Side};
@@ -451,14 +451,49 @@ impl Report {
                 p.name, p.metrics.reverse_motions_before
             )
         };
-        let mut h = format!("<h3>{}</h3><p>Rotary axes (deg)</p>", esc(&caption));
-        h.push_str(&postproc_kinematics::plot::displacement_svg(
-            &p.after, before, true, 900, 300,
-        ));
-        h.push_str("<p>All axes (mm; deg)</p>");
-        h.push_str(&postproc_kinematics::plot::displacement_svg(
-            &p.after, before, false, 900, 300,
-        ));
+        let mut h = format!("<h3>{}</h3>", esc(&caption));
+        for rotary_only in [true, false] {
+            let cols: &[usize] = if rotary_only {
+                &[3, 4]
+            } else {
+                &[0, 1, 2, 3, 4]
+            };
+            let mut series = Vec::new();
+            for (curves, when) in before
+                .map(|b| (b, " before removal"))
+                .into_iter()
+                .chain([(&p.after, "")])
+            {
+                // At most 2000 points per curve (every k-th block, and the last).
+                let n = curves.values.len().min(curves.path_length_mm.len());
+                let step = n.div_ceil(2000).max(1);
+                for &k in cols {
+                    let letter = curves.letters.get(k).copied().unwrap_or('?');
+                    series.push(Series {
+                        label: format!("{letter}{when}"),
+                        points: (0..n)
+                            .filter(|i| i % step == 0 || i + 1 == n)
+                            .map(|i| (curves.path_length_mm[i], curves.values[i][k]))
+                            .collect(),
+                    });
+                }
+            }
+            h.push_str(&line_chart(
+                if rotary_only {
+                    "Rotary axes"
+                } else {
+                    "All axes (linear in mm, rotary in deg)"
+                },
+                "tool-tip path length (mm)",
+                if rotary_only {
+                    "angle (deg)"
+                } else {
+                    "position (mm; deg)"
+                },
+                &series,
+                false,
+            ));
+        }
         self.post_plots.push(h);
     }
 
@@ -494,12 +529,24 @@ impl Report {
                     })
                     .collect();
                 let title = format!(
-                    "{} on {} (u along the flow → , v up)",
+                    "{} on {}",
                     if residual { "Residual" } else { "Overcut" },
                     m.name
                 );
-                self.plots
-                    .push(heat_map(&title, &grid, 0.0, worst(m, residual), "mm"));
+                self.plots.push(heat_map(
+                    &title,
+                    &grid,
+                    0.0,
+                    worst(m, residual),
+                    "mm",
+                    if residual {
+                        Scale::Residual
+                    } else {
+                        Scale::Overcut
+                    },
+                    "u sample (along the flow)",
+                    "v sample",
+                ));
             }
         }
     }
@@ -652,7 +699,16 @@ fn render_plot(plot: &cam_plan::Plot) -> String {
                 (a.min(v), b.max(v))
             });
             let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 1.0) };
-            heat_map(&plot.title, values, lo, hi, unit)
+            heat_map(
+                &plot.title,
+                values,
+                lo,
+                hi,
+                unit,
+                Scale::Sequential,
+                "column",
+                "row",
+            )
         }
     }
 }
@@ -693,7 +749,13 @@ fn table_of_object(h: &mut String, v: &serde_json::Value) {
                 serde_json::Value::String(s) => s.clone(),
                 other => other.to_string(),
             };
-            let _ = write!(h, "<tr><td>{}</td><td>{}</td></tr>", esc(k), esc(&text));
+            let _ = write!(
+                h,
+                "<tr><td title=\"{}\">{}</td><td>{}</td></tr>",
+                esc(k),
+                esc(&human_label(k)),
+                esc(&text)
+            );
         }
         h.push_str("</table>");
     }

@@ -16,9 +16,13 @@
 //!
 //! **Stock deviation.** Each vertex of the machined stock's surface (surface nets on the
 //! verifier's tri-dexel stock, [`machining_sim::extract_surface`], at a lattice of at least
-//! [`STOCK_SPACING_MM`]) takes the signed deviation of the nearest sample of the
-//! verification maps (`verification_maps.json`): residual thickness (+) or overcut depth (−)
-//! measured along the design surface's normal there. Vertices farther than
+//! [`STOCK_SPACING_MM`]) takes the signed deviation of the verification maps' samples
+//! (`verification_maps.json`) nearest it: residual thickness (+) or overcut depth (−)
+//! measured along the design surface's normal there; of the samples within one lattice
+//! spacing of the nearest distance, the worst (an overcut beyond `machining_tol` before
+//! anything else, otherwise the larger magnitude), so that in a corner (blade root) the worse
+//! of the two surfaces shows. Vertices
+//! farther than
 //! [`STOCK_NEAR_MM`] from every sample (blank material away from the design surfaces) are not
 //! measured and drawn neutral. The nearest sample is found in a uniform hash grid of cell
 //! [`STOCK_NEAR_MM`] (3×3×3 neighbouring cells), O(V + S) on average for V vertices and S
@@ -191,7 +195,14 @@ impl Scene {
             stride *= 2;
             mesh = machining_sim::extract_surface(stock, stride);
         }
-        let deviation = nearest_deviation(&mesh.vertices, maps, STOCK_NEAR_MM);
+        let spacing_mm = stride as f64 * h;
+        let deviation = nearest_deviation(
+            &mesh.vertices,
+            maps,
+            STOCK_NEAR_MM,
+            spacing_mm,
+            machining_tol_mm,
+        );
         self.stock = Some(StockView {
             vertices: mesh.vertices,
             triangles: mesh.triangles,
@@ -199,7 +210,7 @@ impl Scene {
             overcut_limit_mm,
             machining_tol_mm,
             resolution_mm: h,
-            spacing_mm: stride as f64 * h,
+            spacing_mm,
         });
     }
 
@@ -506,13 +517,31 @@ pub fn sample_deviation(overcut: Option<f64>, residual: Option<f64>) -> Option<f
     }
 }
 
-/// For each vertex, the deviation of the nearest measured verification sample within
-/// `near` mm (see the module docs).
+/// The order of badness of deviations: an overcut deeper than `tol` (the job's
+/// `machining_tol`) is worse than anything else, the deeper the worse; otherwise the larger
+/// magnitude is worse (a 0.0003 mm overcut does not hide a 0.25 mm residual).
+pub fn badness(d: f64, tol: f64) -> f64 {
+    if d < -tol {
+        1.0e6 - d
+    } else {
+        d.abs()
+    }
+}
+
+/// For each vertex, the worst ([`badness`] with `tol`) deviation among the measured
+/// verification samples within `band` mm of its nearest one, all within `near` mm (see the
+/// module docs);
+/// `None` when no sample is that near. The band (one stock lattice spacing) keeps a corner
+/// (a blade root, where the blade's and the hub's samples are about as near) from hiding
+/// the worse of the two.
 pub fn nearest_deviation(
     vertices: &[[f64; 3]],
     maps: &[machining_sim::SurfaceMap],
     near: f64,
+    band: f64,
+    tol: f64,
 ) -> Vec<Option<f64>> {
+    use rayon::prelude::*;
     use std::collections::HashMap;
     let cell = |p: &[f64; 3]| -> [i64; 3] { p.map(|c| (c / near).floor() as i64) };
     let mut grid: HashMap<[i64; 3], Vec<([f64; 3], f64)>> = HashMap::new();
@@ -525,28 +554,30 @@ pub fn nearest_deviation(
             }
         }
     }
-    let near2 = near * near;
     vertices
-        .iter()
+        .par_iter()
         .map(|v| {
             let c = cell(v);
-            let mut best: Option<(f64, f64)> = None;
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        let Some(list) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
-                            continue;
-                        };
-                        for (p, d) in list {
-                            let e = (0..3).map(|k| (p[k] - v[k]).powi(2)).sum::<f64>();
-                            if e <= near2 && best.is_none_or(|(b, _)| e < b) {
-                                best = Some((e, *d));
-                            }
-                        }
-                    }
-                }
-            }
-            best.map(|(_, d)| d)
+            let around = || {
+                (-1..=1)
+                    .flat_map(move |dx| {
+                        (-1..=1).flat_map(move |dy| (-1..=1).map(move |dz| [dx, dy, dz]))
+                    })
+                    .filter_map(|d: [i64; 3]| grid.get(&[c[0] + d[0], c[1] + d[1], c[2] + d[2]]))
+                    .flatten()
+                    .map(|(p, d)| {
+                        (
+                            ((0..3).map(|k| (p[k] - v[k]).powi(2)).sum::<f64>()).sqrt(),
+                            *d,
+                        )
+                    })
+                    .filter(|(e, _)| *e <= near)
+            };
+            let nearest = around().map(|(e, _)| e).fold(f64::INFINITY, f64::min);
+            around()
+                .filter(|(e, _)| *e <= nearest + band)
+                .map(|(_, d)| d)
+                .max_by(|a, b| badness(*a, tol).total_cmp(&badness(*b, tol)))
         })
         .collect()
 }

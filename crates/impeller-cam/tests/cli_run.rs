@@ -205,8 +205,10 @@ fn c_axis_swing_is_removed_checked_posted_and_verified() {
     assert!(op["max_contact_shift_mm"].as_f64().unwrap() <= 1e-9, "{op}");
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains(&format!("reverse motions {before} → 0")));
+    // Both displacement plots (rotary axes, all axes) carry the curves before removal
+    // (dashed, legend "C before removal") beside those after.
     assert!(
-        html.matches("dashed: before").count() >= 2,
+        html.matches("C before removal</text>").count() >= 2,
         "before/after plots"
     );
 }

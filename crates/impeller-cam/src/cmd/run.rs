@@ -26,6 +26,15 @@ pub struct Args {
     /// left untouched); without it such a folder is refused before anything runs.
     #[arg(long)]
     pub force: bool,
+    /// Also write the machined stock from verification as `stock.stl` (binary STL, surface
+    /// nets on the verifier's dexels at a 0.3 mm lattice or the verification resolution if
+    /// coarser), to open in other viewers.
+    #[arg(long)]
+    pub export_stock: bool,
+    /// Also write the tool paths as `toolpaths.gltf` (glTF 2.0 line primitives per
+    /// operation: cutting moves in the operation's colour, links and rapids grey).
+    #[arg(long)]
+    pub export_paths: bool,
 }
 
 /// What `impeller-cam run` ended with.
@@ -47,6 +56,8 @@ pub fn run(args: Args) -> Result<Outcome, CliError> {
     crate::outputs::check_owned(&args.out, args.force)?;
     job.verification.allow_defects = args.allow_defects;
     job.quiet = args.quiet;
+    job.export_stock = args.export_stock;
+    job.export_paths = args.export_paths;
     let report = crate::pipeline::run_job(&job, &args.out)?;
     for n in &report.notes {
         eprintln!("[impeller-cam] note: {n}");
