@@ -4,9 +4,10 @@
 #
 #   sh docs/view3d-screenshots.sh [OUT_DIR]     (from the repository root; default docs/images)
 #
-# Writes OUT_DIR/view3d-overall.png, view3d-blade-root.png (the blade-root finishing tool at
-# its operation's middle move) and view3d-worst-residual.png (the largest residual's marker),
-# 1280 x 800 px each. Needs `chromium` (Debian package) on PATH.
+# Writes OUT_DIR/view3d-overall.png (the tool in the middle of roughing),
+# view3d-blade-root.png (the blade-root finishing tool in the middle of its operation, seen
+# down the tool) and view3d-worst-residual.png (the largest residual's marker and the move
+# nearest it), 1280 x 800 px each. Needs `chromium` (Debian package) on PATH.
 set -eu
 out=${1:-docs/images}
 mkdir -p "$out"
@@ -14,7 +15,7 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/view3d-shots.XXXXXX")
 cargo build --release -q -p impeller-cam
 ./target/release/impeller-cam run --out "$work/out" --quiet
 report="$work/out/report.html"
-for shot in "overall:focus=overall" "blade-root:focus=op:blade-root&part=1&stock=0&links=0" \
+for shot in "overall:focus=overall&at=rough" "blade-root:focus=op:blade-root&part=1&stock=0&links=0" \
     "worst-residual:focus=marker:residual"; do
     name=${shot%%:*}
     hash=${shot#*:}

@@ -4,8 +4,10 @@
 // script imported through a blob URL): no network.
 //
 // URL hash (for links and screenshots): #view3d (the view alone, full window), move=K
-// (slider at global move K), focus=overall|tool|op:NAME (its middle move, beside the
-// tool)|marker:N|marker:KIND (the first overcut/residual/collision marker), part=0|1,
+// (slider at global move K), at=NAME (slider at that operation's first feed move from its
+// middle on),
+// focus=overall|tool|op:NAME (its first feed move from the
+// middle on, seen down the tool)|marker:N|marker:KIND (the first overcut/residual/collision marker), part=0|1,
 // stock=0|1, shroud=0|1, links=0|1, upto=0|1 (paths up to the current move only).
 // After its first frame the view sets on #view3d: data-drawn="1", data-frames,
 // data-first-frame-ms (since navigation start), data-move, data-nonblank (fraction of
@@ -182,7 +184,7 @@
       };
       const cutLines = lines(cut, new THREE.LineBasicMaterial({ color: op.colour }));
       const linkLines = lines(link, new THREE.LineBasicMaterial({
-        color: 0x999999, transparent: true, opacity: 0.6 }));
+        color: 0x999999, transparent: true, opacity: 0.35 }));
       if (cut.length) { cutLines.geometry.computeBoundingBox(); box.union(cutLines.geometry.boundingBox); }
       // The tool: cutter, shank and holder revolved about +Y, turned onto the axis.
       const tool = new THREE.Group();
@@ -237,9 +239,9 @@
       }
       const ticks = document.createElement('div');
       ticks.style.position = 'relative'; ticks.style.height = '28px'; ticks.style.width = '262px';
-      const at = (d, text) => {
+      const at = (d, text, row) => {
         const s = document.createElement('span');
-        s.style.position = 'absolute'; s.style.top = '0'; s.style.whiteSpace = 'nowrap';
+        s.style.position = 'absolute'; s.style.top = (row ? 13 : 0) + 'px'; s.style.whiteSpace = 'nowrap';
         s.style.fontSize = '10px';
         s.style.left = Math.round(260 * (d - lo) / (hi - lo)) + 'px';
         s.style.transform = 'translateX(-50%)';
@@ -247,7 +249,7 @@
         ticks.appendChild(s);
       };
       at(-st.overcut_limit_mm, '\u2212' + st.overcut_limit_mm.toFixed(3));
-      at(st.machining_tol_mm, '\u00b1' + st.machining_tol_mm);
+      at(st.machining_tol_mm, '\u00b1' + st.machining_tol_mm, 1);
       at(hi, hi.toFixed(2));
       at(hi / 2, (hi / 2).toFixed(2));
       panel.appendChild(ticks);
@@ -350,7 +352,7 @@
     function overall() {
       const c = box.isEmpty() ? new THREE.Vector3() : box.getCenter(new THREE.Vector3());
       const r = box.isEmpty() ? 50 : box.getSize(new THREE.Vector3()).length() / 2;
-      look(c, 1.25 * r / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)));
+      look(c, 1.05 * r / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)));
     }
     function goToMarker(k) {
       const mk = markers[k];
@@ -455,13 +457,25 @@
     if (window.ResizeObserver) new ResizeObserver(resize).observe(container);
     resize();
     overall();
-    setMove(params.move !== undefined ? Number(params.move) : 0);
+    const atOp = params.at !== undefined ? ops.find((q) => q.op.name === params.at) : undefined;
+    if (params.move !== undefined) setMove(Number(params.move));
+    else if (atOp) {
+      // The first feed move from the operation's middle on.
+      let i = Math.floor(atOp.n / 2);
+      while (i + 1 < atOp.n && atOp.kinds[i] !== 2) i++;
+      setMove(atOp.op.first_move + i);
+    }
+    else setMove(0);
     const focus = params.focus || 'overall';
     if (focus === 'tool') focusTool();
     else if (focus.startsWith('op:')) {
       // The middle move of the named operation, seen beside the tool.
       const o = ops.find((q) => q.op.name === focus.slice(3));
-      if (o && params.move === undefined) setMove(o.op.first_move + Math.floor(o.n / 2));
+      if (o && params.move === undefined) {
+        let i = Math.floor(o.n / 2);
+        while (i + 1 < o.n && o.kinds[i] !== 2) i++;
+        setMove(o.op.first_move + i);
+      }
       focusTool();
     } else if (focus.startsWith('marker:')) {
       const key = focus.slice(7);
