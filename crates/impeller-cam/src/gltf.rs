@@ -161,46 +161,29 @@ mod tests {
             plots: Vec::new(),
         };
         let doc = toolpaths(std::slice::from_ref(&op));
-        let uri = doc["buffers"][0]["uri"].as_str().unwrap();
-        let b64 = uri
-            .strip_prefix("data:application/octet-stream;base64,")
-            .unwrap();
-        assert_eq!(b64, crate::view3d::base64(&decode_for_test(b64)));
-        let bytes = decode_for_test(b64);
-        assert_eq!(doc["buffers"][0]["byteLength"], bytes.len());
-        let floats: Vec<f32> = bytes
-            .chunks(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        // Cutting: plunge, feed, feed (3 segments); links: the retract (1 segment); in order.
+        let tips = [
+            [0.0f32, 1.5, 50.0],
+            [0.0, 1.5, 10.0],
+            [5.0, 1.5, 10.0],
+            [9.25, 1.5, 11.0],
+            [9.25, 1.5, 50.0],
+        ];
+        let order = [0, 1, 1, 2, 2, 3, 3, 4];
+        let bytes: Vec<u8> = order
+            .iter()
+            .flat_map(|&i| tips[i].iter().flat_map(|c| c.to_le_bytes()))
             .collect();
-        // Cutting: plunge, feed, feed = 3 segments; links: the retract = 1 segment.
+        let uri = doc["buffers"][0]["uri"].as_str().unwrap();
+        assert_eq!(
+            uri.strip_prefix("data:application/octet-stream;base64,"),
+            Some(crate::view3d::base64(&bytes).as_str())
+        );
+        assert_eq!(doc["buffers"][0]["byteLength"], bytes.len());
         assert_eq!(doc["accessors"][0]["count"], 6);
         assert_eq!(doc["accessors"][1]["count"], 2);
-        assert_eq!(&floats[..6], &[0.0, 1.5, 50.0, 0.0, 1.5, 10.0]);
-        assert_eq!(&floats[18..24], &[9.25, 1.5, 11.0, 9.25, 1.5, 50.0]);
+        assert_eq!(doc["bufferViews"][1]["byteOffset"], 6 * 12);
         assert_eq!(doc["accessors"][0]["max"][0], 9.25);
         assert_eq!(doc["meshes"][0]["primitives"][1]["material"], 0);
-    }
-
-    fn decode_for_test(s: &str) -> Vec<u8> {
-        let val = |c: u8| -> u32 {
-            match c {
-                b'A'..=b'Z' => u32::from(c - b'A'),
-                b'a'..=b'z' => u32::from(c - b'a') + 26,
-                b'0'..=b'9' => u32::from(c - b'0') + 52,
-                b'+' => 62,
-                _ => 63,
-            }
-        };
-        let mut out = Vec::new();
-        for chunk in s.as_bytes().chunks(4) {
-            let pad = chunk.iter().filter(|&&c| c == b'=').count();
-            let n = chunk
-                .iter()
-                .filter(|&&c| c != b'=')
-                .fold(0u32, |n, &c| (n << 6) | val(c))
-                << (6 * pad);
-            out.extend_from_slice(&[(n >> 16) as u8, (n >> 8) as u8, n as u8][..3 - pad]);
-        }
-        out
     }
 }

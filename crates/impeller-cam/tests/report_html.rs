@@ -1,9 +1,13 @@
 //! `report.html` as a person sees it: rendered by headless Chromium (Debian `chromium`), the
-//! DOM after rendering must hold every plot of the file, each with drawn content.
+//! DOM after rendering must hold every plot of the file, each with drawn content, and the 3D
+//! view must draw (WebGL on Chromium's software rasteriser); the 3D view's data must agree
+//! with the CL file and the verification maps.
 //!
-//! Without `chromium` on PATH the test prints that it was skipped; under CI (`CI=true`) it
-//! fails instead (`cargo xtask ci` installs it).
+//! Without `chromium` on PATH the rendering tests print that they were skipped; under CI
+//! (`CI=true`) they fail instead (`cargo xtask ci` installs it).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test helpers
+
+mod common;
 
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
@@ -15,6 +19,38 @@ fn chromium() -> Option<PathBuf> {
             .map(|d| d.join(name))
             .find(|p| p.is_file())
     })
+}
+
+/// The DOM of `url` after headless Chromium rendered it (`extra`: flags beyond the common
+/// ones); fails the test when Chromium fails.
+fn dump_dom(
+    browser: &std::path::Path,
+    profile: &std::path::Path,
+    url: &str,
+    extra: &[&str],
+) -> String {
+    let r = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+        ])
+        .args(extra)
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg("--dump-dom")
+        .arg(url)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    assert!(
+        r.status.success(),
+        "chromium failed on {url}: {}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    String::from_utf8_lossy(&r.stdout).into_owned()
 }
 
 fn under_ci() -> bool {
@@ -90,29 +126,12 @@ fn report_html_renders_every_plot_in_headless_chromium() {
     let plots = svgs(&written).len();
     assert!(plots >= 1, "report.html holds no plot");
     let profile = dir.join("profile");
-    let r = Command::new(&browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg("--dump-dom")
-        .arg(format!("file://{}", file.display()))
-        .stdin(Stdio::null())
-        .output()
-        .unwrap();
-    assert!(
-        r.status.success(),
-        "chromium failed: {}",
-        String::from_utf8_lossy(&r.stderr)
+    let dom = dump_dom(
+        &browser,
+        &profile,
+        &format!("file://{}", file.display()),
+        &["--disable-gpu", "--disable-quic"],
     );
-    let dom = String::from_utf8_lossy(&r.stdout);
     assert!(dom.contains("<body"), "no rendered document:\n{dom}");
     let rendered = svgs(&dom);
     assert_eq!(rendered.len(), plots, "plots in the rendered DOM");
@@ -122,21 +141,12 @@ fn report_html_renders_every_plot_in_headless_chromium() {
     // The setup sheet renders too, with every tool of the program listed (name, stick-out,
     // gauge length), the cycle time and the verdict.
     let setup = out.join("setup.html");
-    let r = Command::new(&browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--no-first-run",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg("--dump-dom")
-        .arg(format!("file://{}", setup.display()))
-        .stdin(Stdio::null())
-        .output()
-        .unwrap();
-    assert!(r.status.success(), "chromium failed on setup.html");
-    let dom = String::from_utf8_lossy(&r.stdout);
+    let dom = dump_dom(
+        &browser,
+        &profile,
+        &format!("file://{}", setup.display()),
+        &["--disable-gpu"],
+    );
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     for op in report["operations"].as_array().unwrap() {
@@ -270,9 +280,7 @@ fn positions(data: &serde_json::Value, b64: &serde_json::Value) -> Vec<[f64; 3]>
 /// "not measured" when there is none.
 #[test]
 fn view3d_data_round_trips_against_the_cl_file_and_the_verification_maps() {
-    let dir = std::env::temp_dir().join(format!("impeller-cam-view3d-rt-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch("impeller-cam-view3d", "round-trip");
     let out = run_small_view_job(&dir, &["--export-stock", "--export-paths"]);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     let data = view_data(&html);
@@ -411,39 +419,24 @@ fn view3d_data_round_trips_against_the_cl_file_and_the_verification_maps() {
     for m in markers {
         assert!(m["move"].as_u64().is_some_and(|i| i < total), "{m}");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// One headless Chromium run of `page` (a file URL with its hash); returns the `#view3d`
 /// element's attributes.
 fn view_attributes(browser: &std::path::Path, profile: &std::path::Path, url: &str) -> String {
-    let r = Command::new(browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
+    let dom = dump_dom(
+        browser,
+        profile,
+        url,
+        &[
             // WebGL through the software rasteriser (SwiftShader).
             "--use-angle=swiftshader",
             "--enable-unsafe-swiftshader",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
             "--window-size=1000,700",
             // JavaScript runs (imports, first frame) before the DOM is dumped.
             "--virtual-time-budget=30000",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg("--dump-dom")
-        .arg(url)
-        .stdin(Stdio::null())
-        .output()
-        .unwrap();
-    assert!(
-        r.status.success(),
-        "chromium failed: {}",
-        String::from_utf8_lossy(&r.stderr)
+        ],
     );
-    let dom = String::from_utf8_lossy(&r.stdout);
     let a = dom
         .find("<div id=\"view3d\"")
         .expect("no #view3d in the DOM");
@@ -476,9 +469,7 @@ fn view3d_draws_in_headless_chromium_at_three_playback_positions() {
         );
         return;
     };
-    let dir = std::env::temp_dir().join(format!("impeller-cam-view3d-gl-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch("impeller-cam-view3d", "chromium");
     let out = run_small_view_job(&dir, &[]);
     let file = out.join("report.html");
     let data = view_data(&std::fs::read_to_string(&file).unwrap());
@@ -505,5 +496,4 @@ fn view3d_draws_in_headless_chromium_at_three_playback_positions() {
             "blank canvas at move {mv}: {nonblank} drawn, {colours} colours"
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
