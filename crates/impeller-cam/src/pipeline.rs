@@ -1042,7 +1042,7 @@ pub fn verify(
     let rep = machining_sim::simulate(&mut stock, &design, &verifiable, &options).map_err(msg);
     bar.finish_and_clear();
     let rep = rep?;
-    let crosscheck = overcut_crosscheck(&rep, &verifiable, job.verification.crosscheck)?;
+    let crosscheck = overcut_crosscheck(&rep, &design, &verifiable, job.verification.crosscheck)?;
     let maps = serde_json::to_string(&rep.maps).map_err(msg)?;
     gcode_emit::write_atomic(&out.join("verification_maps.json"), maps.as_bytes()).map_err(msg)?;
     let limit = job.tolerances.machining_tol
@@ -1105,29 +1105,41 @@ pub fn verify(
     Ok(())
 }
 
-/// The deepest `count` dexel overcut samples of `rep` re-measured on the exact swept
-/// envelopes of the verified paths ([`machining_sim::crosscheck_overcut`]): the samples and
-/// the largest envelope depth among them (`max_envelope_overcut_mm`), or `null` when `count`
-/// is 0 or no sample reads an overcut. The dexel reading is a detector with the simulation's
-/// error bound (a thin edge between two cells reads up to that bound); the envelope depth of
-/// the same point is the depth of that point inside the swept cutters, without that error.
+/// The verifier's overcut re-measured on the exact swept envelopes of the verified paths:
+/// the location of the largest reading (`deepest`, [`machining_sim::crosscheck_location`]:
+/// projected onto the design surface, its depth inside the envelopes) and the deepest
+/// `count` map samples ([`machining_sim::crosscheck_overcut`]); `max_envelope_overcut_mm` is
+/// the largest of them, or `null` when `count` is 0 or nothing reads an overcut. The dexel
+/// reading is a detector with the simulation's error bound (a thin edge between two cells
+/// reads up to that bound); the envelope depth is the depth inside the swept cutters, exact
+/// for ball ends, without that error. A map sample carries the depth of the nearest cut end
+/// point, which may lie up to a sample spacing away, so the samples alone can miss the cut.
 fn overcut_crosscheck(
     rep: &machining_sim::Report,
+    design: &dyn machining_sim::DesignModel,
     verifiable: &[(Cutter, ToolPath)],
     count: usize,
 ) -> Result<serde_json::Value, CliError> {
     if count == 0 || rep.metrics.max_overcut_mm <= 0.0 {
         return Ok(serde_json::Value::Null);
     }
+    let deepest = match &rep.max_overcut {
+        Some(e) => {
+            Some(machining_sim::crosscheck_location(design, verifiable, e.point).map_err(msg)?)
+        }
+        None => None,
+    };
     let points = machining_sim::crosscheck_overcut(rep, verifiable, count).map_err(msg)?;
     let max = points
         .iter()
         .map(|p| p.envelope_overcut_mm)
+        .chain(deepest.iter().map(|d| d.envelope_overcut_mm))
         .fold(0.0f64, f64::max);
     Ok(serde_json::json!({
         "samples": points.len(),
         "max_dexel_overcut_mm": rep.metrics.max_overcut_mm,
         "max_envelope_overcut_mm": max,
+        "deepest": deepest,
         "points": points,
     }))
 }

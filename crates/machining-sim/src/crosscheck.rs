@@ -12,6 +12,7 @@
 //! (the usual case for small gouges); it must agree with the dexel overcut within the dexel
 //! resolution. Cost per point: O(positions) seeds + Newton per envelope.
 
+use crate::design::DesignModel;
 use crate::error::SimError;
 use crate::simulate::Report;
 use cam_core::{
@@ -220,4 +221,62 @@ pub fn crosscheck_overcut(
         });
     }
     Ok(out)
+}
+
+/// The cross-check of one overcut location `e` read inside the design (a cut end point: on
+/// the swept envelope's boundary, `−sd(e)` below the design surface).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CrossCheckLocation {
+    /// The location read (mm).
+    pub point: [f64; 3],
+    /// Its depth inside the design, `max(0, −sd(e))` (mm).
+    pub design_depth_mm: f64,
+    /// The design surface point above it, `e − sd(e)·∇sd/|∇sd|` (mm).
+    pub surface_point: [f64; 3],
+    /// Depth of that surface point inside the swept envelopes, `max(0, −d)` (mm): the
+    /// overcut there for a ball-ended cutter (the ball's depth below the surface point
+    /// above its deepest point), a lower bound for sharper cutter shapes.
+    pub envelope_overcut_mm: f64,
+}
+
+/// Re-measures the overcut read at `e` on the exact swept envelopes of `ops`: projects `e`
+/// onto the design surface along the design distance's gradient (central differences of
+/// `design.signed_distance`, step 10⁻³ mm) and takes that surface point's depth inside the
+/// envelopes ([`Envelopes::around`]). Where the dexel reading attributes an end point's
+/// depth to the nearest map sample (up to a sample spacing away), this measures at the cut
+/// itself. Cost: 7 design distance queries and the envelopes of the runs near the point.
+pub fn crosscheck_location(
+    design: &dyn DesignModel,
+    ops: &[(Cutter, ToolPath)],
+    e: [f64; 3],
+) -> Result<CrossCheckLocation, SimError> {
+    let p = Point3::new(e[0], e[1], e[2]);
+    let sd = design.signed_distance(&p);
+    let h = 1e-3;
+    let mut g = [0.0; 3];
+    for (k, gk) in g.iter_mut().enumerate() {
+        let mut a = p;
+        let mut b = p;
+        a[k] += h;
+        b[k] -= h;
+        *gk = (design.signed_distance(&a) - design.signed_distance(&b)) / (2.0 * h);
+    }
+    let norm = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    let q = if norm > 1e-9 && sd.is_finite() {
+        Point3::new(
+            p.x - sd * g[0] / norm,
+            p.y - sd * g[1] / norm,
+            p.z - sd * g[2] / norm,
+        )
+    } else {
+        p
+    };
+    let env = Envelopes::around(ops, &[q])?;
+    let d = env.signed_distance(&q)?;
+    Ok(CrossCheckLocation {
+        point: e,
+        design_depth_mm: (-sd).max(0.0),
+        surface_point: [q.x, q.y, q.z],
+        envelope_overcut_mm: (-d).max(0.0),
+    })
 }

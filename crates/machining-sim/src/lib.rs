@@ -69,7 +69,9 @@ pub mod synthetic;
 pub mod tool_solid;
 mod witness;
 
-pub use crosscheck::{crosscheck_overcut, CrossCheckPoint, Envelopes};
+pub use crosscheck::{
+    crosscheck_location, crosscheck_overcut, CrossCheckLocation, CrossCheckPoint, Envelopes,
+};
 pub use design::{BoxDesign, CylinderDesign, DesignModel, SurfaceGrid, TriangleMesh, UnionDesign};
 pub use dexel::{DexelGrid, GridGeometry, Segments, TriDexel};
 pub use endpoints::{overcut_error_bound, EndpointDepth};

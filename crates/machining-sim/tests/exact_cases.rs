@@ -348,6 +348,28 @@ fn dexel_overcut_agrees_with_the_swept_envelope_within_a_cell() {
     assert!((rep.metrics.max_overcut_mm - env_max).abs() < h);
 }
 
+/// The largest reading's own location re-measured on the envelopes: the plate's x_max face
+/// is gouged 0.35 mm by the flat end's side (a cylinder: the gouge floor is parallel to the
+/// face), so the surface point above the cut end point lies 0.35 mm inside the envelope.
+#[test]
+fn the_deepest_reading_is_re_measured_at_its_own_location() {
+    let h = 0.2;
+    let (rep, ops) = plate_case_with_ops(h, 0.35);
+    let design = BoxDesign {
+        min: [-1.0, -10.0, 0.0],
+        max: [1.0, 10.0, 15.0],
+        sample_spacing: 0.25,
+    };
+    let e = rep.max_overcut.clone().unwrap();
+    let c = machining_sim::crosscheck_location(&design, &ops, e.point).unwrap();
+    assert!((c.surface_point[0] - 1.0).abs() < 1e-6, "{c:?}");
+    assert!((c.envelope_overcut_mm - 0.35).abs() < 0.01, "{c:?}");
+    assert!(
+        (c.envelope_overcut_mm - c.design_depth_mm).abs() < h,
+        "{c:?}"
+    );
+}
+
 #[test]
 fn contour_around_a_cylinder_design_finds_the_radial_gouge() {
     // Cylinder design r = 5 (z 0..8) in a box blank; a flat end (r 2) contours it at
