@@ -14,6 +14,9 @@
 //!   the surface for the cutter, shank and holder frusta as convex shapes against the mesh;
 //! - [`pass_check`]: the whole tool (cutter, shank, holder) of a cutting pass, every posture
 //!   and every motion between two, against the whole design with a floor per part;
+//! - [`axis_smoothing`]: the tool axes of a ball-end cutting run made monotone and smooth
+//!   about the ball centres, re-checked with the whole-tool query, kept reversals reported
+//!   with their reasons;
 //! - [`linking`]: retract along the tool axis to a safety surface, travel on it, approach
 //!   along the tool axis;
 //! - [`pattern`]: rotational copy of one channel's or blade's paths to every channel/blade
@@ -29,6 +32,7 @@
 //! (`machining-sim`) never depends on this crate. Third-party: parry3d-f64 (the workspace's
 //! choice for BVH and convex-shape distance queries) in [`clearance`].
 
+pub mod axis_smoothing;
 pub mod clearance;
 pub mod error;
 pub mod linking;
@@ -42,6 +46,7 @@ pub mod pattern;
 pub mod process;
 pub mod tool;
 
+pub use axis_smoothing::{AxisSmoothing, KeptReason, PostureCheck, RunSmoothing, SmoothingSummary};
 pub use clearance::{
     Clearance, ClearanceOptions, DesignClearance, DesignMesh, DesignPart, PartSet, Row, ToolPart,
 };

@@ -67,6 +67,11 @@
 //! slerp of the two axes (at most 5 levels, each posture accessible); where the slerp is not
 //! accessible the run is split there with a retract and an approach (`path_splits`, a note).
 //!
+//! The axes of each run are then smoothed about the ball centres by the shared step
+//! [`cam_plan::axis_smoothing`] (the search's turns in whole steps alternate between
+//! neighbouring positions), every changed posture checked with the axis search's test and
+//! every motion with the check above (`axis_reversals_*`, `axis_smoothing_*` metrics).
+//!
 //! Cost: O(positions · (regula-falsi iterations + 4 blade projections + steps · tool samples
 //! · design distance)), plus 12 axis searches per inaccessible station for its largest ball.
 
@@ -414,6 +419,8 @@ pub struct SidePlan {
     /// above the ball against the design) by inserted positions: the run is split there, a
     /// retract and an approach replace the motion.
     pub motion_splits: Vec<MotionSplit>,
+    /// The axis smoothing of the runs ([`cam_plan::axis_smoothing`]).
+    pub smoothing: cam_plan::SmoothingSummary,
 }
 
 /// A motion between two consecutive positions replaced by a retract and an approach.
@@ -617,6 +624,12 @@ impl SidePlanner<'_, '_> {
         let (Some(ca), Some(cb)) = (self.cl_of(a), self.cl_of(b)) else {
             return false;
         };
+        self.motion_clear_cl(&ca, &cb)
+    }
+
+    /// [`Self::motion_clear`] of two cutter locations.
+    fn motion_clear_cl(&self, ca: &CutterLocation, cb: &CutterLocation) -> bool {
+        let (ca, cb) = (*ca, *cb);
         let min = -self.ctx.tolerances.machining_tol - MOTION_SAMPLE_TOL_MM;
         let qa = self.motion.clearance(&ca).distance_mm;
         let qb = self.motion.clearance(&cb).distance_mm;
@@ -629,6 +642,43 @@ impl SidePlanner<'_, '_> {
                 SEGMENT_QUERIES,
             )
             .is_ok()
+    }
+
+    /// The clearance of flutes, shank and holder of the posture with ball centre `centre` and
+    /// axis `axis` (the accessibility test of the axis search).
+    fn posture_clearance(&self, centre: &Vector3<f64>, axis: &Vector3<f64>) -> f64 {
+        assembly_clearance(
+            self.ctx,
+            &self.upper,
+            centre,
+            axis,
+            self.r,
+            self.r,
+            f64::NEG_INFINITY,
+        )
+    }
+
+    /// The shared axis smoothing ([`cam_plan::axis_smoothing`]) of a run: turns about the
+    /// ball centres (the ball's contact with hub, fillet and side stays exact), checked with
+    /// the axis search's accessibility test and this planner's motion check.
+    fn smooth_axes(&self, run: &mut [RootPosition], summary: &mut cam_plan::SmoothingSummary) {
+        let cls: Vec<CutterLocation> = run.iter().filter_map(|p| self.cl_of(p)).collect();
+        if cls.len() != run.len() {
+            return;
+        }
+        let out = cam_plan::axis_smoothing::smooth_run(
+            &cls,
+            &cam_plan::AxisSmoothing::ball_end(self.r),
+            self,
+        );
+        summary.add(&out);
+        for (p, cl) in run.iter_mut().zip(out.postures) {
+            let axis = cl.axis.into_inner();
+            if axis != p.axis {
+                p.axis = axis;
+                p.clearance = self.posture_clearance(&p.centre, &axis);
+            }
+        }
     }
 
     /// Positions inserted between `a` and `b` so that every motion between consecutive
@@ -878,6 +928,9 @@ pub fn plan_side(
         }
         runs.push(cur);
     }
+    for run in &mut runs {
+        planner.smooth_axes(run, &mut plan.smoothing);
+    }
     plan.runs = runs;
     listed.par_iter_mut().for_each(|l| {
         if !l.reason.is_unfit() {
@@ -899,6 +952,20 @@ pub fn plan_side(
         ));
     }
     Ok(plan)
+}
+
+/// The checks a smoothed root posture and motion must pass: the axis search's (flutes,
+/// shank and holder at least `−machining_tol` from the design) and the motion check between
+/// positions ([`SidePlanner::motion_clear`]); the ball is not moved by a turn about its
+/// centre.
+impl cam_plan::PostureCheck for SidePlanner<'_, '_> {
+    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> bool {
+        let centre = cl.axis_point(self.r).coords;
+        self.posture_clearance(&centre, &cl.axis.into_inner()) >= -self.ctx.tolerances.machining_tol
+    }
+    fn motion_clear(&self, _: usize, a: &CutterLocation, b: &CutterLocation) -> bool {
+        self.motion_clear_cl(a, b)
+    }
 }
 
 /// Why a station was left out, in words (for notes and errors).
@@ -1031,6 +1098,7 @@ impl Operation for BladeRootFinishing {
         let (mut over, mut under, mut clear, mut steps, mut max_rot) =
             (0.0f64, 0.0f64, f64::INFINITY, 0usize, 0.0f64);
         let (mut kept, mut skipped, mut unfit, mut splits, mut tilts) = (0, 0, 0, 0, 0);
+        let mut smoothing = cam_plan::SmoothingSummary::default();
         for (label, blade, next, prev) in reference_blades(imp) {
             let count = if label.starts_with("main") {
                 imp.main().count()
@@ -1054,6 +1122,7 @@ impl Operation for BladeRootFinishing {
                 skipped += plan.skipped();
                 unfit += plan.unfit();
                 splits += plan.runs.len().saturating_sub(1);
+                smoothing.merge(&plan.smoothing.clone().times(count));
                 notes.extend(side_notes(&label, side, &plan, r, self.step_rad));
                 let mut path = ToolPath::new(format!("{} {label} {side:?}", self.name), &self.tool);
                 let many = plan.runs.len() > 1;
@@ -1100,10 +1169,9 @@ impl Operation for BladeRootFinishing {
             .count("skipped_stations", skipped)
             .count("unfit_stations", unfit)
             .count("path_splits", splits);
-        Ok(PlannedOperation {
-            paths,
-            metrics,
-            plots: vec![Plot {
+        smoothing.add_metrics(&mut metrics);
+        notes.push(smoothing.note());
+        let mut plots = vec![Plot {
                 title: "Tool-axis turn from the blade's ruling per position (about the impeller axis, or tilted about the root tangent)".into(),
                 kind: PlotKind::Lines {
                     x_label: "blade side parameter u (leading → trailing edge)".into(),
@@ -1111,7 +1179,12 @@ impl Operation for BladeRootFinishing {
                     series,
                     equal_aspect: false,
                 },
-            }],
+            }];
+        plots.extend(smoothing.plot());
+        Ok(PlannedOperation {
+            paths,
+            metrics,
+            plots,
             notes,
         })
     }

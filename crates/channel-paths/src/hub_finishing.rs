@@ -56,6 +56,12 @@
 //! clear a locally flat hub by `r(1 − sin θ)` at tilt `θ ≤ max_tilt_deg`). A motion that fails splits the line
 //! (`split_motions`). The stock simulation of the written program is the independent check.
 //!
+//! The search in whole steps makes neighbouring points of a line alternate between turns
+//! (the rotary axes chatter inside the cut): once a line's runs are planned, their axes are
+//! smoothed about the ball centres by the shared step [`cam_plan::axis_smoothing`], every
+//! changed posture and motion checked again with the checks above (`axis_reversals_*`,
+//! `axis_smoothing_*` metrics; a plot of the run with the most direction changes).
+//!
 //! # Measured, not assumed
 //! `max_scallop_mm`: on a grid of every lane (40 stations × 4 samples between adjacent lines;
 //! samples where a ball kept `ρ_b` from the blades cannot touch the hub are left out: that
@@ -283,6 +289,8 @@ struct LineResult {
     max_offset_error: f64,
     /// Split motions by cause: ball into hub, ball into blades, tool above the ball.
     split_causes: [usize; 3],
+    /// The axis smoothing of the line's runs.
+    smoothing: cam_plan::SmoothingSummary,
 }
 
 /// Shared planning data of the reference channel.
@@ -587,7 +595,31 @@ impl Planner<'_> {
             res.runs.push(run);
         }
         res.max_overcut = res.max_overcut.max(0.0);
+        self.smooth_axes(&mut res);
         res
+    }
+
+    /// The shared axis smoothing ([`cam_plan::axis_smoothing`]) of every run of a line: turns
+    /// about the ball centres (the hub contact and every figure measured from the centres stay
+    /// exact), checked with this planner's posture and motion checks.
+    fn smooth_axes(&self, res: &mut LineResult) {
+        let opts = cam_plan::AxisSmoothing::ball_end(self.r);
+        for run in &mut res.runs {
+            let cls: Vec<CutterLocation> = run.iter().map(|p| p.cl).collect();
+            let out = cam_plan::axis_smoothing::smooth_run(&cls, &opts, self);
+            res.smoothing.add(&out);
+            for (p, cl) in run.iter_mut().zip(out.postures) {
+                if p.cl != cl {
+                    let q = self.posture_of(cl);
+                    res.min_blade_clearance = res.min_blade_clearance.min(q.blade_clearance);
+                    *p = Posture {
+                        steps: p.steps,
+                        rotation: p.rotation,
+                        ..q
+                    };
+                }
+            }
+        }
     }
 
     /// Whether the motion from `a` to `b` is clear (module docs): the tool above its ball
@@ -651,6 +683,19 @@ impl Planner<'_> {
             steps: 0,
             rotation: 0.0,
         }
+    }
+}
+
+/// The checks a smoothed posture and motion must pass: the planner's own (module docs,
+/// "Tool axis and accessibility"; the ball is not moved by a turn about its centre).
+impl cam_plan::PostureCheck for Planner<'_> {
+    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> bool {
+        let min = -0.5 * self.tol;
+        self.upper.clearance_if_clear(cl, min).is_some()
+            && self.blades_only.clearance_if_clear(cl, min).is_some()
+    }
+    fn motion_clear(&self, _: usize, a: &CutterLocation, b: &CutterLocation) -> bool {
+        self.motion_clear(&self.posture_of(*a), &self.posture_of(*b))
     }
 }
 
@@ -1010,6 +1055,7 @@ impl Operation for HubFinishing {
         let mut series = Vec::new();
         let mut heat = Vec::new();
         let mut cross_links = 0usize;
+        let mut smoothing = cam_plan::SmoothingSummary::default();
         for (li, (lane, lane_st)) in lanes.iter().enumerate() {
             let w_max = lane
                 .rows
@@ -1050,6 +1096,7 @@ impl Operation for HubFinishing {
                 for (acc, c) in metrics_acc.split_causes.iter_mut().zip(res.split_causes) {
                     *acc += c;
                 }
+                smoothing.merge(&res.smoothing);
                 n_lines += 1;
                 if j == 0 || j + 1 == n || j % 4 == 0 {
                     series.push(PlotSeries {
@@ -1125,6 +1172,8 @@ impl Operation for HubFinishing {
                 "max_axis_rotation_deg",
                 metrics_acc.max_rotation.to_degrees(),
             );
+        let smoothing = smoothing.times(count);
+        smoothing.add_metrics(&mut metrics);
         let mut notes = vec![format!(
             "{} lanes, {n_lines} flow lines per channel at ≤ {step:.3} mm; ball centres kept {:.3} mm from the blades (the strip to the root is blade-root finishing's); {cross_links} line-to-line steps at feed",
             lanes.len(),
@@ -1137,16 +1186,14 @@ impl Operation for HubFinishing {
                 metrics_acc.split
             ));
         }
+        notes.push(smoothing.note());
         if metrics_acc.skipped > 0 {
             notes.push(format!(
                 "{} points per channel have no collision-free axis within ±{}° and are left uncut (see max_scallop_mm)",
                 metrics_acc.skipped, self.params.max_turn_deg
             ));
         }
-        Ok(PlannedOperation {
-            paths,
-            metrics,
-            plots: vec![
+        let mut plots = vec![
                 Plot {
                     title: "Hub finishing flow lines of channel 0 (every fourth line)".into(),
                     kind: PlotKind::Lines {
@@ -1163,7 +1210,12 @@ impl Operation for HubFinishing {
                         unit: "mm".into(),
                     },
                 },
-            ],
+            ];
+        plots.extend(smoothing.plot());
+        Ok(PlannedOperation {
+            paths,
+            metrics,
+            plots,
             notes,
         })
     }

@@ -909,6 +909,10 @@ pub fn post(
             .max(m.max_rapid_linearisation_error_mm);
         post.reverse_motions_before += m.reverse_motions_before;
         post.reverse_motions_after += m.reverse_motions_after;
+        post.reverse_motions_cutting_before += m.reverse_motions_cutting_before;
+        post.reverse_motions_cutting_after += m.reverse_motions_cutting_after;
+        post.reverse_motions_links_before += m.reverse_motions_links_before;
+        post.reverse_motions_links_after += m.reverse_motions_links_after;
         post.max_linearisation_error_mm = post
             .max_linearisation_error_mm
             .max(m.max_linearisation_error_mm);

@@ -53,6 +53,15 @@ pub struct PostReport {
     pub reverse_motions_before: usize,
     /// Rotary direction reversals after smoothing.
     pub reverse_motions_after: usize,
+    /// Of `reverse_motions_before`, the reversals inside a cut (what paper 004 removes;
+    /// [`postproc_kinematics::rotary_motion`]).
+    pub reverse_motions_cutting_before: usize,
+    /// Of `reverse_motions_after`, the reversals inside a cut.
+    pub reverse_motions_cutting_after: usize,
+    /// Of `reverse_motions_before`, the reversals at path ends and links (harmless).
+    pub reverse_motions_links_before: usize,
+    /// Of `reverse_motions_after`, the reversals at path ends and links.
+    pub reverse_motions_links_after: usize,
     /// Largest deviation of the tool tip or the flute top from the intended motion between
     /// cutting blocks (mm).
     pub max_linearisation_error_mm: f64,
@@ -111,6 +120,41 @@ pub struct PostOperationReport {
     pub max_contact_shift_mm: f64,
     /// Runs kept unsmoothed because the contact would have moved more than allowed.
     pub runs_kept_for_contact: usize,
+    /// Runs kept unsmoothed because a changed posture or motion failed the gouge check or
+    /// the axis limits.
+    pub runs_kept_for_clearance: usize,
+    /// Runs kept unsmoothed because no reversal-free fit stays within the angle limit.
+    pub runs_kept_for_angle_limit: usize,
+    /// Of `reverse_motions_before`, the reversals inside a cut.
+    pub reverse_motions_cutting_before: usize,
+    /// Of `reverse_motions_after`, the reversals inside a cut.
+    pub reverse_motions_cutting_after: usize,
+    /// Of `reverse_motions_before`, the reversals at path ends and links.
+    pub reverse_motions_links_before: usize,
+    /// Of `reverse_motions_after`, the reversals at path ends and links.
+    pub reverse_motions_links_after: usize,
+    /// Reversals inside cuts after smoothing, of the tilting axis.
+    pub reverse_motions_cutting_tilt: usize,
+    /// The same of C.
+    pub reverse_motions_cutting_rotate: usize,
+    /// Smallest reversing step of the reversals inside cuts (deg; 0 without one).
+    pub reversal_step_min_deg: f64,
+    /// Largest reversing step of the reversals inside cuts (deg).
+    pub reversal_step_max_deg: f64,
+    /// Largest step of a rotary axis between consecutive cutting blocks (deg).
+    pub max_rotary_step_deg: f64,
+    /// Largest angular acceleration of the tilting axis at the programmed feed (deg/s²).
+    pub max_tilt_acceleration_deg_per_s2: f64,
+    /// The same of C.
+    pub max_rotate_acceleration_deg_per_s2: f64,
+    /// The machine's acceleration limit of the tilting axis (deg/s²; `null` when its file
+    /// gives none).
+    pub tilt_acceleration_limit_deg_per_s2: Option<f64>,
+    /// The same of C.
+    pub rotate_acceleration_limit_deg_per_s2: Option<f64>,
+    /// Blocks at which the acceleration at programmed feed exceeds a rotary axis' limit (the
+    /// machine slows the feed there: see the cycle time).
+    pub blocks_over_rotary_acceleration_limit: usize,
 }
 
 impl PostOperationReport {
@@ -127,6 +171,20 @@ impl PostOperationReport {
             limit_violations: m.limit_violations,
             reconfigurations: m.reconfigurations,
             reverse_motion_removal: p.reverse_motion_removal,
+            reverse_motions_cutting_before: m.reverse_motions_cutting_before,
+            reverse_motions_cutting_after: m.reverse_motions_cutting_after,
+            reverse_motions_links_before: m.reverse_motions_links_before,
+            reverse_motions_links_after: m.reverse_motions_links_after,
+            reverse_motions_cutting_tilt: m.reversals.tilt.cutting,
+            reverse_motions_cutting_rotate: m.reversals.rotate.cutting,
+            reversal_step_min_deg: m.reversals.cutting_steps().0.to_degrees(),
+            reversal_step_max_deg: m.reversals.cutting_steps().1.to_degrees(),
+            max_rotary_step_deg: m.rotary.max_step.to_degrees(),
+            max_tilt_acceleration_deg_per_s2: m.rotary.max_acceleration_tilt.to_degrees(),
+            max_rotate_acceleration_deg_per_s2: m.rotary.max_acceleration_rotate.to_degrees(),
+            tilt_acceleration_limit_deg_per_s2: m.rotary.limit_tilt.map(f64::to_degrees),
+            rotate_acceleration_limit_deg_per_s2: m.rotary.limit_rotate.map(f64::to_degrees),
+            blocks_over_rotary_acceleration_limit: m.rotary.blocks_over_limit,
             ..Self::default()
         };
         if let Some(rm) = &p.reverse_motion {
@@ -142,6 +200,8 @@ impl PostOperationReport {
             r.max_angle_change_deg = rm.max_angle_change_deg;
             r.max_contact_shift_mm = rm.max_contact_shift_mm;
             r.runs_kept_for_contact = rm.runs_kept_for_contact;
+            r.runs_kept_for_clearance = rm.runs_kept_for_clearance;
+            r.runs_kept_for_angle_limit = rm.runs_kept_for_angle_limit;
         }
         r
     }

@@ -19,7 +19,8 @@
 //! Modules: [`machine`] (description and TOML file), [`kinematics`] (forward / inverse,
 //! solution choice), [`post`] (path post-processing and metrics), [`cycle_time`] (block
 //! times from the axis speed and acceleration limits), [`reverse_motion`]
-//! (detection and removal, paper 004), [`bspline_fit`] (least-squares cubic B-spline used by
+//! (detection and removal, paper 004), [`rotary_motion`] (reversals inside cuts vs at links,
+//! angular steps and accelerations at the programmed feed), [`bspline_fit`] (least-squares cubic B-spline used by
 //! the smoothing), [`linearise`] (joint-interpolation error and subdivision), [`feed`]
 //! (inverse-time feed), [`plot`] (SVG displacement curves).
 //!
@@ -71,6 +72,7 @@ pub mod machine;
 pub mod plot;
 pub mod post;
 pub mod reverse_motion;
+pub mod rotary_motion;
 
 pub use cycle_time::{BlockProfile, CycleTimeError, MotionTimer};
 pub use error::{KinematicsError, MachineError, PostError};
@@ -86,6 +88,7 @@ pub use post::{
 pub use reverse_motion::{
     AccessibilityChecker, DisplacementCurves, ReverseMotionOptions, ReverseMotionReport,
 };
+pub use rotary_motion::{AxisReversals, ReversalSplit, RotarySmoothness};
 
 // The README's code blocks are compiled and run as doc tests (`cargo test --doc`).
 #[cfg(doctest)]

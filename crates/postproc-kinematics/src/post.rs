@@ -13,6 +13,7 @@ use crate::reverse_motion::{
     count_path_reverse_motions, remove_reverse_motions, AccessibilityChecker, ReverseMotionOptions,
     ReverseMotionReport,
 };
+use crate::rotary_motion::{reversal_split, rotary_smoothness, ReversalSplit, RotarySmoothness};
 use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -164,6 +165,28 @@ pub struct PostMetrics {
     pub reverse_motions_before: usize,
     /// The same after removal (equals `before` without removal).
     pub reverse_motions_after: usize,
+    /// Of `reverse_motions_before`, the reversals inside a cut (what paper 004 removes;
+    /// [`crate::rotary_motion`]); the rest lie at path ends and links.
+    #[serde(default)]
+    pub reverse_motions_cutting_before: usize,
+    /// Of `reverse_motions_after`, the reversals inside a cut.
+    #[serde(default)]
+    pub reverse_motions_cutting_after: usize,
+    /// Of `reverse_motions_before`, the reversals at path ends and links (a zig-zag's turn,
+    /// a plunge or retract: harmless).
+    #[serde(default)]
+    pub reverse_motions_links_before: usize,
+    /// Of `reverse_motions_after`, the reversals at path ends and links.
+    #[serde(default)]
+    pub reverse_motions_links_after: usize,
+    /// The reversals after removal per rotary axis, with the smallest and largest reversing
+    /// step inside cuts.
+    #[serde(default)]
+    pub reversals: ReversalSplit,
+    /// Largest angular step and angular acceleration at the programmed feed of the written
+    /// blocks, with the machine's limits ([`crate::rotary_motion::rotary_smoothness`]).
+    #[serde(default)]
+    pub rotary: RotarySmoothness,
     /// Largest deviation (mm) of any joint-interpolated cutting (non-rapid) block after
     /// linearisation control: of the tool tip and of the checked flute height.
     pub max_linearisation_error_mm: f64,
@@ -314,6 +337,7 @@ pub fn post_path_checked(
     }
 
     let reverse_motions_before = count_path_reverse_motions(&blocks);
+    let split_before = reversal_split(&blocks);
     let reverse_report = match &options.reverse_motion {
         Some(rm) => Some(remove_reverse_motions(
             machine,
@@ -325,6 +349,7 @@ pub fn post_path_checked(
         None => None,
     };
     let reverse_motions_after = count_path_reverse_motions(&blocks);
+    let split_after = reversal_split(&blocks);
 
     // Linearisation control and feeds.
     let mut out: Vec<PostedBlock> = Vec::with_capacity(blocks.len());
@@ -481,6 +506,12 @@ pub fn post_path_checked(
     let metrics = PostMetrics {
         reverse_motions_before,
         reverse_motions_after,
+        reverse_motions_cutting_before: split_before.cutting(),
+        reverse_motions_cutting_after: split_after.cutting(),
+        reverse_motions_links_before: split_before.links(),
+        reverse_motions_links_after: split_after.links(),
+        reversals: split_after,
+        rotary: rotary_smoothness(machine, &out),
         max_linearisation_error_mm: max_err,
         max_rapid_linearisation_error_mm: max_rapid_err,
         limit_violations: out.iter().filter(|b| b.limit_violation.is_some()).count(),

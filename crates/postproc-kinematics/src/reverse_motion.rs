@@ -340,6 +340,14 @@ pub struct ReverseMotionReport {
     /// `ReverseMotionOptions::max_contact_shift_mm`.
     #[serde(default)]
     pub runs_kept_for_contact: usize,
+    /// Runs kept because a changed posture (or the motion to it) failed the accessibility
+    /// check or left the axis limits (with every C repair tried), the contact staying within
+    /// its bound.
+    #[serde(default)]
+    pub runs_kept_for_clearance: usize,
+    /// Runs kept because no fit free of reverse motions stays within `max_angle_change`.
+    #[serde(default)]
+    pub runs_kept_for_angle_limit: usize,
     /// Displacement curves before removal.
     pub before: DisplacementCurves,
     /// Displacement curves after removal.
@@ -983,6 +991,7 @@ fn smooth_run(
         }
         rep.refits += fits_tried.saturating_sub(1);
         let Some(fit) = accepted else {
+            rep.runs_kept_for_angle_limit += 1;
             ok = false;
             break;
         };
@@ -1089,6 +1098,8 @@ fn smooth_run(
             None => {
                 if contact_failure {
                     rep.runs_kept_for_contact += 1;
+                } else {
+                    rep.runs_kept_for_clearance += 1;
                 }
                 rep.inaccessible_blocks.extend(first_failure);
                 ok = false;
@@ -1120,6 +1131,8 @@ impl ReverseMotionReport {
         self.max_angle_change_deg = self.max_angle_change_deg.max(o.max_angle_change_deg);
         self.max_contact_shift_mm = self.max_contact_shift_mm.max(o.max_contact_shift_mm);
         self.runs_kept_for_contact += o.runs_kept_for_contact;
+        self.runs_kept_for_clearance += o.runs_kept_for_clearance;
+        self.runs_kept_for_angle_limit += o.runs_kept_for_angle_limit;
     }
 }
 
