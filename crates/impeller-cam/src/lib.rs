@@ -35,7 +35,9 @@ pub use report::Report;
 
 /// Exit code of `impeller-cam run` when verification finds an overcut beyond the tolerance
 /// (`machining_tol` plus the simulation's error bound) or a collision: the report is written
-/// and shows where, the program is withheld (`--allow-defects` keeps it and exits 0).
+/// and shows where, the program is withheld (`--allow-defects` keeps it and exits 0); also
+/// when the machine cannot hold the planned tool paths within its travel (no program is
+/// posted; the report lists the violations).
 pub const EXIT_DEFECTS: u8 = 3;
 
 // The README's code blocks are compiled and run as doc tests (`cargo test --doc`).

@@ -4,8 +4,9 @@
 //! Every subcommand exits 0 on success and 1 on a user error with one clear line on stderr
 //! (see `../shared/DESIGN.md` §4); `run` exits [`impeller_cam::EXIT_DEFECTS`] (3) when
 //! verification finds an overcut beyond tolerance or a collision (the report is written, the
-//! program withheld; `--allow-defects` keeps the program and exits 0). Subcommands live in the library's `cmd` module, one
-//! module each.
+//! program withheld; `--allow-defects` keeps the program and exits 0), and when the machine
+//! cannot hold the planned tool paths within its travel (nothing posted, the report lists
+//! every violation). Subcommands live in the library's `cmd` module, one module each.
 
 use clap::{Parser, Subcommand};
 use impeller_cam::cmd;

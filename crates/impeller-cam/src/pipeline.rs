@@ -136,7 +136,7 @@ fn run_stages(job: &Job, out: &Path, registry: &Registry) -> Result<Report, CliE
 
     let t = stage(&progress, "planning operations");
     let mut operations = plan(job, &impeller, registry, &mut report.notes)?;
-    link_for_machine(job, &impeller, &mut operations, &mut report.notes)?;
+    let travel = link_for_machine(job, &impeller, &mut operations, &mut report.notes)?;
     if operations.is_empty() {
         report
             .notes
@@ -153,27 +153,45 @@ fn run_stages(job: &Job, out: &Path, registry: &Registry) -> Result<Report, CliE
     }
     report.timings_ms.insert("plan_ms".into(), ms(t));
 
-    let t = stage(&progress, "post-processing");
-    let assembled = post(job, &impeller, &operations, out, &mut report)?;
-    report.timings_ms.insert("post_ms".into(), ms(t));
-
     let t = stage(
         &progress,
-        if job.verification.enabled {
-            "verifying by stock simulation"
+        if travel.is_empty() {
+            "post-processing"
         } else {
-            "verification disabled by the job ([verification] enabled = false)"
+            "writing the tool paths (no program: they leave the machine's travel)"
         },
     );
-    verify(
-        job,
-        &impeller,
-        &operations,
-        assembled.as_ref(),
-        out,
-        &mut report,
-    )?;
-    report.timings_ms.insert("verify_ms".into(), ms(t));
+    let assembled = post(job, &impeller, &operations, &travel, out, &mut report)?;
+    report.timings_ms.insert("post_ms".into(), ms(t));
+
+    if travel.is_empty() {
+        let t = stage(
+            &progress,
+            if job.verification.enabled {
+                "verifying by stock simulation"
+            } else {
+                "verification disabled by the job ([verification] enabled = false)"
+            },
+        );
+        verify(
+            job,
+            &impeller,
+            &operations,
+            assembled.as_ref(),
+            out,
+            &mut report,
+        )?;
+        report.timings_ms.insert("verify_ms".into(), ms(t));
+    } else {
+        report
+            .notes
+            .push(crate::travel::travel_error(&report.post.machine, &travel));
+        report.notes.push(
+            "no program was posted and nothing was verified: the machine cannot run the \
+             planned tool paths (toolpath.cls holds them)"
+                .into(),
+        );
+    }
     withhold_defective_program(job, out, &mut report)?;
     report.verdict = Some(crate::verdict::Verdict::of(
         &report,
@@ -685,14 +703,18 @@ fn post_options(job: &Job) -> PostOptions {
 /// chained as the program runs them (each starts from the posture the previous one ends
 /// in). Each planned operation reports `machine_links` (rapids rerouted) and
 /// `swinging_rapids_left`; a note names operations with swinging rapids left.
+///
+/// Returns the operations whose posted blocks leave the machine's travel (with the count,
+/// the move range and the range each axis would need, [`crate::travel`]); the run then
+/// posts nothing, reports them and fails (exit 3).
 pub fn link_for_machine(
     job: &Job,
     impeller: &Impeller,
     operations: &mut [JobOperation],
     notes: &mut Vec<String>,
-) -> Result<(), CliError> {
+) -> Result<Vec<crate::travel::TravelViolations>, CliError> {
     if operations.is_empty() {
-        return Ok(());
+        return Ok(Vec::new());
     }
     let machine = load_machine(job)?;
     // On a head machine the gauge length moves the tip: planned operations carry their
@@ -763,21 +785,18 @@ pub fn link_for_machine(
             ));
         }
     }
-    if !travel.is_empty() {
-        return Err(CliError::Message(crate::travel::travel_error(
-            machine.name(),
-            &travel,
-        )));
-    }
-    Ok(())
+    Ok(travel)
 }
 
 /// Stage 3: writes `toolpath.cls` and, when there is something to machine, the program;
 /// fills `report.post` (and its notes and displacement plots). Returns the assembled program.
+/// When operations leave the machine's travel (`travel`, from [`link_for_machine`]) the
+/// program is not posted: `report.post` names it, unwritten, with the violations.
 pub fn post(
     job: &Job,
     impeller: &Impeller,
     operations: &[JobOperation],
+    travel: &[crate::travel::TravelViolations],
     out: &Path,
     report: &mut Report,
 ) -> Result<Option<AssembledProgram>, CliError> {
@@ -813,6 +832,13 @@ pub fn post(
         ..PostReport::default()
     };
     if operations.is_empty() {
+        report.post = post;
+        return Ok(None);
+    }
+    if !travel.is_empty() {
+        // Withheld before posting: the machine cannot run these tool paths.
+        post.program = program_path.display().to_string();
+        post.travel = travel.to_vec();
         report.post = post;
         return Ok(None);
     }

@@ -78,6 +78,9 @@ pub struct PostReport {
     pub operations: Vec<PostOperationReport>,
     /// The program's running time from the machine's limits (`null` without a program).
     pub cycle_time: Option<gcode_emit::ProgramTime>,
+    /// Operations whose blocks leave the machine's travel (the program is then not posted;
+    /// empty when every block lies within the travel).
+    pub travel: Vec<crate::travel::TravelViolations>,
 }
 
 /// Post-processing figures of one simultaneous operation.

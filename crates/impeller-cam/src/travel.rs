@@ -4,13 +4,17 @@
 //! counted, with the range each axis would need. A job the machine cannot hold stops there
 //! with one message naming every such operation (it used to stop in the post at the first
 //! block, `operation 'rough' move 0: axis A = 85.914555 outside its limits`, with no count
-//! and no range). Planning itself does not yet consider travel.
+//! and no range). Such a run posts nothing: the violations go to `report.json`
+//! (`post.travel`), the report and the terminal, and the run fails with exit 3
+//! ([`crate::verdict`]). The post's posture choice prefers postures within the travel (of
+//! the two solutions of a five-axis machine and the 2π-equivalents of a rotary axis); the
+//! planners' tool axes themselves do not yet consider the travel.
 
 use postproc_kinematics::{KinematicsError, PostedBlock};
 use std::fmt::Write as _;
 
 /// The range one axis would need (mm, or degrees for rotary axes).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct AxisNeed {
     /// Axis letter.
     pub axis: char,
@@ -23,7 +27,7 @@ pub struct AxisNeed {
 }
 
 /// The blocks of one operation outside the machine's travel.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct TravelViolations {
     /// Operation name.
     pub operation: String,

@@ -40,7 +40,8 @@ pub enum ProgramState {
 /// The verdict of a run (`verdict` in `report.json`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Verdict {
-    /// Pass, fail or not verified.
+    /// Pass, fail or not verified (fail also when the machine cannot hold the tool paths
+    /// within its travel).
     pub status: Status,
     /// Written, withheld or none.
     pub program: ProgramState,
@@ -57,6 +58,9 @@ pub struct Verdict {
     pub collisions: Option<usize>,
     /// Dexel spacing of the simulation (mm).
     pub resolution_mm: Option<f64>,
+    /// Whether operations leave the machine's travel (the program is then withheld before
+    /// posting and nothing is verified; `report.post.travel` lists them).
+    pub outside_travel: bool,
     /// The defects, one line each, with where they are.
     pub defects: Vec<String>,
 }
@@ -66,11 +70,20 @@ impl Verdict {
     /// `machining_tol` is `machining_tol_mm`.
     pub fn of(report: &Report, machining_tol_mm: f64) -> Self {
         let v = report.verification.as_ref();
+        let outside_travel = !report.post.travel.is_empty();
         let status = match v {
+            _ if outside_travel => Status::Fail,
             None => Status::NotVerified,
             Some(v) if v.defects.is_empty() => Status::Pass,
             Some(_) => Status::Fail,
         };
+        let mut defects: Vec<String> = report
+            .post
+            .travel
+            .iter()
+            .map(|t| format!("machine {}: {}", report.post.machine, t.describe()))
+            .collect();
+        defects.extend(v.map(|v| v.defects.clone()).unwrap_or_default());
         let program = if report.post.written {
             ProgramState::Written
         } else if report.post.program.is_empty() {
@@ -87,7 +100,8 @@ impl Verdict {
             max_residual_mm: v.map(|v| v.max_residual_mm),
             collisions: v.map(|v| v.collisions),
             resolution_mm: v.map(|v| v.resolution_mm),
-            defects: v.map(|v| v.defects.clone()).unwrap_or_default(),
+            outside_travel,
+            defects,
         }
     }
 
@@ -119,6 +133,10 @@ impl Verdict {
                 self.machining_tol_mm,
                 self.max_residual_mm.unwrap_or(0.0),
             ),
+            _ if self.outside_travel => {
+                "FAIL, not verified: the machine cannot hold the tool paths within its travel"
+                    .to_string()
+            }
             _ => format!("verification {}", self.word()),
         }
     }
@@ -128,6 +146,10 @@ impl Verdict {
     pub fn program_text(&self, path: &str) -> String {
         match self.program {
             ProgramState::Written => path.to_string(),
+            ProgramState::Withheld if self.outside_travel => format!(
+                "withheld (the machine cannot hold it within its travel: {})",
+                self.defects.join("; ")
+            ),
             ProgramState::Withheld => format!(
                 "withheld (verification failed: {})",
                 self.defects.join("; ")

@@ -105,6 +105,27 @@ fn default_job_is_the_impeller_8_8_fixture_job() {
     for k in ["model_ms", "plan_ms", "post_ms", "verify_ms", "total_ms"] {
         assert!(r["timings_ms"][k].as_f64().is_some(), "{k}");
     }
+    // The cycle time, re-computed from the written program text and the machine file's own
+    // limits by an independent replay (`replay_ngc_s`), agrees with the report within 1 %.
+    let program = std::fs::read_to_string(out.join("program.ngc")).unwrap();
+    let machine: toml::Value = toml::from_str(
+        &std::fs::read_to_string(repo().join("fixtures/machines/xyzac-trt.toml")).unwrap(),
+    )
+    .unwrap();
+    let replayed = replay_ngc_s(&program, &machine);
+    let reported = r["post"]["cycle_time"]["total_s"].as_f64().unwrap();
+    eprintln!("cycle time: report {reported:.3} s, replay of program.ngc {replayed:.3} s");
+    assert!(
+        (replayed - reported).abs() <= 0.01 * replayed,
+        "cycle time: report {reported} s, replay of program.ngc {replayed} s"
+    );
+    // LinuxCNC's own interpreter accepts the whole program in a trivkins configuration.
+    rs274_accepts(
+        &out,
+        &out.join("program.ngc"),
+        "T5 P5 Z115 D3 ;T5\nT6 P6 Z115 D2 ;T6\nT7 P7 Z110 D2 ;T7\n",
+        50_000,
+    );
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains("<svg") && html.contains("Meridional view"));
     for name in ["rough", "hub-finish", "blade-finish", "blade-root"] {
@@ -114,6 +135,131 @@ fn default_job_is_the_impeller_8_8_fixture_job() {
             "{name}"
         );
     }
+}
+
+/// The running time (s) of a LinuxCNC joint-output program on a machine file, written
+/// independently of the library's cycle-time code from the program text alone: every motion
+/// block moves the five joints X Y Z A C linearly in one parameter `s`; its cruise rate is
+/// `u = min(1/T, min_i v_i/|D_i|)` (T = 60/F s under G93, the XYZ length over F under G94,
+/// none for G0), its acceleration `α = k·min_i a_i/|D_i|` with `k = ½` when the machine blends
+/// (two blends overlap) and 1 at exact stop; from rest to rest it takes `1/u + u/α`
+/// (trapezoid, `u²/α ≤ 1`) or `2/√α` (triangle). Blended blocks start when the block before
+/// begins to decelerate, not before the one before it has ended; M-code blocks stop the
+/// motion, and `M6` with a new tool adds the machine's `tool_change_s`. `G53` moves are taken
+/// in the workpiece frame (the machine files here put G54 at the machine's origin).
+fn replay_ngc_s(program: &str, machine: &toml::Value) -> f64 {
+    let axes = ["X", "Y", "Z", "A", "C"];
+    let limit = |a: &str, k: &str| machine["axes"][a][k].as_float().unwrap();
+    let speed: Vec<f64> = axes.iter().map(|a| limit(a, "max_speed") / 60.0).collect();
+    let accel: Vec<f64> = axes.iter().map(|a| limit(a, "max_acceleration")).collect();
+    let blend = machine["blending"].as_str() == Some("parabolic");
+    let change_s = machine["tool_change_s"].as_float().unwrap_or(0.0);
+    let (mut at, mut rapid, mut inverse_time, mut feed) = ([0.0f64; 5], true, false, 0.0);
+    // End of the program so far, earliest start of the next block, end of the one before.
+    let (mut end, mut next, mut before): (f64, f64, f64) = (0.0, 0.0, 0.0);
+    let (mut tool, mut loaded) = (None::<i64>, None::<i64>);
+    for line in program.lines() {
+        let code = line.split('(').next().unwrap_or_default();
+        let (mut to, mut moved, mut stop, mut m6) = (at, false, false, false);
+        for word in code.split_whitespace() {
+            let (letter, value) = word.split_at(1);
+            let Ok(v) = value.parse::<f64>() else {
+                continue;
+            };
+            match letter {
+                "G" if v == 0.0 => rapid = true,
+                "G" if v == 1.0 => rapid = false,
+                "G" if v == 93.0 => inverse_time = true,
+                "G" if v == 94.0 => inverse_time = false,
+                "F" => feed = v,
+                "T" => tool = Some(v as i64),
+                "M" => {
+                    stop = true;
+                    m6 |= v == 6.0;
+                }
+                _ => {
+                    if let Some(i) = axes.iter().position(|a| *a == letter) {
+                        to[i] = v;
+                        moved = true;
+                    }
+                }
+            }
+        }
+        if stop {
+            before = end;
+            next = end;
+            if m6 && tool != loaded {
+                end += change_s;
+                before = end;
+                next = end;
+                loaded = tool;
+            }
+        }
+        if !moved {
+            continue;
+        }
+        let d: Vec<f64> = (0..5).map(|i| (to[i] - at[i]).abs()).collect();
+        at = to;
+        if d.iter().all(|x| *x < 1e-9) {
+            continue;
+        }
+        let mut u = f64::INFINITY;
+        if !rapid {
+            let xyz = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let t = if inverse_time {
+                60.0 / feed
+            } else {
+                60.0 * if xyz > 0.0 { xyz } else { d[3].hypot(d[4]) } / feed
+            };
+            u = 1.0 / t;
+        }
+        let mut alpha = f64::INFINITY;
+        for i in 0..5 {
+            if d[i] >= 1e-9 {
+                u = u.min(speed[i] / d[i]);
+                alpha = alpha.min(accel[i] / d[i]);
+            }
+        }
+        if blend {
+            alpha *= 0.5;
+        }
+        let (duration, decel) = if u * u / alpha <= 1.0 {
+            (1.0 / u + u / alpha, u / alpha)
+        } else {
+            (2.0 / alpha.sqrt(), 1.0 / alpha.sqrt())
+        };
+        let start = if blend { next.max(before) } else { end };
+        before = end;
+        end = end.max(start + duration);
+        next = start + duration - decel;
+    }
+    end
+}
+
+#[test]
+fn the_program_replay_reproduces_closed_form_times() {
+    let machine: toml::Value = toml::from_str(
+        &std::fs::read_to_string(repo().join("fixtures/machines/xyzac-trt.toml")).unwrap(),
+    )
+    .unwrap();
+    // One 100 mm rapid on X (20 mm/s, 300 mm/s² halved by the blend): 100/20 + 20/150 s.
+    let t = replay_ngc_s("G0 X100\n", &machine);
+    assert!((t - (5.0 + 20.0 / 150.0)).abs() < 1e-12, "{t}");
+    // Ten 1 mm feeds at 60 mm/min under G93 (F = 60 per minute: 1 s each) on Y, blended:
+    // cruise 1 mm/s, one ramp up and one down at 150 mm/s²: 10 + 1/150 s. A tool change
+    // between two of them stops the motion and adds 5 s; the same tool again adds nothing.
+    let mut p = String::from("G93 G1\n");
+    for k in 1..=10 {
+        p.push_str(&format!("Y{k} F60\n"));
+    }
+    let t = replay_ngc_s(&p, &machine);
+    assert!((t - (10.0 + 1.0 / 150.0)).abs() < 1e-9, "{t}");
+    let p2 = p.replace("Y5 F60\n", "Y5 F60\nT3 M6\nT3 M6\n");
+    let t2 = replay_ngc_s(&p2, &machine);
+    assert!((t2 - (10.0 + 2.0 / 150.0 + 5.0)).abs() < 1e-9, "{t2}");
+    // A 90° turn of A alone at 30°/s, from rest to rest: 3 s + 30/150 s.
+    let t = replay_ngc_s("G0 A90\n", &machine);
+    assert!((t - (3.0 + 0.2)).abs() < 1e-12, "{t}");
 }
 
 /// A five-axis ring cut in the stock above the impeller's shroud contour (r = 30 mm, top
@@ -721,10 +867,10 @@ fn a_run_removes_the_earlier_runs_program_of_another_dialect() {
     assert!(out.join("mine.txt").is_file());
 }
 
-/// A machine whose A axis cannot reach the ring's 10° tilt: the run stops right after
-/// planning, before anything is posted or written, naming the operation, how many blocks
-/// and moves leave the travel and the range A needs (it used to stop in the post at the
-/// first block with no count and no range).
+/// A machine whose A axis cannot reach the ring's 10° tilt: the run posts nothing, names
+/// the operation, how many blocks and moves leave the travel and the range A needs, writes
+/// the report with the violations and fails with exit 3 (it used to stop in the post at the
+/// first block with no count, no range and no report, then with exit 1 and no report).
 #[test]
 fn travel_the_machine_cannot_hold_is_reported_with_count_and_range() {
     let job = ring_job("travel", &ring_cl());
@@ -754,18 +900,47 @@ fn travel_the_machine_cannot_hold_is_reported_with_count_and_range() {
     assert!(text.contains(&fixture));
     std::fs::write(&job, text.replace(&fixture, "\"narrow.toml\"")).unwrap();
     let out = dir.join("out");
-    let st = run_into(&job, &out);
-    assert_eq!(st.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&st.stderr);
-    assert!(
-        err.contains("cannot hold the planned tool paths within its travel")
-            && err.contains(" blocks (moves 0–")
-            && err.contains("A needs -10.000 to -10.000 (travel -5 to 5)"),
-        "{err}"
-    );
-    assert!(
-        !err.contains("post-processing"),
-        "stops before posting: {err}"
-    );
-    assert!(!out.join("toolpath.cls").exists() && !out.join("report.json").exists());
+    for allow in [false, true] {
+        let mut cmd = cli();
+        cmd.arg("run")
+            .arg(&job)
+            .arg("--out")
+            .arg(&out)
+            .arg("--force");
+        if allow {
+            cmd.arg("--allow-defects");
+        }
+        let st = cmd.output().unwrap();
+        // Exit 3 even with --allow-defects: there is no program to keep.
+        assert_eq!(st.status.code(), Some(3), "allow {allow}");
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert!(
+            err.contains("cannot hold the planned tool paths within its travel")
+                && err.contains(" blocks (moves 0–")
+                && err.contains("A needs -10.000 to -10.000 (travel -5 to 5)"),
+            "{err}"
+        );
+        assert!(
+            err.contains("DEFECT: machine ") && err.contains("program withheld (the machine"),
+            "{err}"
+        );
+        assert!(
+            !err.contains("verifying by stock simulation"),
+            "nothing verified: {err}"
+        );
+        assert!(!out.join("program.ngc").exists(), "no program posted");
+        assert!(out.join("toolpath.cls").is_file() && out.join("report.html").is_file());
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        let t = &r["post"]["travel"][0];
+        assert_eq!(t["operation"], "op1", "{t}");
+        assert!(t["blocks"].as_u64().unwrap() > 0);
+        assert_eq!(t["axes"][0]["axis"], "A");
+        assert!((t["axes"][0]["min_needed"].as_f64().unwrap() + 10.0).abs() < 1e-3);
+        assert_eq!(t["axes"][0]["travel"], serde_json::json!([-5.0, 5.0]));
+        assert_eq!(r["verdict"]["status"], "fail");
+        assert_eq!(r["verdict"]["program"], "withheld");
+        assert!(r["verification"].is_null());
+    }
 }

@@ -69,7 +69,9 @@ pub fn run(args: Args) -> Result<Outcome, CliError> {
     for d in &verdict.defects {
         eprintln!("[impeller-cam] DEFECT: {d}");
     }
-    if !verdict.defects.is_empty() && args.allow_defects {
+    // A program outside the travel is never posted, --allow-defects or not.
+    let kept = args.allow_defects && !verdict.outside_travel;
+    if !verdict.defects.is_empty() && kept {
         eprintln!("[impeller-cam] the program was written anyway (--allow-defects)");
     }
     // The last line: what was made, whether it passed, under which limits.
@@ -86,7 +88,7 @@ pub fn run(args: Args) -> Result<Outcome, CliError> {
         verdict.summary(&report.post.program),
         args.out.join("report.html").display()
     );
-    if verdict.defects.is_empty() || args.allow_defects {
+    if verdict.defects.is_empty() || kept {
         Ok(Outcome::Clean)
     } else {
         Ok(Outcome::Defects)
