@@ -147,6 +147,11 @@ pub struct PostureClearance {
 pub struct PassCheck<'a> {
     blades: DesignClearance<'a>,
     hub: DesignClearance<'a>,
+    /// The queries of the sampled postures along a motion: the whole tool from the ball
+    /// centre up, whatever [`PassCheck::with_postures_above`] leaves out of the posture
+    /// queries (a planner places its ball exactly at its stations, not between them).
+    motion_blades: DesignClearance<'a>,
+    motion_hub: DesignClearance<'a>,
     upper_blades: DesignClearance<'a>,
     upper_hub: DesignClearance<'a>,
     floors: PassFloors,
@@ -191,6 +196,8 @@ impl<'a> PassCheck<'a> {
         Self {
             blades: with(PartSet::BLADES, lowest),
             hub: with(hub, lowest),
+            motion_blades: with(PartSet::BLADES, lowest),
+            motion_hub: with(hub, lowest),
             upper_blades: with(PartSet::BLADES, split_mm),
             upper_hub: with(hub, split_mm),
             floors,
@@ -201,7 +208,9 @@ impl<'a> PassCheck<'a> {
     /// The same check with the tool samples up to `above_mm` above the tip left out of the
     /// posture queries: for a planner that places its ball itself at a verified distance
     /// from the design (the point-milling ball centre is measured exactly against the whole
-    /// design before a posture is tried), so only the tool above it needs the query.
+    /// design before a posture is tried), so only the tool above it needs the query. The
+    /// sampled postures between two postures of a motion keep the whole tool: nothing placed
+    /// the ball there (a step between two passes cuts a chord across the side's offset).
     pub fn with_postures_above(mut self, above_mm: f64) -> Self {
         let set = |q: &DesignClearance<'a>| {
             q.with_options(ClearanceOptions {
@@ -324,12 +333,28 @@ impl<'a> PassCheck<'a> {
 
     /// The violation of the motion from posture `index` (`a`) to the next (`b`), given their
     /// (blade, hub) clearances; `None` when it keeps its floors (module docs: certified above
-    /// the split height within `motion_tol_mm`, sampled below it).
+    /// the split height within `motion_tol_mm`, sampled below it every
+    /// [`MOTION_STEP_MM`]).
     pub fn motion(
+        &self,
+        index: usize,
+        a: (&CutterLocation, &PostureClearance),
+        b: (&CutterLocation, &PostureClearance),
+    ) -> Option<PassViolation> {
+        self.motion_sampled(index, a, b, MOTION_STEP_MM)
+    }
+
+    /// [`PassCheck::motion`] with the lower part sampled every `step_mm` of displacement of
+    /// its highest point: for a motion no planner refined along a curve (a step between two
+    /// passes), where the ball's deviation between two samples is bounded only by the
+    /// surface's curvature (a chord of a surface of radius `ρ` sags at most `step²/(8ρ)`
+    /// between samples `step` apart).
+    pub fn motion_sampled(
         &self,
         index: usize,
         (a, ca): (&CutterLocation, &PostureClearance),
         (b, cb): (&CutterLocation, &PostureClearance),
+        step_mm: f64,
     ) -> Option<PassViolation> {
         let tol = self.floors.motion_tol_mm.max(0.0);
         let at = |s: f64| CutterLocation {
@@ -352,15 +377,15 @@ impl<'a> PassCheck<'a> {
         };
         // The lower part at sampled postures.
         let sweep = (b.tip - a.tip).norm() + a.axis.angle(&b.axis) * self.split_mm;
-        let n = (sweep / MOTION_STEP_MM).ceil() as usize;
+        let n = (sweep / step_mm.max(1e-3)).ceil() as usize;
         for k in 1..n {
             let s = k as f64 / n as f64;
             let cl = at(s);
-            if !self.blades.is_clear(&cl, self.floors.blades_mm) {
-                return Some(violation(&self.blades, s, self.floors.blades_mm));
+            if !self.motion_blades.is_clear(&cl, self.floors.blades_mm) {
+                return Some(violation(&self.motion_blades, s, self.floors.blades_mm));
             }
-            if !self.hub.is_clear(&cl, self.floors.hub_mm) {
-                return Some(violation(&self.hub, s, self.floors.hub_mm));
+            if !self.motion_hub.is_clear(&cl, self.floors.hub_mm) {
+                return Some(violation(&self.motion_hub, s, self.floors.hub_mm));
             }
         }
         // The upper part, certified.

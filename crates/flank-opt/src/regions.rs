@@ -474,6 +474,10 @@ pub struct RowsPlan {
 const APPROACH_MM: f64 = 5.0;
 /// Longest step cut directly from one run to the next (mm): the zig-zag step at an edge.
 const DIRECT_STEP_MM: f64 = 10.0;
+/// Spacing (mm) of the postures at which a direct step is checked, ball included: nothing
+/// refines the step along the side, so between two samples the ball's chord sags into a side
+/// of curvature radius `ρ` by at most `0.25²/(8ρ)` (≤ 0.0016 mm for `ρ ≥ 5 mm`).
+const DIRECT_STEP_SAMPLE_MM: f64 = 0.25;
 
 /// Plans both sides of every row in `rows` (in parallel), assembles each row's runs into
 /// one path (direct certified feed steps between runs where the whole tool keeps the floors,
@@ -520,7 +524,14 @@ pub fn plan_rows(
                         let (ca, cb) = (check.measure(&last), check.measure(first));
                         check.keeps_floors(ca.whole)
                             && check.keeps_floors(cb.whole)
-                            && check.motion(0, (&last, &ca), (first, &cb)).is_none()
+                            && check
+                                .motion_sampled(
+                                    0,
+                                    (&last, &ca),
+                                    (first, &cb),
+                                    DIRECT_STEP_SAMPLE_MM,
+                                )
+                                .is_none()
                     };
                     if clear {
                         direct += 1;

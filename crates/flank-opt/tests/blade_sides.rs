@@ -424,3 +424,63 @@ fn flank_strips_that_leave_more_than_the_tolerance_are_point_milled() {
         );
     });
 }
+
+/// A step between two point-milling passes cuts a straight chord between two balls that
+/// touch the side: along a convex side (here the pressure side along the flow) it sags into it. The pass check of point milling
+/// leaves the ball out of its posture queries (the planner places its balls itself), but the
+/// postures between the two ends are nobody's: the motion check measures the ball there and
+/// finds the sag (it measured only the tool above the ball, and let a 0.023 mm gouge through
+/// on the AutoGrid fixture's splitter).
+#[test]
+fn a_step_whose_ball_sags_into_the_side_is_not_clear() {
+    let imp = bowed();
+    let r = 2.0;
+    let t = tool(r, 3.0, 40.0);
+    let p = process(0.0, 0.0);
+    with_ctx(&imp, &t, &p, |ctx| {
+        let blade = imp.main().blade().clone();
+        let side = Side::Pressure;
+        let (v_lo, v_hi) = regions::side_v_range(ctx, &blade, side).unwrap();
+        let v = 0.5 * (v_lo + v_hi);
+        let posture = |u: f64| {
+            let n = blade.outward_normal(side, u, v).unwrap();
+            let c = blade.side(side).point(u, v) + n * r;
+            let axis = nalgebra::Unit::new_normalize(n + Vector3::z());
+            CutterLocation {
+                tip: Point3::from(c - axis.into_inner() * r),
+                axis,
+            }
+        };
+        let floors = regions::floors(0.0, 0.0, 0.01, 0.01);
+        let check = PassCheck::new(ctx.clearance, floors, 2.0 * r).with_postures_above(r);
+        // The longest chord (≤ 10 mm, the direct step's limit) whose middle ball reaches
+        // 0.02 mm or more into the side.
+        let (a, b, sag) = [0.04, 0.05, 0.06, 0.07]
+            .iter()
+            .find_map(|du| {
+                let (a, b) = (posture(0.5 - du), posture(0.5 + du));
+                let mid = Point3::from((a.tip.coords + b.tip.coords) * 0.5)
+                    + (a.axis.into_inner() + b.axis.into_inner()).normalize() * r;
+                let sag = -(ctx.clearance.blade_signed_distance(&mid).0 - r);
+
+                ((b.tip - a.tip).norm() <= 10.0 && sag > 0.02).then_some((a, b, sag))
+            })
+            .expect("a chord that sags into the convex side");
+        let (ca, cb) = (check.measure(&a), check.measure(&b));
+        assert!(check.keeps_floors(ca.whole) && check.keeps_floors(cb.whole));
+        let v = check
+            .motion_sampled(0, (&a, &ca), (&b, &cb), 0.25)
+            .expect("the sagging ball is found");
+        assert!(matches!(v.design_part, cam_plan::DesignPart::Blade { .. }));
+        assert_eq!(v.tool_part, cam_plan::ToolPart::Cutter);
+        assert!(v.height_mm <= r + 1e-6, "the ball: {}", v.height_mm);
+        // Within the sampling of the middle ball's exact sag (0.25 mm steps).
+        assert!(
+            v.clearance_mm <= -0.5 * sag,
+            "{} vs sag {sag}",
+            v.clearance_mm
+        );
+        // The coarser motion check finds it too.
+        assert!(check.motion(0, (&a, &ca), (&b, &cb)).is_some());
+    });
+}
