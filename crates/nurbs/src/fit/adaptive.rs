@@ -25,7 +25,10 @@
 //!
 //! **Solve.** Per section and per refinement, least squares with both end points fixed
 //! (eqs. 9.63–9.67) by rank-revealing QR ([`super::solve`]); a rank-deficient system after a
-//! refinement undoes it and refines the worst span alone, then freezes that span.
+//! refinement undoes it and refines the worst span alone, then freezes that span. So does a
+//! regular but ill-conditioned one whose curve swings away from its data between two data
+//! points (farther from their chord than the chord is long, [`FitError::Swing`]): the data
+//! points alone do not see it.
 //!
 //! Cost: O(R · Σ_k m_k n²) for R refinement rounds (R ≈ log₂ of the final knot count when
 //! misses are spread, more when they concentrate), m_k points per section, n control points.
@@ -162,12 +165,62 @@ fn lsq_fixed_ends<const D: usize>(
         }
     }
     let curve = NurbsCurve::from_knot_vector(kv.clone(), ctrl.clone(), None)?;
-    let errs = params
+    let errs: Vec<f64> = params
         .iter()
         .zip(points)
         .map(|(&u, q)| (curve.point(u) - q).norm())
         .collect();
+    check_swing(&curve, points, params, &errs)?;
     Ok((ctrl, errs))
+}
+
+/// How far (relative to the chord `|Q_{i+1} − Q_i|`) the fitted curve's point halfway (in
+/// parameter) between two consecutive data points may lie from their chord. A curve that
+/// follows its data deviates by about the sagitta `|ΔQ|²·κ/8`, a small fraction of `|ΔQ|`
+/// wherever the data resolve the curve (a circle sampled every 90° still stays within
+/// `0.21·|ΔQ|`); beyond one chord length the curve swings.
+const SWING_CHORDS: f64 = 1.0;
+
+/// [`FitError::Swing`] when the curve's point halfway between two consecutive data
+/// parameters lies farther from the segment between the two points than [`SWING_CHORDS`]
+/// chords plus the curve's deviations `errs` at the two points (a coarse fit that misses
+/// its data may lie that far off anyway), and more than `1e-9` of the data's extent. Least
+/// squares with fixed ends bounds
+/// the deviation *at* the data only: a knot span that a section's data barely reach (the
+/// knots are shared by every section, refined where any section misses) leaves an
+/// ill-conditioned system whose solution can swing metres away between two points
+/// millimetres apart while every data point stays within tolerance. O(m) evaluations.
+fn check_swing<const D: usize>(
+    curve: &NurbsCurve<D>,
+    points: &[SVector<f64, D>],
+    params: &[f64],
+    errs: &[f64],
+) -> Result<(), FitError> {
+    let extent = points
+        .iter()
+        .map(|q| (q - points[0]).norm())
+        .fold(0.0, f64::max);
+    for (i, (w, u)) in points.windows(2).zip(params.windows(2)).enumerate() {
+        let (a, b) = (w[0], w[1]);
+        let c = curve.point(0.5 * (u[0] + u[1]));
+        let ab = b - a;
+        let len2 = ab.norm_squared();
+        let t = if len2 > 0.0 {
+            ((c - a).dot(&ab) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let deviation = (c - (a + ab * t)).norm();
+        let allowed = SWING_CHORDS * len2.sqrt() + errs[i] + errs[i + 1];
+        // NaN (a curve evaluated to nothing) counts as a swing.
+        if deviation.is_nan() || deviation > allowed.max(1e-9 * extent) {
+            return Err(FitError::Swing {
+                point: i,
+                deviation,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// One fit of every section on `kv`: control points, per-point deviations, worst point.
@@ -230,7 +283,9 @@ pub fn approximate_compatible<const D: usize>(
     kink_angle: f64,
 ) -> Result<CompatibleFit<D>, FitError> {
     match fit_refined(sections, degree, tol, Some(kink_angle)) {
-        Err(FitError::SingularSystem { .. }) => fit_refined(sections, degree, tol, None),
+        Err(FitError::SingularSystem { .. } | FitError::Swing { .. }) => {
+            fit_refined(sections, degree, tol, None)
+        }
         r => r,
     }
 }
@@ -447,4 +502,58 @@ fn fit_refined<const D: usize>(
         kinks,
         worst,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector2;
+
+    /// Data on the x axis every 1 (x = 0..4) and a cubic through them whose control points
+    /// reach y = ±1000 in one span: every data point is on the curve, the curve swings far
+    /// between two of them, which only the swing check sees.
+    #[test]
+    fn a_curve_that_passes_its_data_but_swings_between_them_is_refused() {
+        let kv = KnotVector::new(
+            3,
+            vec![0.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0, 1.0],
+        )
+        .unwrap();
+        let data: Vec<Vector2<f64>> = (0..=4).map(|i| Vector2::new(i as f64, 0.0)).collect();
+        let params = [0.0, 0.25, 0.5, 0.75, 1.0];
+        let straight: Vec<Vector2<f64>> = (0..7)
+            .map(|i| Vector2::new(4.0 * i as f64 / 6.0, 0.0))
+            .collect();
+        let c = NurbsCurve::from_knot_vector(kv.clone(), straight.clone(), None).unwrap();
+        let errs: Vec<f64> = params
+            .iter()
+            .zip(&data)
+            .map(|(&u, q)| (c.point(u) - q).norm())
+            .collect();
+        assert!(check_swing(&c, &data, &params, &errs).is_ok());
+        // The first span's inner control points pushed up and down by 1000·B₂(¼) and
+        // −1000·B₁(¼): their effect B₁y₁ + B₂y₂ vanishes at the one data parameter inside that
+        // span; u = 0 and the C⁰ knot u = ½ sit on unchanged control points.
+        let mut bent = straight;
+        let (b1, b2) = {
+            let mut row = vec![0.0; kv.n_ctrl()];
+            crate::fit::curve_interp::basis_row(&kv, 0.25, 0, &mut row);
+            (row[1], row[2])
+        };
+        bent[1].y = 1000.0 * b2;
+        bent[2].y = -1000.0 * b1;
+        let c = NurbsCurve::from_knot_vector(kv, bent, None).unwrap();
+        let errs: Vec<f64> = params
+            .iter()
+            .zip(&data)
+            .map(|(&u, q)| (c.point(u) - q).norm())
+            .collect();
+        assert!(errs.iter().all(|e| *e < 1e-9), "{errs:?}");
+        match check_swing(&c, &data, &params, &errs) {
+            Err(FitError::Swing { point, deviation }) => {
+                assert!(point <= 1 && deviation > 10.0, "{point} {deviation}")
+            }
+            other => panic!("{other:?}"),
+        }
+    }
 }

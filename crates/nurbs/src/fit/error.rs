@@ -73,6 +73,21 @@ pub enum FitError {
         /// Number of unknowns.
         cols: usize,
     },
+    /// The least-squares curve swings away from its data between two data points: the
+    /// system is regular but so ill-conditioned (a knot span its section's data barely
+    /// reach) that its control points run far from the data. Treated like a singular system
+    /// by the adaptive fit (the refinement that caused it is undone).
+    #[error(
+        "the fitted curve swings {deviation} away from its data between points {point} and {}",
+        point + 1
+    )]
+    Swing {
+        /// Index of the data point before the swing.
+        point: usize,
+        /// Distance of the curve's midpoint between the two points from their chord (data
+        /// length unit).
+        deviation: f64,
+    },
     /// A core operation (curve construction, knot refinement, ...) rejected its input.
     #[error(transparent)]
     Nurbs(#[from] NurbsError),
