@@ -54,7 +54,8 @@ pub use error::PlanError;
 pub use linking::{LinkCheck, LinkStats, Linker, SafetySurface};
 pub use metrics::{MetricValue, Metrics, Plot, PlotKind, PlotSeries};
 pub use operation::{
-    Builder, Operation, OperationSpec, PlanContext, PlannedOperation, PlannedStep, StepTool,
+    AxisReach, Builder, Operation, OperationSpec, PlanContext, PlannedOperation, PlannedStep,
+    StepTool,
 };
 pub use pass_check::{PassCheck, PassFloors, PassViolation, PostureClearance};
 pub use process::Process;

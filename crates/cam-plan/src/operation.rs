@@ -29,9 +29,27 @@ pub struct PlanContext<'a> {
     /// Outcomes of the checked retracts and approaches ([`PlanContext::link`],
     /// [`PlanContext::close`]).
     pub links: &'a LinkStats,
+    /// The tool axes the job's machine can take (its rotary travel), when known: operations
+    /// that search for an axis skip the ones it cannot reach ([`PlanContext::reaches`]).
+    pub reach: Option<&'a dyn AxisReach>,
+}
+
+/// Which tool axes (unit vectors in the workpiece frame, from the tip toward the spindle) a
+/// machine can present to the part within its rotary travel: the machine-side constraint an
+/// operation's axis search respects so that its postures can be posted. The linear travel,
+/// which depends on where the tip is, is not part of it (the run checks it after planning).
+pub trait AxisReach: Sync + std::fmt::Debug {
+    /// Whether some posture within the rotary travel gives the tool axis `axis`.
+    fn reaches(&self, axis: &nalgebra::Vector3<f64>) -> bool;
 }
 
 impl PlanContext<'_> {
+    /// Whether the job's machine can present the tool axis `axis` (unit, workpiece frame;
+    /// `true` when no machine constrains the planning). O(1).
+    pub fn reaches(&self, axis: &nalgebra::Vector3<f64>) -> bool {
+        self.reach.is_none_or(|r| r.reaches(axis))
+    }
+
     /// Feed, plunge and rapid rates of this operation's tool and process row.
     pub fn rates(&self) -> Rates {
         self.process.rates(self.tool)

@@ -65,6 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         clearance: &clearance,
         linker: &linker,
         links: &cam_plan::LinkStats::default(),
+        reach: None,
     };
     let op = channel_paths::build_blade_root_finishing(&OperationSpec {
         name: "root".into(),

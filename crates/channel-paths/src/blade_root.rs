@@ -961,7 +961,9 @@ pub fn plan_side(
 impl cam_plan::PostureCheck for SidePlanner<'_, '_> {
     fn posture_clear(&self, _: usize, cl: &CutterLocation) -> bool {
         let centre = cl.axis_point(self.r).coords;
-        self.posture_clearance(&centre, &cl.axis.into_inner()) >= -self.ctx.tolerances.machining_tol
+        self.ctx.reaches(&cl.axis.into_inner())
+            && self.posture_clearance(&centre, &cl.axis.into_inner())
+                >= -self.ctx.tolerances.machining_tol
     }
     fn motion_clear(&self, _: usize, a: &CutterLocation, b: &CutterLocation) -> bool {
         self.motion_clear_cl(a, b)

@@ -351,7 +351,8 @@ impl Planner<'_> {
     }
 
     /// A clear posture at `(t, φ)` (module docs: first axis, turns about the impeller axis,
-    /// hub normal), or `None`.
+    /// hub normal) whose axis the job's machine can take ([`PlanContext::reaches`]), or
+    /// `None`.
     fn posture(&self, t: f64, phi: f64, st: &Station, hint: f64) -> Option<Posture> {
         let c = self.centre(t, phi);
         let n = self.ctx.impeller.hub().normal(t, phi);
@@ -383,6 +384,9 @@ impl Planner<'_> {
         // the others cheaply.
         let mut fallback: Option<Posture> = None;
         for (a, steps, rotation) in tries {
+            if !self.ctx.reaches(&a) {
+                continue;
+            }
             let Some(cl) = self.location(&c, &a) else {
                 continue;
             };
@@ -687,11 +691,13 @@ impl Planner<'_> {
 }
 
 /// The checks a smoothed posture and motion must pass: the planner's own (module docs,
-/// "Tool axis and accessibility"; the ball is not moved by a turn about its centre).
+/// "Tool axis and accessibility"; the ball is not moved by a turn about its centre), and an
+/// axis the machine can take.
 impl cam_plan::PostureCheck for Planner<'_> {
     fn posture_clear(&self, _: usize, cl: &CutterLocation) -> bool {
         let min = -0.5 * self.tol;
-        self.upper.clearance_if_clear(cl, min).is_some()
+        self.ctx.reaches(&cl.axis.into_inner())
+            && self.upper.clearance_if_clear(cl, min).is_some()
             && self.blades_only.clearance_if_clear(cl, min).is_some()
     }
     fn motion_clear(&self, _: usize, a: &CutterLocation, b: &CutterLocation) -> bool {

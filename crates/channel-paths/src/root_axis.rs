@@ -104,7 +104,8 @@ pub(crate) struct Station<'b> {
 
 /// The axis search of the module docs at `at`, for the job's tool of ball radius `r` with a
 /// ball (and flutes) of radius `ball` (`ball < r` asks whether a smaller ball would fit);
-/// `upper` is [`shank_and_holder`], `step` the turning step (rad).
+/// `upper` is [`shank_and_holder`], `step` the turning step (rad). Axes the job's machine
+/// cannot take within its rotary travel are passed over ([`PlanContext::reaches`]).
 pub(crate) fn search_axis(
     ctx: &PlanContext<'_>,
     upper: &DesignClearance<'_>,
@@ -165,7 +166,9 @@ pub(crate) fn search_axis(
                 break;
             }
             let axis = Rotation3::from_axis_angle(&line, rot) * a0;
-            if assembly_clearance(ctx, upper, centre, &axis, r, ball, -tol) >= -tol {
+            if ctx.reaches(&axis)
+                && assembly_clearance(ctx, upper, centre, &axis, r, ball, -tol) >= -tol
+            {
                 let clearance =
                     assembly_clearance(ctx, upper, centre, &axis, r, ball, f64::NEG_INFINITY);
                 return Search::Found {

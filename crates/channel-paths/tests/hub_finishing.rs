@@ -92,3 +92,71 @@ fn impeller_8_8_hub_is_finished_within_its_scallop_target() {
     );
     assert!(metric(&planned, "max_overcut_mm") < 1e-6);
 }
+
+/// Tool axes no more than `max_tilt` from the impeller axis: a machine whose tilt axis
+/// reaches only that far.
+#[derive(Debug)]
+struct TiltCone {
+    max_tilt: f64,
+}
+
+impl cam_plan::AxisReach for TiltCone {
+    fn reaches(&self, axis: &nalgebra::Vector3<f64>) -> bool {
+        axis.z.clamp(-1.0, 1.0).acos() <= self.max_tilt
+    }
+}
+
+/// A machine that cannot tilt the tool as far as the hub finishing's first choices: the axis
+/// search passes over the axes it cannot take, so every posture planned can be posted (the
+/// search used to ignore the machine, and the run stopped after planning with the blocks
+/// outside the travel). The cone is set below the largest tilt planned without it.
+#[test]
+fn hub_axes_stay_within_the_machines_reach() {
+    let mut c = support::Ctx::new("impeller-8+8", 1.0);
+    c.tool = support::tapered_t6();
+    c.process.width_of_cut_mm = None;
+    let cl = c.clearance();
+    let op = channel_paths::build_hub_finishing(&spec("scallop_mm = 0.5\nstations = 4")).unwrap();
+    let tilts = |p: &cam_plan::PlannedOperation| -> Vec<f64> {
+        p.paths
+            .iter()
+            .flat_map(|path| path.moves.iter())
+            .filter(|m| m.kind == MoveKind::Feed)
+            .map(|m| m.cl.axis.z.clamp(-1.0, 1.0).acos())
+            .collect()
+    };
+    let free = tilts(&op.plan(&plan_ctx!(c, cl)).unwrap());
+    let mut sorted = free.clone();
+    sorted.sort_by(f64::total_cmp);
+    let cone = TiltCone {
+        max_tilt: sorted[sorted.len() * 3 / 4],
+    };
+    assert!(free.iter().any(|t| *t > cone.max_tilt + 1e-3));
+    let links = cam_plan::LinkStats::default();
+    let ctx = cam_plan::PlanContext {
+        impeller: &c.imp,
+        stock: c.imp.stock(),
+        tool: &c.tool,
+        tolerances: &c.tol,
+        process: &c.process,
+        clearance: &cl,
+        linker: &c.linker,
+        links: &links,
+        reach: Some(&cone),
+    };
+    let held = op.plan(&ctx).unwrap();
+    let t = tilts(&held);
+    assert!(
+        t.len() > free.len() / 2,
+        "{} of {} feed moves",
+        t.len(),
+        free.len()
+    );
+    let worst = t.iter().copied().fold(0.0, f64::max);
+    assert!(
+        worst <= cone.max_tilt + 1e-9,
+        "{}° > {}°",
+        worst.to_degrees(),
+        cone.max_tilt.to_degrees()
+    );
+}

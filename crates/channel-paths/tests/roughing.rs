@@ -71,6 +71,7 @@ fn plan_rough(
         clearance,
         linker: &linker,
         links: &cam_plan::LinkStats::default(),
+        reach: None,
     };
     build_channel_roughing(&spec(params))
         .unwrap()

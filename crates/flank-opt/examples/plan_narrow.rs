@@ -72,6 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         clearance: &clearance,
         linker: &linker,
         links: &cam_plan::LinkStats::default(),
+        reach: None,
     };
     let spec = OperationSpec {
         name: "flank".into(),

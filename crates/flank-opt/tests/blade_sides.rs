@@ -94,6 +94,7 @@ fn with_ctx<T>(
         clearance: &clearance,
         linker: &linker,
         links: &links,
+        reach: None,
     };
     f(&ctx)
 }

@@ -83,6 +83,7 @@ fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
         clearance: &clearance,
         linker: &linker,
         links: &cam_plan::LinkStats::default(),
+        reach: None,
     };
     let spec = OperationSpec {
         name: "blade-finish".into(),

@@ -409,6 +409,8 @@ pub fn plan(
     } else {
         Some(design_mesh(job, impeller)?)
     };
+    // The machine's rotary travel, for the operations that search for a tool axis.
+    let reach = crate::travel::MachineReach(load_machine(job)?);
     let progress = Progress::new(job.quiet);
     let planned: Vec<Result<Vec<JobOperation>, CliError>> = job
         .operations
@@ -456,6 +458,7 @@ pub fn plan(
                 clearance: &clearance,
                 linker: &linker,
                 links: &links,
+                reach: Some(&reach),
             };
             let (planned, steps) = op.plan_with_steps(&ctx, &step_tools).map_err(fail)?;
             let mut main =

@@ -7,10 +7,26 @@
 //! and no range). Such a run posts nothing: the violations go to `report.json`
 //! (`post.travel`), the report and the terminal, and the run fails with exit 3
 //! ([`crate::verdict`]). The post's posture choice prefers postures within the travel (of
-//! the two solutions of a five-axis machine and the 2π-equivalents of a rotary axis); the
-//! planners' tool axes themselves do not yet consider the travel.
+//! the two solutions of a five-axis machine and the 2π-equivalents of a rotary axis), and
+//! the planners' axis searches (hub finishing, blade-root finishing, point milling) skip tool
+//! axes the rotary travel cannot give ([`MachineReach`]); the operations whose axes the
+//! geometry fixes (flank passes along the rulings, plunge and channel roughing) are left to
+//! this check.
 
-use postproc_kinematics::{KinematicsError, PostedBlock};
+use postproc_kinematics::{KinematicsError, Machine, PostedBlock};
+
+/// The tool axes a machine can present within its rotary travel
+/// ([`Machine::orientation_reachable`]), for the planners' axis searches
+/// ([`cam_plan::PlanContext::reaches`]).
+#[derive(Debug)]
+pub struct MachineReach(pub Machine);
+
+impl cam_plan::AxisReach for MachineReach {
+    fn reaches(&self, axis: &cam_core::Vector3) -> bool {
+        cam_core::UnitVector3::try_new(*axis, 1e-12)
+            .is_some_and(|a| self.0.orientation_reachable(&a))
+    }
+}
 use std::fmt::Write as _;
 
 /// The range one axis would need (mm, or degrees for rotary axes).

@@ -40,7 +40,10 @@ fn exports_load_by_extension() {
     let blades = [Some(imp.main()), imp.splitter()];
     for set in blades.into_iter().flatten() {
         let b = set.blade();
-        for side in [impeller_model::Side::Pressure, impeller_model::Side::Suction] {
+        for side in [
+            impeller_model::Side::Pressure,
+            impeller_model::Side::Suction,
+        ] {
             let s = b.side(side);
             let ((u0, u1), (v0, v1)) = s.domain();
             for i in 0..=160 {

@@ -112,6 +112,7 @@ fn channel(c: &mut Criterion) {
         clearance: &clearance,
         linker: &linker,
         links: &cam_plan::LinkStats::default(),
+        reach: None,
     };
     let mut g = c.benchmark_group("plan");
     g.sample_size(10);

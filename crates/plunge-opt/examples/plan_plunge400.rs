@@ -165,6 +165,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             clearance: &clearance,
             linker: &linker,
             links: &cam_plan::LinkStats::default(),
+            reach: None,
         };
         let t0 = std::time::Instant::now();
         let (planned, steps) = op.plan_with_steps(&ctx, &[&drill])?;

@@ -354,6 +354,20 @@ impl Machine {
         }
     }
 
+    /// Whether some posture within the rotary axes' travel gives the tool axis `axis` (of the
+    /// two tilt signs and the 2π-equivalents of each angle; the linear axes, which depend on
+    /// the tip, are not checked). What a planner may choose among tool axes on this machine.
+    /// O(1).
+    pub fn orientation_reachable(&self, axis: &UnitVector3) -> bool {
+        let cl = CutterLocation {
+            tip: Point3::origin(),
+            axis: *axis,
+        };
+        self.candidate_angles(&cl, &self.home())
+            .map(|mut c| c.next().is_some())
+            .unwrap_or(false)
+    }
+
     /// All postures that reach `cl` within the limits: both tilt signs and, for each, the
     /// 2π-equivalents of the rotary angles next to the one nearest `reference` (at most three
     /// per axis). Used to look ahead along a path when the greedy choice runs into a limit.

@@ -455,3 +455,48 @@ fn conventional_directions_match_linuxcnc_both_ways() {
         }
     }
 }
+
+/// Which tool axes a machine can present: xyzac-trt tilts A from −100° to 50°, so of the two
+/// solutions (A, C) and (−A, C + 180°) one reaches every axis up to 100° from the C axis and
+/// none beyond; narrowed to A ∈ [−5°, 5°], only a 5° cone is left.
+#[test]
+fn reachable_orientations_follow_the_tilt_travel() {
+    let tilted = |deg: f64, az: f64| {
+        let (t, a) = (deg.to_radians(), az.to_radians());
+        cam_core::UnitVector3::new_normalize(Vector3::new(
+            t.sin() * a.cos(),
+            t.sin() * a.sin(),
+            t.cos(),
+        ))
+    };
+    let m = fixture("xyzac-trt");
+    for az in [0.0, 70.0, 180.0, 250.0] {
+        for deg in [0.0, 30.0, 60.0, 99.0] {
+            assert!(m.orientation_reachable(&tilted(deg, az)), "{deg}° at {az}°");
+        }
+        assert!(
+            !m.orientation_reachable(&tilted(101.0, az)),
+            "101° at {az}°"
+        );
+    }
+    let text = std::fs::read_to_string(format!(
+        "{}/../../fixtures/machines/xyzac-trt.toml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let (a, c) = (
+        text.find("[axes.A]").unwrap(),
+        text.find("[axes.C]").unwrap(),
+    );
+    let narrow = format!(
+        "{}{}{}",
+        &text[..a],
+        text[a..c]
+            .replace("min = -100.0", "min = -5.0")
+            .replace("max = 50.0", "max = 5.0"),
+        &text[c..]
+    );
+    let m = Machine::from_toml_str(&narrow, "narrow.toml").unwrap();
+    assert!(m.orientation_reachable(&tilted(4.9, 123.0)));
+    assert!(!m.orientation_reachable(&tilted(5.2, 123.0)));
+}

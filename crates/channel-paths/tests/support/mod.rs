@@ -128,6 +128,7 @@ macro_rules! plan_ctx {
             clearance: &$cl,
             linker: &$c.linker,
             links: &cam_plan::LinkStats::default(),
+            reach: None,
         }
     };
 }

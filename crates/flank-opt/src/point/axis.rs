@@ -134,8 +134,9 @@ pub struct Found {
     pub tried: usize,
 }
 
-/// The first accessible (tilt, lead) in [`AxisLimits::candidates`] order; `None` when none
-/// keeps the floors.
+/// The first accessible (tilt, lead) in [`AxisLimits::candidates`] order whose axis the
+/// machine can take (`reaches`, [`cam_plan::PlanContext::reaches`]); `None` when none keeps
+/// the floors.
 pub fn search(
     check: &PassCheck<'_>,
     frame: &Frame,
@@ -143,9 +144,14 @@ pub fn search(
     r: f64,
     limits: &AxisLimits,
     prev: (f64, f64),
+    reaches: impl Fn(&Vector3<f64>) -> bool,
 ) -> Option<Found> {
     for (k, (beta, lambda)) in limits.candidates(prev).into_iter().enumerate() {
-        let cl = posture(centre, &frame.axis(beta, lambda), r);
+        let axis = frame.axis(beta, lambda);
+        if !reaches(&axis) {
+            continue;
+        }
+        let cl = posture(centre, &axis, r);
         if let Some(clearance) = check.clear_posture(&cl) {
             return Some(Found {
                 angles: (beta, lambda),

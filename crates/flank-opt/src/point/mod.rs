@@ -427,7 +427,15 @@ fn plan_pass(
         };
         match &c {
             Ok(c) => {
-                match axis::search(check, &c.frame, &c.centre, st.ball_radius, &st.limits, prev) {
+                match axis::search(
+                    check,
+                    &c.frame,
+                    &c.centre,
+                    st.ball_radius,
+                    &st.limits,
+                    prev,
+                    |a| ctx.reaches(a),
+                ) {
                     Some(f) => {
                         pass.search_steps += f.tried - 1;
                         prev = f.angles;
@@ -586,7 +594,15 @@ fn connect(
         0.5 * (a.angles.0 + b.angles.0),
         0.5 * (a.angles.1 + b.angles.1),
     );
-    let Some(f) = axis::search(check, &c.frame, &c.centre, st.ball_radius, &st.limits, prev) else {
+    let Some(f) = axis::search(
+        check,
+        &c.frame,
+        &c.centre,
+        st.ball_radius,
+        &st.limits,
+        prev,
+        |a| ctx.reaches(a),
+    ) else {
         return false;
     };
     let m = Station {
