@@ -112,6 +112,11 @@ pub struct AxisSmoothing {
     pub kernel_spacings: f64,
     /// Largest number of fits (and checks) per run (default 24).
     pub max_fits: usize,
+    /// The reason given to a direction change kept because the fit turns a posture more than
+    /// `max_change_rad`: [`KeptReason::AngleLimit`] for the default limit,
+    /// [`KeptReason::Accuracy`] where the limit is an accuracy budget (a flank pass: the
+    /// turn that moves the cutter's flank by the pass's accuracy slack).
+    pub limit_reason: KeptReason,
 }
 
 impl AxisSmoothing {
@@ -122,6 +127,7 @@ impl AxisSmoothing {
             max_change_rad: DEFAULT_MAX_CHANGE_DEG.to_radians(),
             kernel_spacings: 2.0,
             max_fits: 24,
+            limit_reason: KeptReason::AngleLimit,
         }
     }
 }
@@ -140,15 +146,20 @@ pub enum KeptReason {
     NearPole,
     /// The fit budget `max_fits` was spent.
     Budget,
+    /// The smoothed run would move the cutting edge beyond the operation's accuracy
+    /// tolerance (a flank pass, whose axis is the ruling it cuts with: the turn exceeds the
+    /// accuracy budget, or the re-measured pass misses the tolerance).
+    Accuracy,
 }
 
 impl KeptReason {
     /// All reasons, in report order.
-    pub const ALL: [KeptReason; 4] = [
+    pub const ALL: [KeptReason; 5] = [
         KeptReason::Clearance,
         KeptReason::AngleLimit,
         KeptReason::NearPole,
         KeptReason::Budget,
+        KeptReason::Accuracy,
     ];
     /// Snake-case name for metrics.
     pub fn name(self) -> &'static str {
@@ -157,6 +168,7 @@ impl KeptReason {
             KeptReason::AngleLimit => "angle_limit",
             KeptReason::NearPole => "near_pole",
             KeptReason::Budget => "budget",
+            KeptReason::Accuracy => "accuracy",
         }
     }
 }
@@ -365,7 +377,7 @@ fn refused(
         .map(|i| (i, planned[i].axis.angle(&cand[i].axis)))
         .max_by(|x, y| x.1.total_cmp(&y.1))?;
     if turn > opts.max_change_rad {
-        return Some((vec![worst], KeptReason::AngleLimit));
+        return Some((vec![worst], opts.limit_reason));
     }
     let changed: Vec<usize> = (a..b).filter(|&i| cand[i] != planned[i]).collect();
     let bad: Vec<usize> = changed
@@ -566,7 +578,7 @@ pub struct SmoothingSummary {
     /// The same after.
     pub reversals_after: usize,
     /// Those left, per reason (in [`KeptReason::ALL`] order).
-    pub kept: [usize; 4],
+    pub kept: [usize; 5],
     /// Largest turn of a posture (rad).
     pub max_change_rad: f64,
     /// Largest movement of a ball centre (mm).
@@ -770,6 +782,39 @@ mod tests {
         assert!(r.changed > 30);
         // The smoothed azimuth stays within the chatter of the planned one.
         assert!(r.max_change_rad < 1f64.to_radians(), "{}", r.max_change_rad);
+    }
+
+    /// An accuracy budget (a flank pass: the turn that moves the flank by its slack) below
+    /// the chatter: nothing is turned beyond it, and every reversal left is reported as kept
+    /// for accuracy, not as the angle limit.
+    #[test]
+    fn reversals_beyond_an_accuracy_budget_are_kept_for_accuracy() {
+        let run = chattering_run(41);
+        let budget = 0.05f64.to_radians();
+        let opts = AxisSmoothing {
+            max_change_rad: budget,
+            limit_reason: KeptReason::Accuracy,
+            ..AxisSmoothing::ball_end(R)
+        };
+        let r = smooth_run(&run, &opts, &Always);
+        assert!(r.reversals_after.0 + r.reversals_after.1 > 0, "{r:?}");
+        assert_eq!(
+            r.kept.len(),
+            r.reversals_after.0 + r.reversals_after.1,
+            "every reversal left is reported"
+        );
+        assert!(
+            r.kept.iter().all(|k| k.reason == KeptReason::Accuracy),
+            "{:?}",
+            r.kept
+        );
+        assert!(r.max_change_rad <= budget + 1e-12, "{}", r.max_change_rad);
+        let mut sum = SmoothingSummary::default();
+        sum.add(&r);
+        let mut m = Metrics::new();
+        sum.add_metrics(&mut m);
+        assert!(sum.note().contains("accuracy"), "{}", sum.note());
+        assert_eq!(sum.kept[4], r.kept.len());
     }
 
     /// The tool must lean 10° further round and back to pass a wall in the middle of the run

@@ -17,7 +17,10 @@
 //!    current path (at most `REFINE_ROUNDS` rounds, cutting planes). The operation's
 //!    `max_overcut_mm`, `max_undercut_mm` and `max_deviation_mm` are that dense measurement
 //!    (`sample_max_*` keep the optimiser's own figures); a pass still outside after the
-//!    rounds is refused ([`FlankError::NotAccurate`]).
+//!    rounds is refused ([`FlankError::NotAccurate`]). The pass's tool axes are then made
+//!    monotone about the impeller axis within its accuracy slack ([`crate::axis_smoothing`]:
+//!    turned about the ball centres, clearance re-checked, the smoothed pass measured densely
+//!    again); every direction change left is reported with its reason (`axis_reversals_*`).
 //! 4. Comparison: the largest catalogue cylindrical ball end whose initial path keeps the
 //!    clearance, with its own minimax path, refined and measured densely by the same route
 //!    ([`minimax_measured`]); `stiffness_ratio_vs_cylindrical` is the job tool's stiffness
@@ -727,6 +730,7 @@ impl FlankFinishing {
         let mut initial_dev = 0.0f64;
         let mut final_dev = 0.0f64;
         let mut row_paths: Vec<(Row, ToolPath)> = Vec::new();
+        let mut smoothing = cam_plan::SmoothingSummary::default();
         // The SLP runs are independent of each other (each side's job path; on the first
         // side also the shape study, the best cylinder and the second start): run them in
         // parallel, then report them in the order of the sides.
@@ -825,7 +829,58 @@ impl FlankFinishing {
             let (fs, measured) = job?;
             iterations += measured.iterations;
             termination = worse(termination, measured.termination);
-            let (res, dense) = (&measured.path, &measured.dense);
+            let res = &measured.path;
+            // The written locations between the optimiser's hub-tangency samples may hang the
+            // ball over the hub body's edge (the inlet corner of impeller-8+8's hub: 0.03 mm
+            // into it): each such location is lifted along its axis until the ball keeps the
+            // hub tangency tolerance.
+            let (locations, lifted, lift_max) = lift_off_hub(
+                ctx,
+                &res.locations,
+                ball_radius(&cutter.shape),
+                run.problem.hub_tol,
+            );
+            hub_lifts += lifted;
+            hub_lift_max = hub_lift_max.max(lift_max);
+            // The whole tool along the written pass against the whole design: a finishing
+            // pass may touch its side within the overcut tolerance (its accuracy there is the
+            // dense measurement's; this check is for the rest of the design), its motions
+            // within the chord tolerance more, nothing else nearer.
+            let floor = -(run.problem.overcut_tol + ctx.tolerances.chord_tol);
+            let check = PassCheck::new(
+                ctx.clearance,
+                PassFloors {
+                    blades_mm: floor,
+                    hub_mm: floor - run.problem.hub_tol,
+                    motion_tol_mm: ctx.tolerances.chord_tol,
+                },
+                cutter.flute_length,
+            );
+            // The axes made monotone within the pass's accuracy slack (issue 37), the
+            // smoothed pass measured densely again: its figures are the side's when accepted.
+            let pr = &run.problem;
+            let smoothed = crate::axis_smoothing::smooth_pass(
+                &crate::axis_smoothing::PlannedPass {
+                    locations: &locations,
+                    side: &fs,
+                    shape: cutter.shape,
+                    flute_length: pr.flute_length,
+                    root: pr.min_sample_height.max(ball_radius(&cutter.shape)),
+                    tol_mm: (pr.overcut_tol, pr.undercut_tol),
+                    measured_mm: (
+                        measured.dense.max_overcut_mm,
+                        measured.dense.max_undercut_mm,
+                    ),
+                    report_mm: REFINE_FRACTION * pr.overcut_tol.min(pr.undercut_tol),
+                },
+                &check,
+            )?;
+            let (_, copies) = rows::pitch_and_count(ctx.impeller, row)?;
+            let mut one = cam_plan::SmoothingSummary::default();
+            one.add(&smoothed.run);
+            smoothing.merge(&one.times(copies));
+            let dense = smoothed.dense.as_ref().unwrap_or(&measured.dense);
+            let locations = smoothed.run.postures;
             refine_rounds += measured.refine_rounds;
             dense_points += dense.points;
             uncertified += dense.uncertified;
@@ -948,32 +1003,6 @@ impl FlankFinishing {
                 .map(|(l, h)| (l.as_str(), h.as_slice()))
                 .collect();
             out.plots.extend(history_plots(&refs));
-            // The written locations between the optimiser's hub-tangency samples may hang the
-            // ball over the hub body's edge (the inlet corner of impeller-8+8's hub: 0.03 mm
-            // into it): each such location is lifted along its axis until the ball keeps the
-            // hub tangency tolerance.
-            let (locations, lifted, lift_max) = lift_off_hub(
-                ctx,
-                &res.locations,
-                ball_radius(&cutter.shape),
-                run.problem.hub_tol,
-            );
-            hub_lifts += lifted;
-            hub_lift_max = hub_lift_max.max(lift_max);
-            // The whole tool along the written pass against the whole design: a finishing
-            // pass may touch its side within the overcut tolerance (its accuracy there is the
-            // dense measurement's; this check is for the rest of the design), its motions
-            // within the chord tolerance more, nothing else nearer.
-            let floor = -(run.problem.overcut_tol + ctx.tolerances.chord_tol);
-            let check = PassCheck::new(
-                ctx.clearance,
-                PassFloors {
-                    blades_mm: floor,
-                    hub_mm: floor - run.problem.hub_tol,
-                    motion_tol_mm: ctx.tolerances.chord_tol,
-                },
-                cutter.flute_length,
-            );
             let violations = check.check(&locations);
             let worst_violation = violations
                 .iter()
@@ -1066,6 +1095,13 @@ impl FlankFinishing {
         );
         metrics.number("max_overcut_mm", over);
         metrics.number("max_undercut_mm", under);
+        smoothing.add_metrics(&mut metrics);
+        out.notes.push(format!(
+            "{} (about the ball centre, within each pass's accuracy slack, the smoothed pass \
+             measured densely again)",
+            smoothing.note()
+        ));
+        out.plots.extend(smoothing.plot());
         metrics.count("hub_lifted_locations", hub_lifts);
         metrics.number("max_hub_lift_mm", hub_lift_max);
         metrics.number("sample_max_overcut_mm", sample_over);

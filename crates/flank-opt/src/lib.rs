@@ -33,6 +33,7 @@
 //! Dependency direction: `nurbs`, `cam-core`, `impeller-model`, `cutter-stiffness`,
 //! `cam-plan` only.
 
+pub mod axis_smoothing;
 pub mod catalogue;
 pub mod finishing;
 pub mod geometry;

@@ -173,4 +173,50 @@ fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
         worst.1
     );
     assert!(reported <= TOL, "reported {reported}");
+
+    // Issue 37: every direction change of the tool-axis angles (about the impeller axis)
+    // inside the written passes is either smoothed away or reported with its reason, and the
+    // count reported is the count of the written passes (counted here independently).
+    let count = |k: &str| match planned.metrics.get(k) {
+        Some(MetricValue::Count(v)) => *v as usize,
+        other => panic!("metric {k}: {other:?}"),
+    };
+    let mut written = 0;
+    let mut run: Vec<cam_core::CutterLocation> = Vec::new();
+    let mut runs = 0;
+    for m in path.moves.iter().chain(std::iter::once(&path.moves[0])) {
+        if m.kind == MoveKind::Feed {
+            run.push(m.cl);
+            continue;
+        }
+        if run.len() > 2 {
+            runs += 1;
+            let angles = cam_plan::axis_smoothing::spherical_angles(&run);
+            for pick in [|a: &(f64, f64)| a.0, |a: &(f64, f64)| a.1] {
+                let x: Vec<f64> = angles.iter().map(pick).collect();
+                written += cam_plan::axis_smoothing::reversal_indices(&x).len();
+            }
+        }
+        run.clear();
+    }
+    assert!(runs >= 1);
+    let after = count("axis_reversals_after");
+    let kept: usize = [
+        "clearance",
+        "angle_limit",
+        "near_pole",
+        "budget",
+        "accuracy",
+    ]
+    .iter()
+    .map(|r| count(&format!("axis_reversals_kept_{r}")))
+    .sum();
+    assert_eq!(kept, after, "every reversal left has its reason");
+    // The pass is copied to every main blade: one blade's pass holds 1/blades of them.
+    let blades = imp.main().count();
+    assert_eq!(
+        written * blades,
+        after,
+        "{written} per pass x {blades} blades"
+    );
 }
