@@ -179,6 +179,9 @@ impl BladePointFinishing {
             passes_along: p.passes_along,
             // Finishing: a flank region must leave no more than the flank tolerance.
             flank_residual_mm: Some(p.flank_tol_mm.unwrap_or(tol)),
+            // Issue 37: left out here (see the report of issue 37: a 0.062 mm blade-tip
+            // overcut on impeller-autoblade-12+12 when the point runs were smoothed).
+            smooth_flank_axes: false,
             point: PointSettings {
                 ball_radius: ball_radius(&shape),
                 half_angle,

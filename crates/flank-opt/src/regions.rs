@@ -23,11 +23,13 @@
 //! ([`crate::point::scallop`]), over a grid of the region, giving the largest overcut and
 //! residual of the surface the operation is to leave (the side offset by its allowance).
 
+use crate::axis_smoothing::{accuracy_turn_limit, kept_for_accuracy, WIDER_LIMIT};
 use crate::point::{self, scallop::SweptBalls, BandPlan, PointSettings};
 use crate::rows;
 use crate::semi::strip_pass;
 use crate::FlankError;
 use cam_core::{CutterLocation, Point3};
+use cam_plan::axis_smoothing::{smooth_run, AxisSmoothing, KeptReason, RunSmoothing};
 use cam_plan::{PassCheck, PassFloors, PlanContext, Row};
 use impeller_model::{Blade, Side};
 use serde::Deserialize;
@@ -81,6 +83,9 @@ pub struct SideSettings {
     /// A ruled strip within τ does not make a flank pass within τ: the cone cannot stay
     /// tangent along every ruling of a twisted (non-developable) ruled surface.
     pub flank_residual_mm: Option<f64>,
+    /// Whether the tool axes of each flank pass are smoothed within its accuracy slack
+    /// ([`smooth_flank_region`]).
+    pub smooth_flank_axes: bool,
     /// Point milling of the other regions.
     pub point: PointSettings,
 }
@@ -113,6 +118,8 @@ pub struct Region {
     pub lifted: bool,
     /// The point-milling plan (point regions).
     pub band: Option<BandPlan>,
+    /// The axis smoothing of a flank pass ([`smooth_flank_region`]), when asked for.
+    pub axis_smoothing: Option<RunSmoothing>,
 }
 
 /// The regions of one side, shroud end first.
@@ -259,9 +266,28 @@ pub fn plan_side(
             }
             Err(why) => Err(why),
         };
+        let outcome = match outcome {
+            Ok((pass, over, residual)) if st.smooth_flank_axes => {
+                let sm = smooth_flank_region(
+                    ctx,
+                    (&blade, side, strip.v_range),
+                    &pass,
+                    (over, residual),
+                    st,
+                    &flank_check,
+                )?;
+                Ok((pass, sm.over, sm.residual, Some(sm)))
+            }
+            Ok((pass, over, residual)) => Ok((pass, over, residual, None)),
+            Err(why) => Err(why),
+        };
         match outcome {
-            Ok((pass, over, residual)) => {
+            Ok((pass, over, residual, smoothed)) => {
                 flush(&mut pending_point, &mut regions)?;
+                let (locations, axis_smoothing) = match smoothed {
+                    Some(sm) => (sm.run.postures.clone(), Some(sm.run)),
+                    None => (pass.locations, None),
+                };
                 let method = if whole {
                     Method::Flank
                 } else {
@@ -284,12 +310,13 @@ pub fn plan_side(
                         ),
                     },
                     deviation_mm: Some(strip.max_deviation_mm),
-                    runs: vec![pass.locations],
+                    runs: vec![locations],
                     max_overcut_mm: over,
                     max_residual_mm: residual,
                     max_scallop_mm: 0.0,
                     lifted: pass.lifted,
                     band: None,
+                    axis_smoothing,
                 });
             }
             Err(why) => {
@@ -316,6 +343,76 @@ pub fn plan_side(
         strips: strips.len(),
         max_strip_deviation_mm: max_dev,
     })
+}
+
+/// A flank pass after [`smooth_flank_region`]: its axis smoothing and the measurement of
+/// the pass written.
+#[derive(Debug, Clone)]
+pub struct SmoothedFlank {
+    /// The smoothing (its postures are the pass written).
+    pub run: RunSmoothing,
+    /// Largest overcut and residual of the pass written (mm, [`measure_flank`]).
+    pub over: f64,
+    /// See `over`.
+    pub residual: f64,
+}
+
+/// The tool axes of a clear flank pass over a strip made monotone about the impeller axis
+/// within the strip tolerance's slack ([`crate::axis_smoothing`]): the turn about the ball
+/// centres limited to what moves no cutter point more than `τ − overcut` (first four times
+/// that, then that), the changed postures and motions checked with the pass's whole-tool
+/// `check`, the smoothed pass's envelope ([`crate::semi::pass_envelope`]) measured again over
+/// the strip ([`measure_flank`]) and accepted only when its overcut stays within `τ` and
+/// its residual grows by at most the slack. Otherwise the planned pass stays and every
+/// direction change of its axis is reported with [`KeptReason::Accuracy`]. Cost: up to two
+/// smoothings and two envelope measurements.
+pub fn smooth_flank_region(
+    ctx: &PlanContext<'_>,
+    (blade, side, strip): (&Blade, Side, (f64, f64)),
+    pass: &crate::semi::StripPass,
+    (over, residual): (f64, f64),
+    st: &SideSettings,
+    check: &PassCheck<'_>,
+) -> Result<SmoothedFlank, FlankError> {
+    let cutter = &ctx.tool.cutter;
+    let tol = st.strip_tol_mm;
+    let slack = tol - over;
+    let budget = accuracy_turn_limit(&cutter.shape, cutter.flute_length, slack);
+    let mut out = SmoothedFlank {
+        run: kept_for_accuracy(&pass.locations),
+        over,
+        residual,
+    };
+    if out.run.kept.is_empty() || budget <= 0.0 {
+        return Ok(out);
+    }
+    for limit in [WIDER_LIMIT * budget, budget] {
+        let opts = AxisSmoothing {
+            max_change_rad: limit,
+            limit_reason: KeptReason::Accuracy,
+            ..AxisSmoothing::ball_end(crate::geometry::ball_radius(&cutter.shape))
+        };
+        let run = smooth_run(&pass.locations, &opts, check);
+        if run.changed == 0 {
+            continue;
+        }
+        let env = crate::semi::pass_envelope(
+            &cutter.shape,
+            cutter.flute_length,
+            &run.postures,
+            pass.upper_mm,
+        )?;
+        let (o2, r2) = measure_flank(blade, side, strip, &env, st.point.allowance_mm)?;
+        if o2 <= tol && r2 <= residual + slack {
+            out = SmoothedFlank {
+                run,
+                over: o2,
+                residual: r2,
+            };
+            return Ok(out);
+        }
+    }
+    Ok(out)
 }
 
 /// Point-mills `band` of the side and measures it.
@@ -349,6 +446,7 @@ fn point_region(
         max_scallop_mm: scallop,
         lifted: false,
         band: Some(plan),
+        axis_smoothing: None,
     })
 }
 

@@ -352,6 +352,39 @@ pub struct StripPass {
     pub lifted: bool,
     /// The swept envelope of the pass (its tool surface, for measurements).
     pub envelope: SweptEnvelope,
+    /// Height of the envelope's upper guide above the ball centres (mm; the highest contact).
+    pub upper_mm: f64,
+}
+
+/// The swept envelope of a strip pass written at `locations`: the sphere family of `shape`
+/// along the guides through the ball centres and the axis points `upper` above them, as
+/// [`strip_pass`] builds it (so the envelope of its own locations is its own envelope).
+/// O(locations).
+pub fn pass_envelope(
+    shape: &CutterShape,
+    flute_length: f64,
+    locations: &[cam_core::CutterLocation],
+    upper: f64,
+) -> Result<SweptEnvelope, FlankError> {
+    let r = ball_radius(shape);
+    let family = SphereFamily::from_shape(shape, flute_length)?;
+    let c: Vec<Vector3> = locations
+        .iter()
+        .map(|l| l.tip.coords + l.axis.into_inner() * r)
+        .collect();
+    let t: Vec<Vector3> = c
+        .iter()
+        .zip(locations)
+        .map(|(c, l)| c + l.axis.into_inner() * upper)
+        .collect();
+    let (g0, g1) = guides_through(&c, &t)?;
+    Ok(SweptEnvelope::new(
+        family,
+        g0,
+        g1,
+        r,
+        EnvelopeOptions::default(),
+    )?)
 }
 
 fn polyline_length(pts: &[Vector3]) -> f64 {
@@ -425,6 +458,7 @@ impl FlankSemiFinishing {
             strip_tol_mm: p.strip_tol_mm,
             passes_along: p.passes_along,
             flank_residual_mm: None,
+            smooth_flank_axes: true,
             point: PointSettings {
                 ball_radius: r,
                 half_angle,
@@ -490,8 +524,24 @@ impl FlankSemiFinishing {
                 .collect::<Vec<_>>()
                 .join(", "),
         );
+        // Issue 37: the axis smoothing of the flank passes, counted over every blade.
+        let mut smoothing = cam_plan::SmoothingSummary::default();
+        for (row, _, sp) in &plan.sides {
+            let (_, copies) = crate::rows::pitch_and_count(ctx.impeller, *row)?;
+            let mut one = cam_plan::SmoothingSummary::default();
+            for rs in sp.regions.iter().filter_map(|g| g.axis_smoothing.as_ref()) {
+                one.add(rs);
+            }
+            smoothing.merge(&one.times(copies));
+        }
+        smoothing.add_metrics(&mut m);
         let lifts = plan.regions().filter(|g| g.lifted).count();
         let mut notes = plan.notes();
+        notes.push(format!(
+            "flank passes: {} (about the ball centre, within the strip tolerance's slack, the \
+             smoothed pass measured again)",
+            smoothing.note()
+        ));
         if lifts > 0 {
             notes.push(format!(
                 "{lifts} pass(es) lifted along the axis to keep the allowance on the strips \
@@ -519,7 +569,7 @@ impl FlankSemiFinishing {
         Ok(PlannedOperation {
             paths: plan.paths,
             metrics: m,
-            plots: Vec::new(),
+            plots: smoothing.plot().into_iter().collect(),
             notes,
         })
     }
@@ -657,5 +707,6 @@ pub fn strip_pass(
         locations,
         lifted,
         envelope: env,
+        upper_mm: upper,
     })
 }

@@ -119,6 +119,7 @@ fn side_settings(
         strip_tol_mm: tol,
         passes_along: 30,
         flank_residual_mm: None,
+        smooth_flank_axes: false,
         point: PointSettings {
             ball_radius: r,
             half_angle: theta,
