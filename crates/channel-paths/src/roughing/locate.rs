@@ -19,11 +19,12 @@ use super::level::{AreaPlan, LevelPlan};
 use super::operation::ChannelRoughing;
 use super::ordering::{self, Anchors, Linking};
 use super::plan2d::{Path2, Region};
-use super::posture::{Blocked, Posture, BRIDGE_DEPTH, SEGMENT_QUERIES};
+use super::posture::{clear_posture, Blocked, Posture, BRIDGE_DEPTH, SEGMENT_QUERIES};
 use super::scallop::ScallopProbe;
 use super::sides::Bound;
+use cam_core::CutterShape;
 use cam_core::{CutterLocation, Move, MoveKind};
-use cam_plan::{DesignClearance, PlanContext, PlanError};
+use cam_plan::{DesignClearance, PlanContext, PlanError, PostureCheck};
 use impeller_model::levels::DepthLevel;
 use nalgebra::Vector3;
 
@@ -111,6 +112,8 @@ pub(super) struct LevelCl {
     pub(super) split_motions: usize,
     /// Intermediate postures inserted to certify motions.
     pub(super) bridge_postures: usize,
+    /// The axis smoothing of the located runs ([`cam_plan::axis_smoothing`]).
+    pub(super) smoothing: cam_plan::SmoothingSummary,
     /// Per lane, what the report draws.
     pub(super) sketch: Vec<LaneSketch>,
 }
@@ -138,6 +141,46 @@ impl Run {
             q: self.q.iter().rev().copied().collect(),
             postures: self.postures.iter().rev().copied().collect(),
         }
+    }
+}
+
+/// The checks of a located run's smoothed postures ([`Locator::smooth_run_axes`]).
+struct RunCheck<'a, 'b> {
+    loc: &'a Locator<'b>,
+    max_tilt: f64,
+    /// The level normal at each posture's planar point.
+    normals: Vec<Vector3<f64>>,
+}
+
+impl RunCheck<'_, '_> {
+    fn clear(&self, cl: &CutterLocation) -> Option<cam_plan::Clearance> {
+        clear_posture(self.loc.ctx, self.loc.fit, self.loc.fit_min, cl, 0.0)
+    }
+}
+
+impl PostureCheck for RunCheck<'_, '_> {
+    fn posture_clear(&self, index: usize, cl: &CutterLocation) -> bool {
+        let within_tilt = self
+            .normals
+            .get(index)
+            .is_some_and(|n| cl.axis.angle(n) <= self.max_tilt + 1e-9);
+        within_tilt && self.clear(cl).is_some()
+    }
+    fn motion_clear(&self, _: usize, a: &CutterLocation, b: &CutterLocation) -> bool {
+        let (Some(ca), Some(cb)) = (self.clear(a), self.clear(b)) else {
+            return false;
+        };
+        self.loc
+            .ctx
+            .clearance
+            .segment_clearance_between(
+                (a, ca.distance_mm),
+                (b, cb.distance_mm),
+                0.0,
+                self.loc.seg_tol(),
+                SEGMENT_QUERIES,
+            )
+            .is_ok()
     }
 }
 
@@ -242,7 +285,52 @@ impl Locator<'_> {
         if cur.postures.len() >= 2 {
             runs.push(cur);
         }
+        for run in &mut runs {
+            self.smooth_run_axes(axes, run, &mut out.smoothing);
+        }
         Ok(runs)
+    }
+
+    /// The shared axis smoothing ([`cam_plan::axis_smoothing`]) of a located run: each
+    /// posture turned about its ball centre (the ball keeps touching the level at the same
+    /// point), the turned postures held to the tests of [`ChannelRoughing::posture`] (the tilt
+    /// limit from the level normal, the whole tool clear of the design and `fit_min` from the
+    /// blades) and the motions touching them certified as in [`ChannelRoughing::bridge`]
+    /// (without bridge postures: a motion that does not certify directly refuses the fit).
+    fn smooth_run_axes(
+        &self,
+        axes: &Axes<'_>,
+        run: &mut Run,
+        summary: &mut cam_plan::SmoothingSummary,
+    ) {
+        // Only a ball's contact stays where it was when the axis turns about its centre.
+        let r = match self.ctx.tool.cutter.shape {
+            CutterShape::BallEnd { radius } => radius,
+            CutterShape::TaperedBallEnd { ball_radius, .. } => ball_radius,
+            _ => return,
+        };
+        let cls: Vec<CutterLocation> = run.postures.iter().map(|p| p.0).collect();
+        let normals: Vec<Vector3<f64>> = run.q.iter().map(|&q| axes.point_of(q).1).collect();
+        let check = RunCheck {
+            loc: self,
+            max_tilt: axes.max_tilt,
+            normals,
+        };
+        let r = cam_plan::axis_smoothing::smooth_run(
+            &cls,
+            &cam_plan::AxisSmoothing::ball_end(r),
+            &check,
+        );
+        summary.add(&r);
+        for (p, cl) in run.postures.iter_mut().zip(&r.postures) {
+            if p.0 != *cl {
+                // Checked clear by `smooth_run`; its clearance is asked again for the
+                // motion checks and the metrics that read it.
+                if let Some(c) = check.clear(cl) {
+                    *p = (*cl, c);
+                }
+            }
+        }
     }
 
     /// The link on the level from `from` (planar point and posture) to `to` through the
@@ -440,6 +528,7 @@ impl ChannelRoughing {
             skipped_tool: 0,
             split_motions: 0,
             bridge_postures: 0,
+            smoothing: cam_plan::SmoothingSummary::default(),
             sketch: Vec::new(),
         };
         let lv = &lp.level;

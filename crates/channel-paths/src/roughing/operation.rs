@@ -483,7 +483,10 @@ impl ChannelRoughing {
             .count("skipped_shank_or_holder", sum.skipped_tool * count)
             .count("split_motions", sum.split * count)
             .count("bridge_postures", sum.bridged * count);
-        let plots = self.plot(&levels, &per_level);
+        let smoothing = std::mem::take(&mut sum.smoothing).times(count);
+        smoothing.add_metrics(&mut metrics);
+        let mut plots = self.plot(&levels, &per_level);
+        plots.extend(smoothing.plot());
         let offsets = levels
             .iter()
             .flat_map(|l| l.bounds.iter().map(|b| b.offset.abs()))
@@ -495,6 +498,7 @@ impl ChannelRoughing {
             metrics,
             plots,
             notes: vec![
+                smoothing.note(),
                 format!(
                     "{n_levels} levels of ≤ {doc} mm; {} bounding sides per level (ruled over \
                      each level's span band, offset {:.3}–{:.3} mm); the cutter does not fit \
@@ -553,6 +557,7 @@ struct Sums {
     skipped_tool: usize,
     split: usize,
     bridged: usize,
+    smoothing: cam_plan::SmoothingSummary,
 }
 
 impl Sums {
@@ -578,6 +583,7 @@ impl Sums {
         self.skipped_tool += lc.skipped_tool;
         self.split += lc.split_motions;
         self.bridged += lc.bridge_postures;
+        self.smoothing.merge(&lc.smoothing);
     }
 }
 

@@ -32,6 +32,28 @@ pub(super) enum Blocked {
     ShankOrHolder,
 }
 
+/// The clearance of the whole tool at `cl` when it keeps `want` (at least 0) from the design
+/// and `fit_min` from the blades, the test of [`ChannelRoughing::posture`]. The whole tool's
+/// clearance to the design bounds its clearance to the blades from below: the blades alone are
+/// asked only when the nearest part is the hub or the shroud and comes within `fit_min`.
+pub(super) fn clear_posture(
+    ctx: &PlanContext<'_>,
+    fit: &FitQuery<'_>,
+    fit_min: f64,
+    cl: &CutterLocation,
+    want: f64,
+) -> Option<cam_plan::Clearance> {
+    let c = ctx.clearance.clearance_if_clear(cl, want)?;
+    if c.distance_mm < fit_min {
+        let blades_kept = !matches!(c.design_part, cam_plan::DesignPart::Blade { .. })
+            && fit.tool.is_clear(cl, fit_min);
+        if !blades_kept {
+            return None;
+        }
+    }
+    Some(c)
+}
+
 impl ChannelRoughing {
     /// A posture at planar `q` (module docs, step 5): the axes `first` (when given), then
     /// the candidates of [`Axes::candidates`]; the whole tool (cutter, shank and holder) must
@@ -67,21 +89,10 @@ impl ChannelRoughing {
             // The whole tool's clearance bounds the cutter's against the blades from below:
             // the cutter query runs only when the whole tool's does not settle it.
             let want = if fallback.is_none() { 0.0 } else { room };
-            let Some(c) = ctx.clearance.clearance_if_clear(&cl, want) else {
+            let Some(c) = clear_posture(ctx, fit, fit_min, &cl, want) else {
                 cutter_fits = cutter_fits || fit.cutter.is_clear(&cl, fit_min);
                 continue;
             };
-            // The whole tool's clearance to the design bounds its clearance to the blades from
-            // below: the blades alone are asked only when the nearest part is the hub or
-            // the shroud and comes within `fit_min`.
-            if c.distance_mm < fit_min {
-                let blades_kept = !matches!(c.design_part, cam_plan::DesignPart::Blade { .. })
-                    && fit.tool.is_clear(&cl, fit_min);
-                if !blades_kept {
-                    cutter_fits = cutter_fits || fit.cutter.is_clear(&cl, fit_min);
-                    continue;
-                }
-            }
             cutter_fits = true;
             if c.distance_mm >= room {
                 return Ok(Ok((cl, c)));
