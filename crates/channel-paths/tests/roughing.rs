@@ -198,6 +198,18 @@ fn rough_tapered_ball_trimmed_to_where_the_cutter_fits() {
     );
     let (area, out) = (get("level_area_mm2"), get("unmachinable_area_mm2"));
     assert!(out > 0.0 && out < 0.2 * area, "{out} of {area} mm²");
+    // Issue 37: the located runs' axes smoothed about the ball centres (the postures above,
+    // all clear, are the smoothed ones): fewer direction changes, each one left reported
+    // with its reason, no ball centre moved.
+    let (before, after) = (get("axis_reversals_before"), get("axis_reversals_after"));
+    assert!(after < before, "{before} -> {after}");
+    let kept: f64 = ["clearance", "angle_limit", "near_pole", "budget", "accuracy"]
+        .iter()
+        .map(|r| get(&format!("axis_reversals_kept_{r}")))
+        .sum();
+    assert_eq!(kept, after);
+    assert!(get("axis_smoothing_runs_smoothed") >= 1.0);
+    assert!(get("axis_smoothing_max_centre_shift_mm") <= 1e-6);
     assert!(get("saving_ratio") > 0.0);
 }
 
