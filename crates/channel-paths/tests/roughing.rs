@@ -203,10 +203,16 @@ fn rough_tapered_ball_trimmed_to_where_the_cutter_fits() {
     // with its reason, no ball centre moved.
     let (before, after) = (get("axis_reversals_before"), get("axis_reversals_after"));
     assert!(after < before, "{before} -> {after}");
-    let kept: f64 = ["clearance", "angle_limit", "near_pole", "budget", "accuracy"]
-        .iter()
-        .map(|r| get(&format!("axis_reversals_kept_{r}")))
-        .sum();
+    let kept: f64 = [
+        "clearance",
+        "angle_limit",
+        "near_pole",
+        "budget",
+        "accuracy",
+    ]
+    .iter()
+    .map(|r| get(&format!("axis_reversals_kept_{r}")))
+    .sum();
     assert_eq!(kept, after);
     assert!(get("axis_smoothing_runs_smoothed") >= 1.0);
     assert!(get("axis_smoothing_max_centre_shift_mm") <= 1e-6);

@@ -94,39 +94,58 @@ pub struct PlannedPass<'a> {
     pub report_mm: f64,
 }
 
-/// Smooths the axes of one flank pass within its accuracy slack (module docs); `check` is the
-/// whole-tool clearance query of the pass.
+/// The accuracy-limited fits of a flank pass at `locations` (module docs): the shared
+/// smoothing with the turn limited to [`WIDER_LIMIT`] times `budget` (rad), then `budget`,
+/// each changed pass handed to `measure`, which returns its measurement when the pass keeps
+/// its tolerances. The first accepted smoothing with its measurement, or `None` (no direction
+/// change, no budget, or no fit accepted). Cost: up to two smoothings and two measurements.
+pub fn within_budget<T>(
+    locations: &[CutterLocation],
+    shape: &CutterShape,
+    budget: f64,
+    check: &dyn PostureCheck,
+    mut measure: impl FnMut(&[CutterLocation]) -> Result<Option<T>, FlankError>,
+) -> Result<Option<(RunSmoothing, T)>, FlankError> {
+    let angles = spherical_angles(locations);
+    let th: Vec<f64> = angles.iter().map(|a| a.0).collect();
+    let ph: Vec<f64> = angles.iter().map(|a| a.1).collect();
+    let reverses = !reversal_indices(&th).is_empty() || !reversal_indices(&ph).is_empty();
+    if !reverses || budget <= 0.0 {
+        return Ok(None);
+    }
+    for limit in [WIDER_LIMIT * budget, budget] {
+        let opts = AxisSmoothing {
+            max_change_rad: limit,
+            limit_reason: KeptReason::Accuracy,
+            ..AxisSmoothing::ball_end(ball_radius(shape))
+        };
+        let run = smooth_run(locations, &opts, check);
+        if run.changed == 0 {
+            continue;
+        }
+        if let Some(m) = measure(&run.postures)? {
+            return Ok(Some((run, m)));
+        }
+    }
+    Ok(None)
+}
+
+/// Smooths the axes of one flank pass within its accuracy slack (module docs), each smoothed
+/// pass measured densely ([`measure_written_path`]) and accepted when it holds both
+/// tolerances (certified queries included); `check` is the whole-tool clearance query of the
+/// pass.
 pub fn smooth_pass(
     pass: &PlannedPass<'_>,
     check: &dyn PostureCheck,
 ) -> Result<PassSmoothing, FlankError> {
     let slack = (pass.tol_mm.0 - pass.measured_mm.0).min(pass.tol_mm.1 - pass.measured_mm.1);
     let budget = accuracy_turn_limit(&pass.shape, pass.flute_length, slack);
-    let r = ball_radius(&pass.shape);
-    let mut out = PassSmoothing {
-        run: kept_for_accuracy(pass.locations),
-        dense: None,
-        slack_mm: slack,
-        budget_rad: budget,
-    };
-    if out.run.kept.is_empty() || budget <= 0.0 {
-        return Ok(out);
-    }
-    for limit in [WIDER_LIMIT * budget, budget] {
-        let opts = AxisSmoothing {
-            max_change_rad: limit,
-            limit_reason: KeptReason::Accuracy,
-            ..AxisSmoothing::ball_end(r)
-        };
-        let run = smooth_run(pass.locations, &opts, check);
-        if run.changed == 0 {
-            continue;
-        }
+    let accepted = within_budget(pass.locations, &pass.shape, budget, check, |postures| {
         let dense = measure_written_path(
             pass.side,
             &pass.shape,
             pass.flute_length,
-            &run.postures,
+            postures,
             pass.root,
             DenseGrid::default(),
             pass.report_mm,
@@ -134,13 +153,18 @@ pub fn smooth_pass(
         let holds = dense.max_overcut_mm <= pass.tol_mm.0
             && dense.max_undercut_mm <= pass.tol_mm.1
             && dense.uncertified_max_overcut_mm <= pass.tol_mm.0;
-        if holds {
-            out.run = run;
-            out.dense = Some(dense);
-            return Ok(out);
-        }
-    }
-    Ok(out)
+        Ok(holds.then_some(dense))
+    })?;
+    let (run, dense) = match accepted {
+        Some((run, dense)) => (run, Some(dense)),
+        None => (kept_for_accuracy(pass.locations), None),
+    };
+    Ok(PassSmoothing {
+        run,
+        dense,
+        slack_mm: slack,
+        budget_rad: budget,
+    })
 }
 
 /// The planned pass unchanged, every direction change of its axis angles reported with

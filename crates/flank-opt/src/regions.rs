@@ -23,13 +23,13 @@
 //! ([`crate::point::scallop`]), over a grid of the region, giving the largest overcut and
 //! residual of the surface the operation is to leave (the side offset by its allowance).
 
-use crate::axis_smoothing::{accuracy_turn_limit, kept_for_accuracy, WIDER_LIMIT};
+use crate::axis_smoothing::{accuracy_turn_limit, kept_for_accuracy, within_budget};
 use crate::point::{self, scallop::SweptBalls, BandPlan, PointSettings};
 use crate::rows;
 use crate::semi::strip_pass;
 use crate::FlankError;
 use cam_core::{CutterLocation, Point3};
-use cam_plan::axis_smoothing::{smooth_run, AxisSmoothing, KeptReason, RunSmoothing};
+use cam_plan::axis_smoothing::RunSmoothing;
 use cam_plan::{PassCheck, PassFloors, PlanContext, Row};
 use impeller_model::{Blade, Side};
 use serde::Deserialize;
@@ -364,7 +364,7 @@ pub struct SmoothedFlank {
 /// `check`, the smoothed pass's envelope ([`crate::semi::pass_envelope`]) measured again over
 /// the strip ([`measure_flank`]) and accepted only when its overcut stays within `τ` and
 /// its residual grows by at most the slack. Otherwise the planned pass stays and every
-/// direction change of its axis is reported with [`KeptReason::Accuracy`]. Cost: up to two
+/// direction change of its axis is reported with [`cam_plan::KeptReason::Accuracy`]. Cost: up to two
 /// smoothings and two envelope measurements.
 pub fn smooth_flank_region(
     ctx: &PlanContext<'_>,
@@ -378,41 +378,28 @@ pub fn smooth_flank_region(
     let tol = st.strip_tol_mm;
     let slack = tol - over;
     let budget = accuracy_turn_limit(&cutter.shape, cutter.flute_length, slack);
-    let mut out = SmoothedFlank {
-        run: kept_for_accuracy(&pass.locations),
-        over,
-        residual,
-    };
-    if out.run.kept.is_empty() || budget <= 0.0 {
-        return Ok(out);
-    }
-    for limit in [WIDER_LIMIT * budget, budget] {
-        let opts = AxisSmoothing {
-            max_change_rad: limit,
-            limit_reason: KeptReason::Accuracy,
-            ..AxisSmoothing::ball_end(crate::geometry::ball_radius(&cutter.shape))
-        };
-        let run = smooth_run(&pass.locations, &opts, check);
-        if run.changed == 0 {
-            continue;
-        }
+    let accepted = within_budget(&pass.locations, &cutter.shape, budget, check, |postures| {
         let env = crate::semi::pass_envelope(
             &cutter.shape,
             cutter.flute_length,
-            &run.postures,
+            postures,
             pass.upper_mm,
         )?;
         let (o2, r2) = measure_flank(blade, side, strip, &env, st.point.allowance_mm)?;
-        if o2 <= tol && r2 <= residual + slack {
-            out = SmoothedFlank {
-                run,
-                over: o2,
-                residual: r2,
-            };
-            return Ok(out);
-        }
-    }
-    Ok(out)
+        Ok((o2 <= tol && r2 <= residual + slack).then_some((o2, r2)))
+    })?;
+    Ok(match accepted {
+        Some((run, (over, residual))) => SmoothedFlank {
+            run,
+            over,
+            residual,
+        },
+        None => SmoothedFlank {
+            run: kept_for_accuracy(&pass.locations),
+            over,
+            residual,
+        },
+    })
 }
 
 /// Point-mills `band` of the side and measures it.
