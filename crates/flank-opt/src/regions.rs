@@ -345,6 +345,9 @@ pub fn plan_side(
     })
 }
 
+/// Rounding allowed to the overcut of a smoothed flank pass over its planned one (mm).
+pub const NO_WORSE_MM: f64 = 1e-6;
+
 /// A flank pass after [`smooth_flank_region`]: its axis smoothing and the measurement of
 /// the pass written.
 #[derive(Debug, Clone)]
@@ -362,8 +365,9 @@ pub struct SmoothedFlank {
 /// centres limited to what moves no cutter point more than `τ − overcut` (first four times
 /// that, then that), the changed postures and motions checked with the pass's whole-tool
 /// `check`, the smoothed pass's envelope ([`crate::semi::pass_envelope`]) measured again over
-/// the strip ([`measure_flank`]) and accepted only when its overcut stays within `τ` and
-/// its residual grows by at most the slack. Otherwise the planned pass stays and every
+/// the strip ([`measure_flank`]) and accepted only when its overcut does not grow (the
+/// allowance left to finishing is not eaten further; [`NO_WORSE_MM`] for rounding) and its
+/// residual grows by at most the slack. Otherwise the planned pass stays and every
 /// direction change of its axis is reported with [`cam_plan::KeptReason::Accuracy`]. Cost: up to two
 /// smoothings and two envelope measurements.
 pub fn smooth_flank_region(
@@ -386,7 +390,7 @@ pub fn smooth_flank_region(
             pass.upper_mm,
         )?;
         let (o2, r2) = measure_flank(blade, side, strip, &env, st.point.allowance_mm)?;
-        Ok((o2 <= tol && r2 <= residual + slack).then_some((o2, r2)))
+        Ok((o2 <= over + NO_WORSE_MM && r2 <= residual + slack).then_some((o2, r2)))
     })?;
     Ok(match accepted {
         Some((run, (over, residual))) => SmoothedFlank {

@@ -21,7 +21,10 @@
 //!    centre its hub allowance less `strip_tol` from the hub body; a pass that comes nearer
 //!    is lifted along its axes by bisection until it keeps that distance ([`strip_pass`]).
 //!    The pass is then checked for its whole tool against the whole design
-//!    ([`crate::regions`]); a strip whose pass is not clear is point-milled instead;
+//!    ([`crate::regions`]); a strip whose pass is not clear is point-milled instead. Its
+//!    tool axes are then made monotone about the impeller axis where the strip tolerance
+//!    allows ([`crate::regions::smooth_flank_region`]: overcut not grown, clearance
+//!    re-checked; the direction changes left reported as kept for accuracy);
 //! 4. baseline: isoparametric point milling of the same side with the same tool: zig-zag
 //!    passes along u, step-over across for the scallop height `h` equal to `strip_tol_mm`
 //!    (`w = 2√(2Rh − h²)` between passes on a locally flat side, R the ball radius); its path

@@ -491,9 +491,9 @@ fn a_step_whose_ball_sags_into_the_side_is_not_clear() {
 /// allowances) have their tool axes made monotone about the impeller axis where the strip
 /// tolerance allows it: fewer direction changes than the planned passes, every one left
 /// reported (as accuracy), every ball centre kept within 1e-6 mm, no posture turned beyond
-/// four times the accuracy budget, the pass still within τ of overcut and clear for the
-/// whole tool. (Measured 2026-11-28: the four reference sides hold 15 direction changes
-/// planned, 4 after, two passes smoothed.)
+/// four times the accuracy budget, the pass's overcut not grown, its residual grown by at
+/// most τ, and clear for the whole tool. (Measured 2026-11-28: the four reference sides
+/// hold 15 direction changes planned, 4 after, two passes smoothed.)
 #[test]
 fn semi_flank_passes_are_smoothed_within_the_strip_tolerance() {
     let imp = impeller_model::load(fixture("impeller-8+8")).unwrap();
@@ -545,7 +545,13 @@ fn semi_flank_passes_are_smoothed_within_the_strip_tolerance() {
                         let d = (x.axis_point(1.5) - y.axis_point(1.5)).norm();
                         assert!(d <= 1e-6, "ball centre moved {d} mm");
                     }
-                    assert!(gb.max_overcut_mm <= tol, "{}", gb.max_overcut_mm);
+                    assert!(
+                        gb.max_overcut_mm <= ga.max_overcut_mm + regions::NO_WORSE_MM,
+                        "overcut {} -> {}",
+                        ga.max_overcut_mm,
+                        gb.max_overcut_mm
+                    );
+                    assert!(gb.max_residual_mm <= ga.max_residual_mm + tol);
                     assert!(check.check(&gb.runs[0]).is_empty());
                 }
             }
