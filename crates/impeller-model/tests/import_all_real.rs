@@ -287,15 +287,8 @@ fn cold_blades_below_a_hot_shroud_are_refused_and_their_fit_does_not_swing() {
             b.name
         );
         for s in [&b.pressure, &b.suction] {
-            let ((u0, u1), (v0, v1)) = s.domain();
-            for i in 0..=1600 {
-                for j in 0..=32 {
-                    let p = s.point(
-                        u0 + (u1 - u0) * i as f64 / 1600.0,
-                        v0 + (v1 - v0) * j as f64 / 32.0,
-                    );
-                    assert!(p.x.hypot(p.y) < 230.0, "{} at {i}, {j}: {p:?}", b.name);
-                }
+            for (i, j, p) in import_common::grid_points(s, 1600, 32) {
+                assert!(p.x.hypot(p.y) < 230.0, "{} at {i}, {j}: {p:?}", b.name);
             }
         }
     }

@@ -44,19 +44,11 @@ fn exports_load_by_extension() {
             impeller_model::Side::Pressure,
             impeller_model::Side::Suction,
         ] {
-            let s = b.side(side);
-            let ((u0, u1), (v0, v1)) = s.domain();
-            for i in 0..=160 {
-                for j in 0..=32 {
-                    let p = s.point(
-                        u0 + (u1 - u0) * i as f64 / 160.0,
-                        v0 + (v1 - v0) * j as f64 / 32.0,
-                    );
-                    assert!(
-                        (-3.0..=45.0).contains(&p.z) && p.x.hypot(p.y) <= 43.0,
-                        "{side:?} ({i}, {j}): {p:?}"
-                    );
-                }
+            for (i, j, p) in import_common::grid_points(b.side(side), 160, 32) {
+                assert!(
+                    (-3.0..=45.0).contains(&p.z) && p.x.hypot(p.y) <= 43.0,
+                    "{side:?} ({i}, {j}): {p:?}"
+                );
             }
         }
     }

@@ -19,7 +19,6 @@ use crate::meridional::MeridionalCurve;
 use crate::revolved::RevolvedSurface;
 use crate::stock::Stock;
 use nalgebra::Vector2;
-use nurbs::Curve2;
 use std::path::Path;
 
 /// How an export is turned into an impeller.
@@ -321,66 +320,38 @@ pub fn check_extent(fitted: &FittedImpeller) -> Result<(), ImportError> {
     Ok(())
 }
 
-/// Signed meridional distance (mm) of `m` = (z, r) from the polyline `line`, positive on
-/// the side where `inside` lies; `None` where the nearest point is an end of the polyline
-/// (beyond the contour, where no side is defined). O(len).
-fn side_distance(line: &[Vector2<f64>], inside: &Vector2<f64>, m: &Vector2<f64>) -> Option<f64> {
-    // Nearest segment: (distance, index, parameter, side of the segment's line).
-    let nearest = |q: &Vector2<f64>| {
-        line.windows(2)
-            .enumerate()
-            .map(|(k, w)| {
-                let d = w[1] - w[0];
-                let t = if d.norm_squared() > 0.0 {
-                    ((q - w[0]).dot(&d) / d.norm_squared()).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                let side = d.x * (q.y - w[0].y) - d.y * (q.x - w[0].x);
-                ((q - (w[0] + d * t)).norm(), k, t, side.signum())
-            })
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-    };
-    let (dist, k, t, side) = nearest(m)?;
-    let last = line.len().saturating_sub(2);
-    if (k == 0 && t <= 0.0) || (k == last && t >= 1.0) {
-        return None;
-    }
-    let (.., inside_side) = nearest(inside)?;
-    Some(if side == inside_side { dist } else { -dist })
-}
-
 /// Fails when a fitted blade side (span extension included) stops short of the shroud or
 /// of the hub by more than the fit tolerance: the impeller model has every blade run from
 /// the hub through the shroud contour, its tip cut by that contour. Sections that end below
 /// the shroud (a blade tip with clearance, or blades of another state than the flow path —
 /// the as-manufactured cold blades of an archive next to its hot design-intent shroud) would
 /// leave the blade without a tip. Each side's top and bottom edges are sampled at 161 points
-/// against the contours sampled at 401; samples whose nearest contour point is a contour end
-/// are skipped. Cost 2·161·401 per blade and contour.
-pub fn check_reach(fitted: &FittedImpeller) -> Result<(), ImportError> {
-    let sample = |c: &Curve2| -> Vec<Vector2<f64>> {
-        let (a, b) = c.domain();
-        (0..=400)
-            .map(|k| c.point(a + (b - a) * k as f64 / 400.0))
-            .collect()
-    };
-    let (hub, shroud) = (sample(&fitted.hub), sample(&fitted.shroud));
-    let (hub_mid, shroud_mid) = (hub[200], shroud[200]);
+/// and projected on the assembled impeller's contours (`MeridionalCurve::closest_point`,
+/// certified global); samples whose nearest contour point is a contour end are skipped.
+/// Cost 2·161 projections per blade side.
+pub fn check_reach(fitted: &FittedImpeller, impeller: &Impeller) -> Result<(), ImportError> {
     let tol = fitted.tol_mm.max(0.0);
+    // How far a meridional point lies inside the flow path from a contour: the channel side
+    // of the hub, below the shroud (`RevolvedSurface::signed_distance` signs); `None` where the
+    // nearest contour point is an end of the contour (beyond it no side is defined).
+    let short_of = |c: &MeridionalCurve, sign: f64, m: Vector2<f64>| -> Option<f64> {
+        let (t, d, _) = c.closest_point(m);
+        let (t0, t1) = c.domain();
+        let end = 1e-9 * (t1 - t0);
+        (t > t0 + end && t < t1 - end).then_some(sign * d)
+    };
     for b in &fitted.blades {
         for (side, s) in [("pressure", &b.pressure), ("suction", &b.suction)] {
             let ((u0, u1), (v0, v1)) = s.domain();
-            for (edge, v, line, inside, contour) in [
-                ("top", v1, &shroud, &hub_mid, "shroud"),
-                ("bottom", v0, &hub, &shroud_mid, "hub"),
+            for (edge, v, contour, sign, name) in [
+                ("top", v1, impeller.shroud().meridional(), -1.0, "shroud"),
+                ("bottom", v0, impeller.hub().meridional(), 1.0, "hub"),
             ] {
                 let mut worst: Option<(f64, f64, Vector2<f64>)> = None;
                 for i in 0..=160 {
                     let u = u0 + (u1 - u0) * i as f64 / 160.0;
-                    let p = s.point(u, v);
-                    let m = Vector2::new(p.z, p.x.hypot(p.y));
-                    if let Some(d) = side_distance(line, inside, &m) {
+                    let m = MeridionalCurve::zr_of(&s.point(u, v));
+                    if let Some(d) = short_of(contour, sign, m) {
                         if d > tol && worst.is_none_or(|(w, ..)| d > w) {
                             worst = Some((d, u, m));
                         }
@@ -392,12 +363,12 @@ pub fn check_reach(fitted: &FittedImpeller) -> Result<(), ImportError> {
                         entity: format!("blade {:?} {side} side", b.name),
                         reason: format!(
                             "its {edge} edge (span extension included) stops {d:.3} mm short of \
-                             the {contour} contour at (z, r) = ({:.2}, {:.2}) mm (u = {u:.3}): \
+                             the {name} contour at (z, r) = ({:.2}, {:.2}) mm (u = {u:.3}): \
                              every blade must run from the hub through the shroud contour. The \
                              sections end inside the flow path (a blade tip with clearance, or \
                              blades of another state than the flow path, such as cold \
-                             as-manufactured blades next to a hot design-intent {contour}); give \
-                             a {contour} contour through the blades' {edge} (`{contour}_file`)",
+                             as-manufactured blades next to a hot design-intent {name}); give \
+                             a {name} contour through the blades' {edge} (`{name}_file`)",
                             m.x, m.y
                         ),
                     });
@@ -425,7 +396,7 @@ pub fn import_raw(raw: &RawImpeller, opts: &ImportOptions) -> Result<Imported, I
     check_extent(&fitted)?;
     let impeller = assemble(&fitted, opts)?;
     // After the model's own checks (a shroud below the hub is that, not blades too short).
-    check_reach(&fitted)?;
+    check_reach(&fitted, &impeller)?;
     Ok(Imported { impeller, fitted })
 }
 

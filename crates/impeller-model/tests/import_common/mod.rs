@@ -99,3 +99,22 @@ pub fn sample(name: &str) -> PathBuf {
         .join("tests/data")
         .join(name)
 }
+
+/// The points of `s` on a `(nu + 1) × (nv + 1)` grid over its whole domain, with their grid
+/// indices: where a fitted surface is searched for a swing between its data.
+pub fn grid_points(
+    s: &nurbs::NurbsSurface,
+    nu: usize,
+    nv: usize,
+) -> impl Iterator<Item = (usize, usize, nalgebra::Vector3<f64>)> + '_ {
+    let ((u0, u1), (v0, v1)) = s.domain();
+    (0..=nu).flat_map(move |i| {
+        (0..=nv).map(move |j| {
+            let (u, v) = (
+                u0 + (u1 - u0) * i as f64 / nu as f64,
+                v0 + (v1 - v0) * j as f64 / nv as f64,
+            );
+            (i, j, s.point(u, v))
+        })
+    })
+}
