@@ -202,3 +202,67 @@ fn collision_mesh_blades_end_at_the_shroud_contour() {
         "{near_contour} vertices on the contour, {sides} sides"
     );
 }
+
+/// A cut end point just under a blade tip, reached by a ray grazing the side at the top
+/// edge: its depth is its distance below the tip (the nearest face), not its distance from
+/// the side the ray entered through (0.06 mm). The old rule read the side's 0.06 mm: a
+/// 0.0616 mm "overcut" on impeller-autoblade-12+12's tip edge whose exact swept-envelope
+/// re-measure was 0.0056 mm.
+#[test]
+fn depth_under_a_tip_edge_is_the_depth_below_the_tip() {
+    let imp = default_impeller().unwrap();
+    let d = ImpellerDesign::new(&imp, coarse()).unwrap();
+    let blade = imp.main().instance(0);
+    let s = blade.side(Side::Pressure);
+    let ((u0, u1), (v0, v1)) = s.domain();
+    let u = 0.5 * (u0 + u1);
+    // The side point 0.005 mm below the shroud contour (bisection in v).
+    let below = |v: f64| -imp.shroud().signed_distance(&s.point(u, v)) - 0.005;
+    let (mut lo, mut hi) = (0.5 * (v0 + v1), v1);
+    assert!(below(lo) > 0.0 && below(hi) < 0.0);
+    for _ in 0..60 {
+        let m = 0.5 * (lo + hi);
+        if below(m) > 0.0 {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    let entry = s.point(u, lo);
+    let n = blade.outward_normal(Side::Pressure, u, lo).unwrap();
+    let p = Point3::from(entry - n * 0.06);
+    let sd = d.signed_distance(&p);
+    let depth = d.depth_below(&p, &Point3::from(entry));
+    // 0.06 mm inside the side, about 0.005 mm under the tip (the shroud contour turns
+    // little over 0.06 mm).
+    assert!(sd < 0.0 && -sd < 0.02, "sd {sd}");
+    assert!(depth < 0.02, "depth {depth} (sd {sd})");
+    assert!(depth >= -sd - 1e-9, "depth {depth} below -sd {}", -sd);
+    // Deeper under the tip than inside the side, the side's depth is kept.
+    let h = 1e-4;
+    let grad = Vector3::from_fn(|k, _| {
+        let mut e = Vector3::zeros();
+        e[k] = h;
+        (imp.shroud().signed_distance(&(entry + e)) - imp.shroud().signed_distance(&(entry - e)))
+            / (2.0 * h)
+    });
+    let q = Point3::from(entry - n * 0.06 - grad.normalize() * 0.5);
+    let dq = d.depth_below(&q, &Point3::from(entry));
+    let sq = d.signed_distance(&q);
+    assert!(dq > 0.06 && dq < 0.4, "depth {dq}");
+    assert!((dq + sq).abs() < 1e-6, "depth {dq}, sd {sq}");
+    // A cut lowering the tip by 0.6 mm, read in the middle of the wall through the tip face:
+    // the sides (half the wall away) are the far faces, the depth stays the tip's.
+    let ss = blade.side(Side::Suction);
+    let mid = (entry + ss.point(u, lo)) * 0.5;
+    let half_wall = 0.5 * (entry - ss.point(u, lo)).norm();
+    assert!(half_wall < 0.6, "half wall {half_wall}");
+    let top = mid + grad.normalize() * -imp.shroud().signed_distance(&mid);
+    let deep = Point3::from(top - grad.normalize() * 0.6);
+    let dt = d.depth_below(&deep, &Point3::from(top));
+    assert!(
+        (dt - 0.6).abs() < 0.02,
+        "depth {dt} (half wall {half_wall})"
+    );
+    assert!(-d.signed_distance(&deep) < dt - 0.05);
+}
