@@ -712,6 +712,29 @@ impl RowsPlan {
         );
     }
 
+    /// The axis smoothing of every flank pass and point-milling run, counted over every
+    /// blade of each row (the reference blade's figures times the row's blade count).
+    pub fn smoothing(
+        &self,
+        impeller: &impeller_model::Impeller,
+    ) -> Result<cam_plan::SmoothingSummary, FlankError> {
+        let mut all = cam_plan::SmoothingSummary::default();
+        for (row, _, sp) in &self.sides {
+            let (_, copies) = rows::pitch_and_count(impeller, *row)?;
+            let mut one = cam_plan::SmoothingSummary::default();
+            for g in &sp.regions {
+                if let Some(rs) = &g.axis_smoothing {
+                    one.add(rs);
+                }
+                if let Some(b) = &g.band {
+                    one.merge(&b.smoothing());
+                }
+            }
+            all.merge(&one.times(copies));
+        }
+        Ok(all)
+    }
+
     /// Notes: skipped stations with where the first was, split motions.
     pub fn notes(&self) -> Vec<String> {
         let mut out = Vec::new();

@@ -472,6 +472,7 @@ impl FlankSemiFinishing {
                 tol_mm: p.strip_tol_mm,
                 limits: p.axis().limits(half_angle),
                 max_axis_step: p.max_axis_step_deg.to_radians(),
+                smooth_axes: true,
             },
         };
         let plan = regions::plan_rows(ctx, &self.name, &self.tool, &row_list, &settings)?;
@@ -527,16 +528,9 @@ impl FlankSemiFinishing {
                 .collect::<Vec<_>>()
                 .join(", "),
         );
-        // Issue 37: the axis smoothing of the flank passes, counted over every blade.
-        let mut smoothing = cam_plan::SmoothingSummary::default();
-        for (row, _, sp) in &plan.sides {
-            let (_, copies) = crate::rows::pitch_and_count(ctx.impeller, *row)?;
-            let mut one = cam_plan::SmoothingSummary::default();
-            for rs in sp.regions.iter().filter_map(|g| g.axis_smoothing.as_ref()) {
-                one.add(rs);
-            }
-            smoothing.merge(&one.times(copies));
-        }
+        // Issue 37: the axis smoothing of the flank passes and the point-milling runs,
+        // counted over every blade.
+        let smoothing = plan.smoothing(ctx.impeller)?;
         smoothing.add_metrics(&mut m);
         let lifts = plan.regions().filter(|g| g.lifted).count();
         let mut notes = plan.notes();

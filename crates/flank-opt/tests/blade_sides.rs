@@ -130,6 +130,7 @@ fn side_settings(
             tol_mm: tol,
             limits: axis.limits(theta),
             max_axis_step: axis.max_axis_step_deg.to_radians(),
+            smooth_axes: true,
         },
     }
 }
@@ -373,6 +374,61 @@ fn free_form_side_is_finished() {
                 "brute-force residual {brute}"
             );
         }
+    });
+}
+
+/// Issue 37: the axes of the point-milling runs are smoothed once planned, turning each
+/// posture about its ball centre: the same balls as without smoothing (centres within
+/// 1e-9 mm, so contacts and scallops are those planned), fewer direction changes of the axis
+/// angles inside the runs (counted here independently of the smoothing's own figures, which
+/// must agree), every axis step within the pass's limit.
+#[test]
+fn point_milling_axes_are_smoothed_about_the_ball_centres() {
+    use cam_plan::axis_smoothing::{reversal_indices, spherical_angles};
+    let imp = impeller_model::load(fixture("impeller-5-freeform")).unwrap();
+    let t = tool(3.0, 1.0, 40.0);
+    let p = process(0.0, 0.0);
+    with_ctx(&imp, &t, &p, |ctx| {
+        let st = side_settings(MethodChoice::Point, 0.01, 0.05, &p, &t);
+        let mut raw_st = st;
+        raw_st.point.smooth_axes = false;
+        let smooth = regions::plan_side(ctx, Row::Main, Side::Suction, &st).unwrap();
+        let raw = regions::plan_side(ctx, Row::Main, Side::Suction, &raw_st).unwrap();
+        let reversals = |runs: &[Vec<CutterLocation>]| -> usize {
+            runs.iter()
+                .map(|r| {
+                    let a = spherical_angles(r);
+                    let th: Vec<f64> = a.iter().map(|x| x.0).collect();
+                    let ph: Vec<f64> = a.iter().map(|x| x.1).collect();
+                    reversal_indices(&th).len() + reversal_indices(&ph).len()
+                })
+                .sum()
+        };
+        let (mut before, mut after, mut reported) = (0, 0, 0);
+        for (gs, gr) in smooth.regions.iter().zip(&raw.regions) {
+            let (Some(bs), Some(br)) = (&gs.band, &gr.band) else {
+                continue;
+            };
+            assert_eq!(bs.postures(), br.postures());
+            for (a, b) in bs.runs().flatten().zip(br.runs().flatten()) {
+                assert!((a.contact.centre - b.contact.centre).norm() < 1e-9);
+                let ca = a.cl.tip.coords + a.cl.axis.into_inner() * 3.0;
+                assert!((ca - a.contact.centre).norm() < 1e-9, "ball moved");
+            }
+            for run in bs.runs() {
+                for w in run.windows(2) {
+                    let turn = w[0].cl.axis.angle(&w[1].cl.axis);
+                    assert!(turn <= st.point.max_axis_step + 1e-9, "axis step {turn}");
+                }
+            }
+            before += reversals(&gr.runs);
+            after += reversals(&gs.runs);
+            reported += bs.smoothing().reversals_after;
+            assert_eq!(bs.smoothing().reversals_before, reversals(&gr.runs));
+        }
+        assert!(before > 0, "no reversals to smooth");
+        assert!(after < before, "reversals {before} -> {after}");
+        assert_eq!(after, reported);
     });
 }
 

@@ -30,6 +30,11 @@
 //! midpoint station (three levels), else the pass is split there (the caller links the
 //! pieces over the safety surface).
 //!
+//! # Smooth axes
+//! Once a pass is planned, the axes of each of its runs are smoothed about the ball centres
+//! ([`smoothing`]): the ball, the contacts and the measurement below stay as planned; the
+//! turned postures and their motions are checked again with the same whole-tool queries.
+//!
 //! # Measurement
 //! [`scallop`] measures the residual and overcut of the emitted ball-centre polylines over a
 //! dense grid of the band (exact ray–capsule entries along the normal).
@@ -40,6 +45,7 @@
 pub mod axis;
 pub mod layout;
 pub mod scallop;
+pub mod smoothing;
 
 use crate::FlankError;
 use axis::{AxisLimits, Frame};
@@ -187,6 +193,8 @@ pub struct PointSettings {
     pub limits: AxisLimits,
     /// Largest turn of the axis between two postures (rad).
     pub max_axis_step: f64,
+    /// Whether the axes of each run are smoothed once planned ([`smoothing`]).
+    pub smooth_axes: bool,
 }
 
 /// One station: its contact and ball centre.
@@ -232,6 +240,8 @@ pub struct PointPass {
     pub split_motions: usize,
     /// Candidates tried beyond the first, over the pass.
     pub search_steps: usize,
+    /// The axis smoothing of its runs ([`smoothing`]; empty when not asked for).
+    pub smoothing: cam_plan::SmoothingSummary,
 }
 
 /// The plan of a band.
@@ -265,6 +275,15 @@ impl BandPlan {
     /// Candidates tried beyond the first.
     pub fn search_steps(&self) -> usize {
         self.passes.iter().map(|p| p.search_steps).sum()
+    }
+
+    /// The axis smoothing of every pass.
+    pub fn smoothing(&self) -> cam_plan::SmoothingSummary {
+        let mut s = cam_plan::SmoothingSummary::default();
+        for p in &self.passes {
+            s.merge(&p.smoothing);
+        }
+        s
     }
 
     /// Largest tilt and |lead| used (rad).
@@ -301,8 +320,20 @@ pub fn plan_band(
     let passes: Vec<PointPass> = lines
         .par_iter()
         .enumerate()
-        .map(|(k, line)| plan_pass(ctx, blade, side, line, k % 2 == 1, settings, check))
-        .collect::<Result<_, _>>()?;
+        .map(|(k, line)| {
+            let mut pass = plan_pass(ctx, blade, side, line, k % 2 == 1, settings, check)?;
+            if settings.smooth_axes {
+                pass.smoothing = smoothing::smooth_pass(
+                    ctx,
+                    check,
+                    &mut pass,
+                    settings.ball_radius,
+                    settings.max_axis_step,
+                );
+            }
+            Ok(pass)
+        })
+        .collect::<Result<_, FlankError>>()?;
     Ok(BandPlan { passes })
 }
 
