@@ -50,6 +50,11 @@ fn meaning(label: &str) -> Option<(&'static str, bool)> {
         }
     }
     let l = label.to_lowercase();
+    // Per-face series (surface groups: `main pressure`, `splitter suction`, `main tip`) take
+    // the palette: the row's colour alone would not tell the faces apart.
+    if l.ends_with(" pressure") || l.ends_with(" suction") || l.ends_with(" tip") {
+        return None;
+    }
     let dashed = l.contains("tip edge");
     let colour = if l.contains("rapid") || l.contains("link") {
         return Some(("#a0a0a0", true));

@@ -561,8 +561,25 @@ impl Report {
     }
 
     /// Heat maps of overcut and residual on the surfaces where each is largest (at most
-    /// three surfaces each).
+    /// three surfaces each), after the residual distribution of every surface group.
     pub fn add_map_plots(&mut self, maps: &[machining_sim::SurfaceMap]) {
+        let curves = crate::surface_groups::exceedance_curves(maps, 100);
+        if !curves.is_empty() {
+            let series: Vec<Series> = curves
+                .into_iter()
+                .map(|(label, points)| Series {
+                    label: label.replace('_', " "),
+                    points,
+                })
+                .collect();
+            self.plots.push(line_chart(
+                "Residual per surface group (share of points above)",
+                "residual (mm)",
+                "points above (%)",
+                &series,
+                false,
+            ));
+        }
         let worst = |m: &machining_sim::SurfaceMap, residual: bool| -> f64 {
             let v = if residual {
                 &m.residual_mm
@@ -718,6 +735,29 @@ impl Report {
                      <tr><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td><td>{}</td><td>{}</td></tr></table>",
                     v.max_overcut_mm, v.overcut_limit_mm, v.max_residual_mm, v.collisions, v.resolution_mm
                 );
+                if !v.surface_groups.is_empty() {
+                    h.push_str(
+                        "<table><tr><th>surface group</th><th>points</th><th>residual &gt; 0.05 mm</th>\
+                         <th>&gt; 0.1 mm</th><th>&gt; 0.2 mm</th><th>p90 (mm)</th><th>max (mm)</th>\
+                         <th>max overcut (mm)</th></tr>",
+                    );
+                    for (name, g) in &v.surface_groups {
+                        let _ = write!(
+                            h,
+                            "<tr><td>{}</td><td>{}</td><td>{:.1} %</td><td>{:.1} %</td><td>{:.1} %</td>\
+                             <td>{:.4}</td><td>{:.4}</td><td>{:.4}</td></tr>",
+                            esc(name),
+                            g.points,
+                            100.0 * g.share_above_0_05_mm,
+                            100.0 * g.share_above_0_1_mm,
+                            100.0 * g.share_above_0_2_mm,
+                            g.p90_mm,
+                            g.max_mm,
+                            g.max_overcut_mm
+                        );
+                    }
+                    h.push_str("</table>");
+                }
             }
             None => h.push_str("<p>Nothing was verified.</p>"),
         }

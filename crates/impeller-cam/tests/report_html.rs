@@ -497,3 +497,26 @@ fn view3d_draws_in_headless_chromium_at_three_playback_positions() {
         );
     }
 }
+
+/// Issue 32: the verification section lists every surface group of `report.json` with its
+/// residual shares, and the residual distribution is plotted per group.
+#[test]
+fn verification_lists_and_plots_the_residual_of_every_surface_group() {
+    let dir = common::scratch("impeller-cam-view3d", "surface-groups");
+    let out = run_small_view_job(&dir, &[]);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let groups = report["verification"]["surface_groups"]
+        .as_object()
+        .unwrap();
+    assert!(groups.len() >= 3, "{groups:?}");
+    assert!(html.contains("<th>surface group</th>"));
+    assert!(html.contains("Residual per surface group"));
+    for (name, g) in groups {
+        let row = format!("<tr><td>{name}</td><td>{}</td>", g["points"]);
+        assert!(html.contains(&row), "no row {row}");
+        // Each group is a series of the distribution plot (its legend label).
+        assert!(html.contains(&name.replace('_', " ")), "no series {name}");
+    }
+}
