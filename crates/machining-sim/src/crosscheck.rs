@@ -19,6 +19,7 @@ use cam_core::{
     Cutter, CutterLocation, EnvelopeOptions, GuideCurve, MoveKind, Point3, SphereFamily,
     SweptEnvelope, ToolPath,
 };
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The swept envelopes of a set of tool paths, each with an axis-aligned box that holds it
@@ -96,11 +97,13 @@ impl Envelopes {
         Self::new_where(ops, |b| points.iter().any(|p| box_distance(b, p) == 0.0))
     }
 
+    /// The runs of cutting moves (with their boxes) are collected in order, and the kept
+    /// runs' envelopes are built in parallel (rayon; independent, order kept).
     fn new_where(
         ops: &[(Cutter, ToolPath)],
         keep: impl Fn(&[f64; 6]) -> bool,
     ) -> Result<Self, SimError> {
-        let mut envelopes = Vec::new();
+        let mut runs: Vec<(&Cutter, Vec<CutterLocation>, [f64; 6])> = Vec::new();
         for (cutter, path) in ops {
             let mut run: Vec<CutterLocation> = Vec::new();
             // A member tangent to a cone of half angle α at radius R sits R·tan α above that
@@ -108,18 +111,17 @@ impl Envelopes {
             // the guide point for α ≤ 45°.
             let pad = 2.5 * cutter.max_cutting_radius() + 1.0;
             let l = cutter.flute_length;
-            let mut close = |run: &[CutterLocation]| -> Result<(), SimError> {
+            let mut close = |run: &mut Vec<CutterLocation>| {
                 let b = box_of(run, l, pad);
                 if keep(&b) {
-                    envelopes.push((envelope_of(cutter, run)?, b));
+                    runs.push((cutter, std::mem::take(run), b));
                 }
-                Ok(())
+                run.clear();
             };
             for (k, mv) in path.moves.iter().enumerate() {
                 if mv.kind == MoveKind::Rapid {
                     if !run.is_empty() {
-                        close(&run)?;
-                        run.clear();
+                        close(&mut run);
                     }
                     continue;
                 }
@@ -129,9 +131,13 @@ impl Envelopes {
                 run.push(mv.cl);
             }
             if !run.is_empty() {
-                close(&run)?;
+                close(&mut run);
             }
         }
+        let envelopes = runs
+            .par_iter()
+            .map(|(cutter, run, b)| Ok((envelope_of(cutter, run)?, *b)))
+            .collect::<Result<Vec<_>, SimError>>()?;
         Ok(Self { envelopes })
     }
 
@@ -206,21 +212,23 @@ pub fn crosscheck_overcut(
         })
         .collect();
     let env = Envelopes::around(ops, &points)?;
-    let mut out = Vec::with_capacity(cands.len());
-    for (v, m, k) in cands {
-        let map = &report.maps[m];
-        let p = map.points[k];
-        let d = env.signed_distance(&Point3::new(p[0], p[1], p[2]))?;
-        out.push(CrossCheckPoint {
-            surface: map.name.clone(),
-            i: k % map.nu.max(1),
-            j: k / map.nu.max(1),
-            point: p,
-            dexel_overcut_mm: v,
-            envelope_overcut_mm: (-d).max(0.0),
-        });
-    }
-    Ok(out)
+    // Independent points, in parallel (order kept).
+    cands
+        .par_iter()
+        .map(|&(v, m, k)| {
+            let map = &report.maps[m];
+            let p = map.points[k];
+            let d = env.signed_distance(&Point3::new(p[0], p[1], p[2]))?;
+            Ok(CrossCheckPoint {
+                surface: map.name.clone(),
+                i: k % map.nu.max(1),
+                j: k / map.nu.max(1),
+                point: p,
+                dexel_overcut_mm: v,
+                envelope_overcut_mm: (-d).max(0.0),
+            })
+        })
+        .collect()
 }
 
 /// The cross-check of one overcut location `e` read inside the design (a cut end point: on

@@ -17,6 +17,7 @@
 //! side signs are negative, and the sign rule alone would put such points inside the blade.
 
 use crate::design::{DesignModel, SurfaceGrid, TriangleMesh};
+use crate::design_memo::{self, Visit};
 use crate::error::SimError;
 use crate::stock_shape::RevolvedStock;
 use cam_core::{Point3, Vector3};
@@ -83,6 +84,9 @@ pub struct ImpellerDesign {
     far_mm: f64,
     hub_sd: ContourDistance,
     shroud_sd: ContourDistance,
+    /// Identity in the per-thread memo of recent distance evaluations
+    /// ([`crate::design_memo`]); a clone is the same design and keeps it.
+    id: u64,
 }
 
 fn grid_tris(nu: usize, nv: usize, base: u32, out: &mut Vec<[u32; 3]>) {
@@ -195,6 +199,7 @@ impl ImpellerDesign {
             sides_mesh,
             tri_info,
             sampling,
+            id: crate::design_memo::next_design_id(),
         })
     }
 
@@ -239,23 +244,29 @@ impl ImpellerDesign {
     /// side, or the shroud contour over the blade tips; far from every blade, where the
     /// distance is the lower bound `dm − far_mm`, the foot on the side mesh).
     fn blade_foot(&self, p: &Point3) -> (f64, Foot) {
-        let q = PVec::new(p.x, p.y, p.z);
-        let (proj, (tri, _)) = self
-            .sides_mesh
-            .project_local_point_and_get_location(q, false);
+        let (proj, tri, dm) = self.nearest_triangle(p);
         let Some(&(bi, side, u, v)) = self.tri_info.get(tri as usize) else {
             return (f64::INFINITY, Foot::At(*p));
         };
-        let dm = (proj.point - q).length();
+        let mut visit = Visit {
+            design: self.id,
+            p: [p.x, p.y, p.z],
+            mesh: (dm, tri),
+            hub: None,
+            shroud: None,
+            side: None,
+        };
         if dm > self.far_mm + EXACT_BAND_MM {
             // Farther than half the thickest blade from every side: outside all blades, and
             // the distance to the blade solids is at least dm − chord − t_max/2.
             let (ds, zr) = self.shroud_sd.foot(p);
+            visit.shroud = Some(ds);
+            design_memo::record(visit);
             let bound = dm - self.far_mm;
             let foot = if ds > bound {
                 Foot::Meridian(zr)
             } else {
-                Foot::At(Point3::new(proj.point.x, proj.point.y, proj.point.z))
+                Foot::At(Point3::new(proj.x, proj.y, proj.z))
             };
             return (bound.max(ds).max(1e-9), foot);
         }
@@ -263,6 +274,9 @@ impl ImpellerDesign {
         let (d1, f1) = side_foot(blade, side, p, (u, v));
         let (d2, f2) = side_foot(blade, side.other(), p, (u, v));
         let (ds, zr) = self.shroud_sd.foot(p);
+        visit.shroud = Some(ds);
+        visit.side = Some(d1);
+        design_memo::record(visit);
         let u_pressure = if side == Side::Pressure { f1.u } else { f2.u };
         let ((ua, ub), _) = blade.side(Side::Pressure).domain();
         let end = usize::from(u_pressure > 0.5 * (ua + ub));
@@ -283,6 +297,23 @@ impl ImpellerDesign {
             Foot::At(Point3::from(f2.point))
         };
         (d, foot)
+    }
+
+    /// The nearest triangle of the blade-side mesh to `p`: the projection, the triangle and
+    /// the distance. The BVH search starts from the bound left by this thread's previous
+    /// query ([`crate::design_memo`]: same triangle and projection as an unbounded search).
+    /// O(log T) for T triangles.
+    fn nearest_triangle(&self, p: &Point3) -> (PVec, u32, f64) {
+        let q = PVec::new(p.x, p.y, p.z);
+        let bounded = design_memo::mesh_bound(self.id, &[p.x, p.y, p.z]).and_then(|m| {
+            self.sides_mesh
+                .project_local_point_and_get_location_with_max_dist(q, false, m)
+        });
+        let (proj, (tri, _)) = bounded.unwrap_or_else(|| {
+            self.sides_mesh
+                .project_local_point_and_get_location(q, false)
+        });
+        (proj.point, tri, (proj.point - q).length())
     }
 
     /// The verifier's design distance with the point that decides it: the minimum of
@@ -571,10 +602,8 @@ impl ImpellerDesign {
     /// `p` lies in the outer third of the wall there (nearer that face than half the
     /// distance to the other side); `None` in the middle of the wall or outside the blades.
     fn wall_depth_near_a_face(&self, p: &Point3) -> Option<f64> {
-        let q = PVec::new(p.x, p.y, p.z);
-        let (_, (tri, _)) = self
-            .sides_mesh
-            .project_local_point_and_get_location(q, false);
+        let tri = design_memo::recall(self.id, &[p.x, p.y, p.z])
+            .map_or_else(|| self.nearest_triangle(p).1, |v| v.mesh.1);
         let &(bi, side, u, v) = self.tri_info.get(tri as usize)?;
         let blade = &self.blades[bi as usize].1;
         let (d1, f1) = side_foot(blade, side, p, (u, v));
@@ -591,8 +620,10 @@ impl ImpellerDesign {
 
 impl DesignModel for ImpellerDesign {
     fn signed_distance(&self, p: &Point3) -> f64 {
-        self.hub_signed_distance(p)
-            .min(self.blade_signed_distance(p))
+        let hub = self.hub_signed_distance(p);
+        let blade = self.blade_signed_distance(p);
+        design_memo::note_hub(self.id, &[p.x, p.y, p.z], hub);
+        hub.min(blade)
     }
 
     /// The face nearest to `entry` among the hub, the shroud contour (blade tips) and the
@@ -606,17 +637,30 @@ impl DesignModel for ImpellerDesign {
     /// re-measure there: 0.0056 mm). The result is never below `−sd(p)` in
     /// [`crate::endpoints`], which takes the larger.
     fn depth_below(&self, p: &Point3, entry: &Point3) -> f64 {
-        let hub = self.hub_signed_distance(entry).abs();
-        let shroud = self.shroud_sd.signed_distance(entry).abs();
-        let q = PVec::new(entry.x, entry.y, entry.z);
-        let (_, (tri, _)) = self
-            .sides_mesh
-            .project_local_point_and_get_location(q, false);
+        // The entry point is usually the last point whose signed distance the walk to it
+        // evaluated (`crate::endpoints`): its hub, shroud, nearest triangle and side
+        // distances are recalled, not computed again (bit-identical, `crate::design_memo`).
+        let known = design_memo::recall(self.id, &[entry.x, entry.y, entry.z]);
+        let hub = known
+            .and_then(|v| v.hub)
+            .unwrap_or_else(|| self.hub_signed_distance(entry))
+            .abs();
+        let shroud = known
+            .and_then(|v| v.shroud)
+            .unwrap_or_else(|| self.shroud_sd.signed_distance(entry))
+            .abs();
+        let (tri, known_side) = match known {
+            Some(v) => (v.mesh.1, v.side),
+            None => (self.nearest_triangle(entry).1, None),
+        };
         let side = self.tri_info.get(tri as usize).map(|&(bi, side, u, v)| {
             let blade = &self.blades[bi as usize].1;
-            let d = side_distance(blade, side, entry, (u, v)).0.abs();
+            let d = known_side
+                .unwrap_or_else(|| side_distance(blade, side, entry, (u, v)).0)
+                .abs();
             (d, blade, side, (u, v))
         });
+        let at_p = design_memo::recall(self.id, &[p.x, p.y, p.z]);
         match side {
             Some((d, blade, s, hint)) if d <= hub && d <= shroud => {
                 // Near a blunt edge one side's signed distance can read a point behind
@@ -640,7 +684,9 @@ impl DesignModel for ImpellerDesign {
                     side_depth
                 }
             }
-            _ if hub <= shroud => -self.hub_signed_distance(p),
+            _ if hub <= shroud => -at_p
+                .and_then(|v| v.hub)
+                .unwrap_or_else(|| self.hub_signed_distance(p)),
             _ => {
                 // Entered through the tip face. Near the blade's top edge the sides and the
                 // edge faces meet the tip: a point in the outer third of the wall under a
@@ -648,7 +694,9 @@ impl DesignModel for ImpellerDesign {
                 // skimming a leading edge reads, on a ray entering through the tip, the
                 // whole height of the skim). In the middle of the wall the tip's depth is
                 // kept: there the sides are the far faces of a cut lowering the tip.
-                let below_tip = -self.shroud_sd.signed_distance(p);
+                let below_tip = -at_p
+                    .and_then(|v| v.shroud)
+                    .unwrap_or_else(|| self.shroud_sd.signed_distance(p));
                 match self.wall_depth_near_a_face(p) {
                     Some(near) if near > 0.0 => below_tip.min(near),
                     _ => below_tip,
@@ -741,6 +789,64 @@ impl DesignModel for ImpellerDesign {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The per-thread memo (`design_memo`: bounded nearest-triangle search, values recalled
+    /// at the same point) changes no answer: along rows of points a cell apart beside the
+    /// blades and the hub, as the end-point depths ask them (distance at the point, at its
+    /// entry point, then the depth below the entry's face), every signed distance and depth
+    /// is bit-identical to the one computed with the memo cleared before each question.
+    #[test]
+    fn memo_changes_no_distance_or_depth() {
+        let imp = impeller_model::fixtures::default_impeller().unwrap();
+        let design = ImpellerDesign::new(&imp, ImpellerSampling::default()).unwrap();
+        let blade = imp.blades_in_order()[0].clone();
+        let mut rows = Vec::new();
+        for (k, (u, v)) in [(0.3, 0.5), (0.02, 0.3), (0.97, 0.8), (0.6, 0.05)]
+            .into_iter()
+            .enumerate()
+        {
+            let side = if k % 2 == 0 {
+                Side::Pressure
+            } else {
+                Side::Suction
+            };
+            let s = blade.side(side);
+            let ((u0, u1), (v0, v1)) = s.domain();
+            let p = s.point(u0 + u * (u1 - u0), v0 + v * (v1 - v0));
+            rows.push(Point3::new(p.x - 0.7, p.y, p.z - 0.05 * k as f64));
+        }
+        let hub = imp.hub();
+        rows.push(Point3::from(
+            hub.point(0.5, 0.3) + hub.normal(0.5, 0.3) * -0.02,
+        ));
+        let (mut reused, mut checked) = (0usize, 0usize);
+        for start in rows {
+            for i in 0..140 {
+                let p = start + Vector3::new(0.01 * i as f64, 0.0, 0.0);
+                let entry = p + Vector3::new(0.0, 0.0, 0.003);
+                // With the memo, in the order of the end-point measurement.
+                let sd = DesignModel::signed_distance(&design, &p);
+                let sd_e = DesignModel::signed_distance(&design, &entry);
+                reused += usize::from(
+                    design_memo::recall(design.id, &[entry.x, entry.y, entry.z]).is_some(),
+                );
+                let depth = design.depth_below(&p, &entry);
+                // Without it.
+                design_memo::forget();
+                let sd0 = DesignModel::signed_distance(&design, &p);
+                design_memo::forget();
+                let sd_e0 = DesignModel::signed_distance(&design, &entry);
+                design_memo::forget();
+                let depth0 = design.depth_below(&p, &entry);
+                design_memo::forget();
+                assert_eq!(sd.to_bits(), sd0.to_bits(), "{p:?}");
+                assert_eq!(sd_e.to_bits(), sd_e0.to_bits(), "{entry:?}");
+                assert_eq!(depth.to_bits(), depth0.to_bits(), "{p:?}");
+                checked += 1;
+            }
+        }
+        assert_eq!(reused, checked);
+    }
 
     /// The design's `PointQuery` answers the verifier's own distance (bit for bit, on a cloud
     /// around the impeller) and, beside the hub and the blade sides, a point on that face at

@@ -52,6 +52,7 @@ pub mod collision;
 pub mod crosscheck;
 mod cull;
 pub mod design;
+mod design_memo;
 pub mod dexel;
 pub mod endpoints;
 pub mod error;
