@@ -1046,9 +1046,17 @@ pub fn verify(
     if !job.verification.enabled || verifiable.is_empty() {
         return Ok(());
     }
-    let design = ImpellerDesign::new(impeller, ImpellerSampling::default()).map_err(msg)?;
-    let blank = design.blank().map_err(msg)?;
-    let mut stock = TriDexel::from_shape(&blank, job.verification.resolution_mm).map_err(msg)?;
+    // The design (blade projectors, side mesh) and the sampled blank are independent: built
+    // side by side.
+    let (design, stock) = rayon::join(
+        || ImpellerDesign::new(impeller, ImpellerSampling::default()),
+        || {
+            machining_sim::blank_of(impeller)
+                .and_then(|b| TriDexel::from_shape(&b, job.verification.resolution_mm))
+        },
+    );
+    let design = design.map_err(msg)?;
+    let mut stock = stock.map_err(msg)?;
     let progress = Progress::new(job.quiet);
     let total: usize = verifiable.iter().map(|(_, p)| p.moves.len()).sum();
     let bar = progress.bar(total as u64, "verifying");

@@ -826,6 +826,10 @@ impl RowContext<'_> {
         let v = v0 + j as f64 * cell;
         let mut removed = 0.0;
         let mut hits: Vec<StockHit> = Vec::new();
+        if order.is_empty() {
+            // No placement reaches the row: nothing to reset.
+            return (removed, hits);
+        }
         let chunks = row.len().div_ceil(CHUNK);
         scratch.bounds.clear();
         scratch.bounds.resize(chunks, ChunkBound::STALE);
