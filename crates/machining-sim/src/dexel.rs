@@ -179,6 +179,9 @@ pub struct DexelGrid {
     v0: f64,
     cell: f64,
     rays: Vec<Segments>,
+    /// Material bounds of the ray tiles, kept up to date by the removal
+    /// (`crate::cull::TileBounds`; only removal changes rays, and only by removing material).
+    tiles: crate::cull::TileBounds,
 }
 
 impl DexelGrid {
@@ -203,17 +206,23 @@ impl DexelGrid {
     pub fn ray(&self, i: usize, j: usize) -> &Segments {
         &self.rays[j * self.nu + i]
     }
-    /// Rows of rays (each `nu` long), mutable, for parallel processing.
-    pub(crate) fn rows_mut(&mut self) -> rayon::slice::ChunksMut<'_, Segments> {
-        self.rays.par_chunks_mut(self.nu.max(1))
-    }
-    /// Bands of `rows` consecutive rows of rays (each row `nu` long), for parallel reading.
-    pub(crate) fn row_bands_par(&self, rows: usize) -> rayon::slice::Chunks<'_, Segments> {
-        self.rays.par_chunks(self.nu.max(1) * rows.max(1))
-    }
-    /// Rows of rays (each `nu` long), mutable, in order.
+    /// Rows of rays (each `nu` long), mutable, in order. The tile bounds are forgotten:
+    /// changes made through these rows are not marked.
     pub(crate) fn rows_seq_mut(&mut self) -> std::slice::ChunksMut<'_, Segments> {
+        self.tiles.invalidate();
         self.rays.chunks_mut(self.nu.max(1))
+    }
+    /// The tile bounds brought up to date ([`crate::cull::TileBounds::refresh`]), and the
+    /// rows of rays (each `nu` long), mutable, for parallel processing; changes to the rows
+    /// must be marked in the bounds.
+    pub(crate) fn tiles_and_rows_mut(
+        &mut self,
+    ) -> (
+        &crate::cull::TileBounds,
+        rayon::slice::ChunksMut<'_, Segments>,
+    ) {
+        self.tiles.refresh(&self.rays, self.nu);
+        (&self.tiles, self.rays.par_chunks_mut(self.nu.max(1)))
     }
     /// The grid's lattice without its rays.
     #[inline]
@@ -355,6 +364,7 @@ impl TriDexel {
                 v0: min[va],
                 cell,
                 rays: vec![Segments::Empty; n[ua] * n[va]],
+                tiles: crate::cull::TileBounds::default(),
             };
             let nu = g.nu;
             let (u0, v0) = (g.u0, g.v0);

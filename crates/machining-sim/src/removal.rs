@@ -656,18 +656,18 @@ pub fn apply_batch(
         let d = grid.dir();
         let (_, nv) = grid.size();
         let geo = grid.geometry();
-        let tiles = TileBounds::new(grid);
         let (u0, v0) = grid.ray_uv(0, 0);
+        let (tiles, rows) = grid.tiles_and_rows_mut();
         let feet: Vec<(Option<CutFootprint>, Option<Footprint>)> = batch
             .par_iter()
             .zip(&preps)
             .map(|(pl, p)| {
                 let cut = p.cut_box.as_ref().and_then(|bx| {
                     let reach = Reach::new(&bodies[pl.tool].cutting, &pl.tip, &pl.axis, d);
-                    CutFootprint::new(&geo, bx, reach)?.shrink(&tiles, (u0, v0), cell)
+                    CutFootprint::new(&geo, bx, reach)?.shrink(tiles, (u0, v0), cell)
                 });
                 let coll = Footprint::new(&geo, &p.coll_box, p.coll_radius, p.coll_span, pl)
-                    .and_then(|f| f.shrink(&tiles, (u0, v0), cell));
+                    .and_then(|f| f.shrink(tiles, (u0, v0), cell));
                 (cut, coll)
             })
             .collect();
@@ -712,9 +712,9 @@ pub fn apply_batch(
             feet: &feet,
             collision_tol,
             margin,
+            tiles,
         };
-        let (removed, hits) = grid
-            .rows_mut()
+        let (removed, hits) = rows
             .enumerate()
             .map_init(RowScratch::default, |scratch, (j, row)| {
                 ctx.row(scratch, j, row, &order[offsets[j]..offsets[j + 1]])
@@ -798,6 +798,8 @@ struct RowContext<'a> {
     collision_tol: f64,
     /// Margin of the witnesses' point classifications (mm, [`witness_margin`]).
     margin: f64,
+    /// The grid's tile bounds, where the changed chunks are marked.
+    tiles: &'a TileBounds,
 }
 
 /// Whether some material interval of `segs` meets `[lo, hi]` (closed).
@@ -966,6 +968,8 @@ impl RowContext<'_> {
                     if let Some(b) = scratch.bounds.get_mut(c) {
                         b.stale = true;
                     }
+                    // A chunk lies in one tile (`CHUNK` divides `TILE`).
+                    self.tiles.mark(ra, j);
                 }
             }
 
