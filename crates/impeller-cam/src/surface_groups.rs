@@ -35,20 +35,27 @@ pub fn group_of(name: &str) -> String {
     name.chars().filter(|c| !c.is_ascii_digit()).collect()
 }
 
-/// The residual distribution per group of `maps` (groups without measured points are left
-/// out). O(points · log points).
-pub fn surface_groups(maps: &[SurfaceMap]) -> BTreeMap<String, GroupResidual> {
-    let mut residuals: BTreeMap<String, (Vec<f64>, f64)> = BTreeMap::new();
+/// Per group with measured points: its residuals sorted ascending and its largest overcut.
+fn by_group(maps: &[SurfaceMap]) -> BTreeMap<String, (Vec<f64>, f64)> {
+    let mut groups: BTreeMap<String, (Vec<f64>, f64)> = BTreeMap::new();
     for m in maps {
-        let e = residuals.entry(group_of(&m.name)).or_default();
+        let e = groups.entry(group_of(&m.name)).or_default();
         e.0.extend(m.residual_mm.iter().flatten().copied());
         e.1 = m.overcut_mm.iter().flatten().copied().fold(e.1, f64::max);
     }
-    residuals
+    groups.retain(|_, (v, _)| !v.is_empty());
+    for (v, _) in groups.values_mut() {
+        v.sort_by(f64::total_cmp);
+    }
+    groups
+}
+
+/// The residual distribution per group of `maps` (groups without measured points are left
+/// out). O(points · log points).
+pub fn surface_groups(maps: &[SurfaceMap]) -> BTreeMap<String, GroupResidual> {
+    by_group(maps)
         .into_iter()
-        .filter(|(_, (v, _))| !v.is_empty())
-        .map(|(name, (mut v, overcut))| {
-            v.sort_by(f64::total_cmp);
+        .map(|(name, (v, overcut))| {
             let n = v.len();
             let share = |t: f64| v.iter().filter(|&&x| x > t).count() as f64 / n as f64;
             let rank = ((0.9 * n as f64).ceil() as usize).clamp(1, n) - 1;
@@ -76,19 +83,10 @@ pub const CURVE_MAX_MM: f64 = 0.5;
 /// [`CURVE_MAX_MM`] — the whole distribution of which [`GroupResidual`] gives three points
 /// and the 90th percentile. O(points · log points).
 pub fn exceedance_curves(maps: &[SurfaceMap], steps: usize) -> Vec<(String, Vec<(f64, f64)>)> {
-    let mut residuals: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-    for m in maps {
-        residuals
-            .entry(group_of(&m.name))
-            .or_default()
-            .extend(m.residual_mm.iter().flatten().copied());
-    }
     let steps = steps.max(1);
-    residuals
+    by_group(maps)
         .into_iter()
-        .filter(|(_, v)| !v.is_empty())
-        .map(|(name, mut v)| {
-            v.sort_by(f64::total_cmp);
+        .map(|(name, (v, _))| {
             let n = v.len() as f64;
             let curve = (0..=steps)
                 .map(|k| {

@@ -5,6 +5,8 @@
 
 mod common;
 
+use common::repo;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
@@ -14,10 +16,6 @@ fn cli() -> Command {
 
 fn scratch(name: &str) -> common::Scratch {
     common::scratch("impeller-cam-run", name)
-}
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
 fn report(dir: &Path) -> serde_json::Value {

@@ -4,15 +4,12 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use common::repo;
+
 use std::process::Command;
 
 fn cli() -> Command {
     Command::new(env!("CARGO_BIN_EXE_impeller-cam"))
-}
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
 fn scratch(name: &str) -> common::Scratch {

@@ -9,6 +9,8 @@
 
 mod common;
 
+use common::repo;
+
 use cam_core::{CutterLocation, Move, Point3, ToolPath, Vector3};
 use cam_plan::{
     order, params, pattern, Builder, Metrics, Operation, OperationSpec, PlanContext, PlanError,
@@ -16,7 +18,6 @@ use cam_plan::{
 };
 use impeller_cam::{run_job_with, Job};
 use serde::Deserialize;
-use std::path::{Path, PathBuf};
 
 /// The kind's own keys.
 #[derive(Debug, Clone, Deserialize)]
@@ -181,10 +182,6 @@ fn build_ring(spec: &OperationSpec) -> Result<Box<dyn Operation>, PlanError> {
 }
 
 static TEST_REGISTRY: &[(&str, Builder)] = &[("test_ring", build_ring)];
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
 
 fn scratch(name: &str) -> common::Scratch {
     common::scratch("impeller-cam-fw", name)

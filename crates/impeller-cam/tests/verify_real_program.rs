@@ -16,12 +16,9 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use common::repo;
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+use std::process::Command;
 
 /// FNV-1a, 64 bits (a fixed hash: the figure below must not depend on the Rust version).
 fn fnv1a(bytes: &[u8]) -> u64 {

@@ -676,7 +676,9 @@ impl DesignModel for ImpellerDesign {
                 // the blade (a ray grazing the side at the tip edge enters far from `p`
                 // although `p` is just under the tip). The other side of the blade, the
                 // far face of a through-cut, is not taken.
-                let below_tip = -self.shroud_sd.signed_distance(p);
+                let below_tip = -at_p
+                    .and_then(|v| v.shroud)
+                    .unwrap_or_else(|| self.shroud_sd.signed_distance(p));
                 let side_depth = -wedge.unwrap_or(d1);
                 if below_tip > 0.0 {
                     side_depth.min(below_tip)

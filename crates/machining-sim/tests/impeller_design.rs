@@ -239,14 +239,18 @@ fn depth_under_a_tip_edge_is_the_depth_below_the_tip() {
     assert!(depth < 0.02, "depth {depth} (sd {sd})");
     assert!(depth >= -sd - 1e-9, "depth {depth} below -sd {}", -sd);
     // Deeper under the tip than inside the side, the side's depth is kept.
-    let h = 1e-4;
-    let grad = Vector3::from_fn(|k, _| {
-        let mut e = Vector3::zeros();
-        e[k] = h;
-        (imp.shroud().signed_distance(&(entry + e)) - imp.shroud().signed_distance(&(entry - e)))
-            / (2.0 * h)
-    });
-    let q = Point3::from(entry - n * 0.06 - grad.normalize() * 0.5);
+    // The shroud surface's unit normal at the entry, oriented out of the blade (toward
+    // growing shroud distance: the distance's gradient there, within 1e-6 over 0.01 mm).
+    let (t, phi, _) = imp.shroud().closest(&entry);
+    let ns = imp.shroud().normal(t, phi);
+    let sd_s = |x: &Vector3| imp.shroud().signed_distance(x);
+    let grad = if sd_s(&(entry + ns * 0.01)) > sd_s(&entry) {
+        ns
+    } else {
+        -ns
+    };
+    assert!((sd_s(&(entry + grad * 0.01)) - sd_s(&entry) - 0.01).abs() < 1e-6);
+    let q = Point3::from(entry - n * 0.06 - grad * 0.5);
     let dq = d.depth_below(&q, &Point3::from(entry));
     let sq = d.signed_distance(&q);
     assert!(dq > 0.06 && dq < 0.4, "depth {dq}");
@@ -257,8 +261,8 @@ fn depth_under_a_tip_edge_is_the_depth_below_the_tip() {
     let mid = (entry + ss.point(u, lo)) * 0.5;
     let half_wall = 0.5 * (entry - ss.point(u, lo)).norm();
     assert!(half_wall < 0.6, "half wall {half_wall}");
-    let top = mid + grad.normalize() * -imp.shroud().signed_distance(&mid);
-    let deep = Point3::from(top - grad.normalize() * 0.6);
+    let top = mid + grad * -imp.shroud().signed_distance(&mid);
+    let deep = Point3::from(top - grad * 0.6);
     let dt = d.depth_below(&deep, &Point3::from(top));
     assert!(
         (dt - 0.6).abs() < 0.02,

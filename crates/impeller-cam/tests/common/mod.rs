@@ -57,3 +57,8 @@ pub fn scratch(prefix: &str, name: &str) -> Scratch {
     std::fs::create_dir_all(&d).unwrap();
     Scratch(d)
 }
+
+/// The repository root (fixtures are read in place).
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
