@@ -211,7 +211,7 @@ impl SurfaceProjector {
     /// several minima: a piece is dropped when its control-net box is at least the best
     /// distance away, minimised by Newton when its Hessian certificate holds (or at the
     /// depth limit), and split into four otherwise, nearer pieces first. Allocates the
-    /// pieces; only reached for queries beyond a centre of curvature of the leaf.
+    /// pieces' control nets; only reached for queries beyond a centre of curvature of the leaf.
     pub(super) fn branch_and_bound(
         &self,
         patch: &BezierPatch,
@@ -257,19 +257,20 @@ impl SurfaceProjector {
             return;
         }
         let (um, vm) = (0.5 * (sub.u0 + sub.u1), 0.5 * (sub.v0 + sub.v1));
-        let mut kids: Vec<(f64, BezierPatch)> = [(sub.u0, um), (um, sub.u1)]
-            .iter()
-            .flat_map(|&(a, b)| {
-                [(sub.v0, vm), (vm, sub.v1)].map(|(c, d)| sub.sub_patch(a, b, c, d))
-            })
-            .map(|k| {
-                let mut bx = Aabb::empty();
-                for p in k.points() {
-                    bx.add(&p);
-                }
-                (bx.dist2(q), k)
-            })
-            .collect();
+        let mut kids: [(f64, BezierPatch); 4] = [
+            (sub.u0, um, sub.v0, vm),
+            (sub.u0, um, vm, sub.v1),
+            (um, sub.u1, sub.v0, vm),
+            (um, sub.u1, vm, sub.v1),
+        ]
+        .map(|(a, b, c, d)| {
+            let k = sub.sub_patch(a, b, c, d);
+            let mut bx = Aabb::empty();
+            for p in k.points() {
+                bx.add(&p);
+            }
+            (bx.dist2(q), k)
+        });
         kids.sort_by(|x, y| x.0.total_cmp(&y.0));
         for (_, k) in &kids {
             self.branch_and_bound(patch, k, axes, q, best, depth + 1);
