@@ -34,7 +34,10 @@ use std::process::Command;
 pub struct Args {
     /// Only fixtures whose name contains this string.
     pub filter: Option<String>,
-    /// Use the dev profile instead of release (faster build, slower run).
+    /// Use the test profile instead of release (faster build, slower run). The test profile
+    /// (the dev settings) is what `cargo test` builds, so after the test suite the binary and
+    /// every crate under it are already compiled: CI does not build the dependencies a third
+    /// time (the dev profile would, under different artifact hashes).
     #[arg(long)]
     pub debug: bool,
 }
@@ -91,9 +94,7 @@ pub fn run(args: Args) -> Result<bool, String> {
     build
         .current_dir(&root)
         .args(["build", "-q", "-p", "impeller-cam"]);
-    if !args.debug {
-        build.arg("--release");
-    }
+    build.args(["--profile", if args.debug { "test" } else { "release" }]);
     run_cmd(&mut build)?;
     let exe = target
         .join(if args.debug { "debug" } else { "release" })
