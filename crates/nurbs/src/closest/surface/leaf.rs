@@ -161,8 +161,11 @@ impl SurfaceProjector {
         if !certified.unwrap_or_else(|| leaf.hess.certifies(&leaf.obb, q)) {
             // The distance may have several minima on this leaf (query beyond a centre of
             // curvature): search the leaf by branch and bound.
+            // The caller keeps this leaf's answer only when it is strictly nearer than the
+            // best so far: pieces at least that far away cannot matter and are dropped too.
+            let bound = best.map_or(f64::INFINITY, |(b, _)| b.d2);
             let sub = patch.sub_patch(leaf.u0, leaf.u1, leaf.v0, leaf.v1);
-            self.branch_and_bound(patch, &sub, &leaf.obb.axes, q, &mut l, 1);
+            self.branch_and_bound(patch, &sub, &leaf.obb.axes, q, bound, &mut l, 1);
         }
         let ((ua, ub), (va, vb)) = self.domain;
         let kkt_u = match l.active[0] {
@@ -210,20 +213,25 @@ impl SurfaceProjector {
     /// Branch and bound over de Casteljau pieces of a leaf on which the distance may have
     /// several minima: a piece is dropped when its control-net box is at least the best
     /// distance away, minimised by Newton when its Hessian certificate holds (or at the
-    /// depth limit), and split into four otherwise, nearer pieces first. Allocates the
+    /// depth limit), and split into four otherwise, nearer pieces first. A piece is also
+    /// dropped when its box is at least `bound` (squared) away: the caller's best answer from
+    /// other leaves, which a point of this leaf must beat strictly to count. `best` then
+    /// holds the leaf's minimum only where that minimum is below `bound`. Allocates the
     /// pieces' control nets; only reached for queries beyond a centre of curvature of the leaf.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn branch_and_bound(
         &self,
         patch: &BezierPatch,
         sub: &BezierPatch,
         axes: &[Vector3<f64>; 3],
         q: &Vector3<f64>,
+        bound: f64,
         best: &mut Local,
         depth: usize,
     ) {
         let pts: Vec<Vector3<f64>> = sub.points().collect();
         let obb = Obb::from_points(&pts, *axes);
-        if obb.dist2(q) >= best.d2 {
+        if obb.dist2(q) >= best.d2.min(bound) {
             return;
         }
         if depth >= MAX_BB_DEPTH || HessianBounds::of(sub, &pts, axes).certifies(&obb, q) {
@@ -272,8 +280,12 @@ impl SurfaceProjector {
             (bx.dist2(q), k)
         });
         kids.sort_by(|x, y| x.0.total_cmp(&y.0));
-        for (_, k) in &kids {
-            self.branch_and_bound(patch, k, axes, q, best, depth + 1);
+        for k in &kids {
+            if k.0 >= best.d2.min(bound) {
+                // Sorted: the remaining pieces' boxes are no nearer.
+                break;
+            }
+            self.branch_and_bound(patch, &k.1, axes, q, bound, best, depth + 1);
         }
     }
 }
