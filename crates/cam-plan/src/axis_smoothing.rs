@@ -63,6 +63,7 @@ use crate::{Metrics, Plot, PlotKind, PlotSeries};
 use cam_core::{CutterLocation, Point3, Vector3};
 use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
+use std::sync::OnceLock;
 
 /// Angle steps (rad) within which an angle counts as standing still when direction changes
 /// are counted (the post's dead band).
@@ -80,23 +81,45 @@ pub const MIN_POLAR_RAD: f64 = 1.0 * PI / 180.0;
 
 /// The whole-tool check of a smoothed run. `index` is the posture's index in the run, for
 /// planners whose limits vary along it (an axis range in a local frame).
+///
+/// A posture's check measures what the checks of the motions to and from it need (its
+/// clearances, [`PostureCheck::Clear`]): [`smooth_run`] keeps that measure and hands it to
+/// both motions, so each posture is measured once per fit instead of once more for each of
+/// its motions, and each planned posture once per run.
 pub trait PostureCheck: Sync {
-    /// Whether the tool at `cl`, in place of posture `index`, keeps the planner's floors.
-    fn posture_clear(&self, index: usize, cl: &CutterLocation) -> bool;
+    /// What a clear posture's check measured that its motions' checks use.
+    type Clear: Send + Sync;
+    /// The measure of the tool at `cl`, in place of posture `index`, when it keeps the
+    /// planner's floors; `None` otherwise.
+    fn posture_clear(&self, index: usize, cl: &CutterLocation) -> Option<Self::Clear>;
+    /// The measure of posture `index` as the planner placed it (the unchanged end of a
+    /// motion), `None` when a motion from or to it cannot be certified. By default the
+    /// posture check itself.
+    fn planned_clear(&self, index: usize, cl: &CutterLocation) -> Option<Self::Clear> {
+        self.posture_clear(index, cl)
+    }
     /// Whether the motion from `a` (in place of posture `index`) to `b` (of `index + 1`),
-    /// both clear, keeps them.
-    fn motion_clear(&self, index: usize, a: &CutterLocation, b: &CutterLocation) -> bool;
+    /// both clear with the measures given, keeps the floors.
+    fn motion_clear(
+        &self,
+        index: usize,
+        a: (&CutterLocation, &Self::Clear),
+        b: (&CutterLocation, &Self::Clear),
+    ) -> bool;
 }
 
 impl PostureCheck for PassCheck<'_> {
-    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> bool {
-        self.is_clear(cl)
+    type Clear = crate::pass_check::PostureClearance;
+    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> Option<Self::Clear> {
+        self.clear_posture(cl)
     }
-    fn motion_clear(&self, _: usize, a: &CutterLocation, b: &CutterLocation) -> bool {
-        match (self.clear_posture(a), self.clear_posture(b)) {
-            (Some(ca), Some(cb)) => self.motion(0, (a, &ca), (b, &cb)).is_none(),
-            _ => false,
-        }
+    fn motion_clear(
+        &self,
+        _: usize,
+        a: (&CutterLocation, &Self::Clear),
+        b: (&CutterLocation, &Self::Clear),
+    ) -> bool {
+        self.motion(0, a, b).is_none()
     }
 }
 
@@ -363,13 +386,16 @@ pub fn monotone_envelope(x: &[f64], ahead: bool) -> Vec<f64> {
     y.into_iter().map(|v| d * v).collect()
 }
 
-/// Why a segment's fit was refused: the indices to pin and the reason.
-fn refused(
+/// Why a segment's fit was refused: the indices to pin and the reason. `planned_clear`
+/// holds the measures of the planned postures asked so far (filled on demand, kept for the
+/// whole run).
+fn refused<C: PostureCheck + ?Sized>(
     seg: (usize, usize),
     planned: &[CutterLocation],
     cand: &[CutterLocation],
     opts: &AxisSmoothing,
-    check: &dyn PostureCheck,
+    check: &C,
+    planned_clear: &[OnceLock<Option<C::Clear>>],
 ) -> Option<(Vec<usize>, KeptReason)> {
     let (a, b) = seg;
     // The angle limit: pin the posture turned most.
@@ -379,15 +405,30 @@ fn refused(
     if turn > opts.max_change_rad {
         return Some((vec![worst], opts.limit_reason));
     }
-    let changed: Vec<usize> = (a..b).filter(|&i| cand[i] != planned[i]).collect();
+    // The changed postures' measures, in index order (`None`: not clear).
+    let changed: Vec<(usize, Option<C::Clear>)> = (a..b)
+        .into_par_iter()
+        .filter(|&i| cand[i] != planned[i])
+        .map(|i| (i, check.posture_clear(i, &cand[i])))
+        .collect();
     let bad: Vec<usize> = changed
-        .par_iter()
-        .copied()
-        .filter(|&i| !check.posture_clear(i, &cand[i]))
+        .iter()
+        .filter(|(_, c)| c.is_none())
+        .map(|(i, _)| *i)
         .collect();
     if !bad.is_empty() {
         return Some((bad, KeptReason::Clearance));
     }
+    let measure = |i: usize| -> Option<&C::Clear> {
+        if cand[i] != planned[i] {
+            let k = changed.binary_search_by_key(&i, |(j, _)| *j).ok()?;
+            changed[k].1.as_ref()
+        } else {
+            planned_clear[i]
+                .get_or_init(|| check.planned_clear(i, &planned[i]))
+                .as_ref()
+        }
+    };
     // Motions with a changed end: inside the segment and to its pinned neighbours.
     let lo = a.saturating_sub(1);
     let hi = (b + 1).min(cand.len());
@@ -395,7 +436,12 @@ fn refused(
         .into_par_iter()
         .filter(|&i| {
             (cand[i] != planned[i] || cand[i + 1] != planned[i + 1])
-                && !check.motion_clear(i, &cand[i], &cand[i + 1])
+                && !match (measure(i), measure(i + 1)) {
+                    (Some(ca), Some(cb)) => {
+                        check.motion_clear(i, (&cand[i], ca), (&cand[i + 1], cb))
+                    }
+                    _ => false,
+                }
         })
         .map(|i| if cand[i] != planned[i] { i } else { i + 1 })
         .collect();
@@ -407,10 +453,10 @@ fn refused(
 
 /// Smooths the tool axes of one ball-end cutting run (module docs). `run` holds the planned
 /// postures in machining order.
-pub fn smooth_run(
+pub fn smooth_run<C: PostureCheck + ?Sized>(
     run: &[CutterLocation],
     opts: &AxisSmoothing,
-    check: &dyn PostureCheck,
+    check: &C,
 ) -> RunSmoothing {
     let n = run.len();
     let before = spherical_angles(run);
@@ -453,6 +499,8 @@ pub fn smooth_run(
     work.push((from, n));
     {
         let mut cand = run.to_vec();
+        let planned_clear: Vec<OnceLock<Option<C::Clear>>> =
+            (0..n).map(|_| OnceLock::new()).collect();
         while let Some((a, b)) = work.pop() {
             let th = &thetas[a..b];
             let ph = &phis[a..b];
@@ -493,7 +541,7 @@ pub fn smooth_run(
                         axis: nalgebra::Unit::new_normalize(axis),
                     };
                 }
-                match refused((a, b), run, &cand, opts, check) {
+                match refused((a, b), run, &cand, opts, check, &planned_clear) {
                     None => {
                         first_refusal = None;
                         break;
@@ -741,10 +789,16 @@ mod tests {
 
     struct Always;
     impl PostureCheck for Always {
-        fn posture_clear(&self, _: usize, _: &CutterLocation) -> bool {
-            true
+        type Clear = ();
+        fn posture_clear(&self, _: usize, _: &CutterLocation) -> Option<()> {
+            Some(())
         }
-        fn motion_clear(&self, _: usize, _: &CutterLocation, _: &CutterLocation) -> bool {
+        fn motion_clear(
+            &self,
+            _: usize,
+            _: (&CutterLocation, &()),
+            _: (&CutterLocation, &()),
+        ) -> bool {
             true
         }
     }
@@ -841,13 +895,20 @@ mod tests {
             .collect();
         struct Wall(Vec<f64>);
         impl PostureCheck for Wall {
-            fn posture_clear(&self, i: usize, cl: &CutterLocation) -> bool {
+            type Clear = ();
+            fn posture_clear(&self, i: usize, cl: &CutterLocation) -> Option<()> {
                 let a = cl.axis.into_inner();
                 let phi = a.y.atan2(a.x);
-                (12..=28).contains(&i) && (phi - self.0[i]).abs() <= 0.3f64.to_radians()
-                    || !(12..=28).contains(&i)
+                ((12..=28).contains(&i) && (phi - self.0[i]).abs() <= 0.3f64.to_radians()
+                    || !(12..=28).contains(&i))
+                .then_some(())
             }
-            fn motion_clear(&self, _: usize, _: &CutterLocation, _: &CutterLocation) -> bool {
+            fn motion_clear(
+                &self,
+                _: usize,
+                _: (&CutterLocation, &()),
+                _: (&CutterLocation, &()),
+            ) -> bool {
                 true
             }
         }
@@ -868,7 +929,7 @@ mod tests {
         );
         // Every kept posture is clear and every ball centre stayed.
         for (i, (p, q)) in run.iter().zip(&r.postures).enumerate() {
-            assert!(check.posture_clear(i, q));
+            assert!(check.posture_clear(i, q).is_some());
             assert!((p.axis_point(R) - q.axis_point(R)).norm() <= 1e-6);
         }
         // The chatter outside the wall is gone.

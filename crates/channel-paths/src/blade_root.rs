@@ -629,14 +629,23 @@ impl SidePlanner<'_, '_> {
 
     /// [`Self::motion_clear`] of two cutter locations.
     fn motion_clear_cl(&self, ca: &CutterLocation, cb: &CutterLocation) -> bool {
-        let (ca, cb) = (*ca, *cb);
+        let qa = self.motion.clearance(ca).distance_mm;
+        let qb = self.motion.clearance(cb).distance_mm;
+        self.motion_clear_between((ca, qa), (cb, qb))
+    }
+
+    /// [`Self::motion_clear_cl`] with the motion query's clearances `qa`, `qb` of the ends
+    /// already measured.
+    fn motion_clear_between(
+        &self,
+        (ca, qa): (&CutterLocation, f64),
+        (cb, qb): (&CutterLocation, f64),
+    ) -> bool {
         let min = -self.ctx.tolerances.machining_tol - MOTION_SAMPLE_TOL_MM;
-        let qa = self.motion.clearance(&ca).distance_mm;
-        let qb = self.motion.clearance(&cb).distance_mm;
         self.motion
             .segment_clearance_between(
-                (&ca, qa),
-                (&cb, qb),
+                (ca, qa),
+                (cb, qb),
                 min,
                 MOTION_TOL_MM - MOTION_SAMPLE_TOL_MM,
                 SEGMENT_QUERIES,
@@ -958,15 +967,27 @@ pub fn plan_side(
 /// shank and holder at least `−machining_tol` from the design) and the motion check between
 /// positions ([`SidePlanner::motion_clear`]); the ball is not moved by a turn about its
 /// centre.
+/// The measure of a posture is the motion query's clearance of it, an end of the motion's
+/// bisection.
 impl cam_plan::PostureCheck for SidePlanner<'_, '_> {
-    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> bool {
+    type Clear = f64;
+    fn posture_clear(&self, i: usize, cl: &CutterLocation) -> Option<f64> {
         let centre = cl.axis_point(self.r).coords;
-        self.ctx.reaches(&cl.axis.into_inner())
+        let clear = self.ctx.reaches(&cl.axis.into_inner())
             && self.posture_clearance(&centre, &cl.axis.into_inner())
-                >= -self.ctx.tolerances.machining_tol
+                >= -self.ctx.tolerances.machining_tol;
+        clear.then(|| self.planned_clear(i, cl)).flatten()
     }
-    fn motion_clear(&self, _: usize, a: &CutterLocation, b: &CutterLocation) -> bool {
-        self.motion_clear_cl(a, b)
+    fn planned_clear(&self, _: usize, cl: &CutterLocation) -> Option<f64> {
+        Some(self.motion.clearance(cl).distance_mm)
+    }
+    fn motion_clear(
+        &self,
+        _: usize,
+        (a, qa): (&CutterLocation, &f64),
+        (b, qb): (&CutterLocation, &f64),
+    ) -> bool {
+        self.motion_clear_between((a, *qa), (b, *qb))
     }
 }
 

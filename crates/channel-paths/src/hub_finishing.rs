@@ -693,15 +693,37 @@ impl Planner<'_> {
 /// The checks a smoothed posture and motion must pass: the planner's own (module docs,
 /// "Tool axis and accessibility"; the ball is not moved by a turn about its centre), and an
 /// axis the machine can take.
+/// The measure of a posture is its pair of clearances (tool above the ball against hub and
+/// blades, against the blades alone), the ends of the motion check's bisections.
 impl cam_plan::PostureCheck for Planner<'_> {
-    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> bool {
+    type Clear = (f64, f64);
+    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> Option<(f64, f64)> {
         let min = -0.5 * self.tol;
-        self.ctx.reaches(&cl.axis.into_inner())
-            && self.upper.clearance_if_clear(cl, min).is_some()
-            && self.blades_only.clearance_if_clear(cl, min).is_some()
+        if !self.ctx.reaches(&cl.axis.into_inner()) {
+            return None;
+        }
+        let upper = self.upper.clearance_if_clear(cl, min)?;
+        let blades = self.blades_only.clearance_if_clear(cl, min)?;
+        Some((upper.distance_mm, blades.distance_mm))
     }
-    fn motion_clear(&self, _: usize, a: &CutterLocation, b: &CutterLocation) -> bool {
-        self.motion_clear(&self.posture_of(*a), &self.posture_of(*b))
+    fn planned_clear(&self, _: usize, cl: &CutterLocation) -> Option<(f64, f64)> {
+        let p = self.posture_of(*cl);
+        Some((p.clearance, p.blade_clearance))
+    }
+    fn motion_clear(
+        &self,
+        _: usize,
+        (a, ca): (&CutterLocation, &(f64, f64)),
+        (b, cb): (&CutterLocation, &(f64, f64)),
+    ) -> bool {
+        let posture = |cl: &CutterLocation, c: &(f64, f64)| Posture {
+            cl: *cl,
+            clearance: c.0,
+            blade_clearance: c.1,
+            steps: 0,
+            rotation: 0.0,
+        };
+        self.motion_clear(&posture(a, ca), &posture(b, cb))
     }
 }
 

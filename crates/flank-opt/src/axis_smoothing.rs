@@ -99,11 +99,11 @@ pub struct PlannedPass<'a> {
 /// each changed pass handed to `measure`, which returns its measurement when the pass keeps
 /// its tolerances. The first accepted smoothing with its measurement, or `None` (no direction
 /// change, no budget, or no fit accepted). Cost: up to two smoothings and two measurements.
-pub fn within_budget<T>(
+pub fn within_budget<T, C: PostureCheck + ?Sized>(
     locations: &[CutterLocation],
     shape: &CutterShape,
     budget: f64,
-    check: &dyn PostureCheck,
+    check: &C,
     mut measure: impl FnMut(&[CutterLocation]) -> Result<Option<T>, FlankError>,
 ) -> Result<Option<(RunSmoothing, T)>, FlankError> {
     let angles = spherical_angles(locations);
@@ -134,9 +134,9 @@ pub fn within_budget<T>(
 /// pass measured densely ([`measure_written_path`]) and accepted when it holds both
 /// tolerances (certified queries included); `check` is the whole-tool clearance query of the
 /// pass.
-pub fn smooth_pass(
+pub fn smooth_pass<C: PostureCheck + ?Sized>(
     pass: &PlannedPass<'_>,
-    check: &dyn PostureCheck,
+    check: &C,
 ) -> Result<PassSmoothing, FlankError> {
     let slack = (pass.tol_mm.0 - pass.measured_mm.0).min(pass.tol_mm.1 - pass.measured_mm.1);
     let budget = accuracy_turn_limit(&pass.shape, pass.flute_length, slack);

@@ -165,28 +165,32 @@ impl RunCheck<'_, '_> {
     }
 }
 
+/// The measure of a posture is its whole-tool clearance, an end of the motion's bisection.
 impl PostureCheck for RunCheck<'_, '_> {
-    fn posture_clear(&self, index: usize, cl: &CutterLocation) -> bool {
+    type Clear = f64;
+    fn posture_clear(&self, index: usize, cl: &CutterLocation) -> Option<f64> {
         let within_tilt = self
             .normals
             .get(index)
             .is_some_and(|n| cl.axis.angle(n) <= self.max_tilt + 1e-9);
-        within_tilt && self.clear(cl).is_some()
+        if !within_tilt {
+            return None;
+        }
+        self.clear(cl).map(|c| c.distance_mm)
     }
-    fn motion_clear(&self, _: usize, a: &CutterLocation, b: &CutterLocation) -> bool {
-        let (Some(ca), Some(cb)) = (self.clear(a), self.clear(b)) else {
-            return false;
-        };
+    fn planned_clear(&self, _: usize, cl: &CutterLocation) -> Option<f64> {
+        self.clear(cl).map(|c| c.distance_mm)
+    }
+    fn motion_clear(
+        &self,
+        _: usize,
+        (a, ca): (&CutterLocation, &f64),
+        (b, cb): (&CutterLocation, &f64),
+    ) -> bool {
         self.loc
             .ctx
             .clearance
-            .segment_clearance_between(
-                (a, ca.distance_mm),
-                (b, cb.distance_mm),
-                0.0,
-                self.loc.seg_tol(),
-                SEGMENT_QUERIES,
-            )
+            .segment_clearance_between((a, *ca), (b, *cb), 0.0, self.loc.seg_tol(), SEGMENT_QUERIES)
             .is_ok()
     }
 }

@@ -26,7 +26,9 @@
 use super::{PointPass, Station};
 use cam_core::CutterLocation;
 use cam_plan::axis_smoothing::smooth_run;
-use cam_plan::{AxisSmoothing, PassCheck, PlanContext, PostureCheck, SmoothingSummary};
+use cam_plan::{
+    AxisSmoothing, PassCheck, PlanContext, PostureCheck, PostureClearance, SmoothingSummary,
+};
 
 /// Fits (and checks) per run: each refused fit splits the run at the refused postures; six
 /// bound the cost of a run that cannot be smoothed as a whole (as channel roughing's runs).
@@ -44,13 +46,27 @@ struct RunCheck<'a> {
     max_axis_step: f64,
 }
 
+/// The measure of a posture is the pass check's (whole tool and upper part clearances).
 impl PostureCheck for RunCheck<'_> {
-    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> bool {
-        self.ctx.reaches(&cl.axis.into_inner()) && self.check.is_clear(cl)
+    type Clear = PostureClearance;
+    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> Option<PostureClearance> {
+        if !self.ctx.reaches(&cl.axis.into_inner()) {
+            return None;
+        }
+        self.check.clear_posture(cl)
     }
 
-    fn motion_clear(&self, i: usize, a: &CutterLocation, b: &CutterLocation) -> bool {
-        a.axis.angle(&b.axis) <= self.max_axis_step + 1e-12
+    fn planned_clear(&self, _: usize, cl: &CutterLocation) -> Option<PostureClearance> {
+        self.check.clear_posture(cl)
+    }
+
+    fn motion_clear(
+        &self,
+        i: usize,
+        a: (&CutterLocation, &PostureClearance),
+        b: (&CutterLocation, &PostureClearance),
+    ) -> bool {
+        a.0.axis.angle(&b.0.axis) <= self.max_axis_step + 1e-12
             && PostureCheck::motion_clear(self.check, i, a, b)
     }
 }
