@@ -34,10 +34,10 @@ use std::process::Command;
 pub struct Args {
     /// Only fixtures whose name contains this string.
     pub filter: Option<String>,
-    /// Use the test profile instead of release (faster build, slower run). The test profile
-    /// (the dev settings) is what `cargo test` builds, so after the test suite the binary and
-    /// every crate under it are already compiled: CI does not build the dependencies a third
-    /// time (the dev profile would, under different artifact hashes).
+    /// Run the binary `cargo test --workspace` builds (test profile, the dev settings)
+    /// instead of a release build: faster to build, slower to run. After the test suite it
+    /// is already compiled; `cargo build -p impeller-cam` would compile the dependencies
+    /// again, without the features the workspace's dev-dependencies enable.
     #[arg(long)]
     pub debug: bool,
 }
@@ -91,10 +91,15 @@ pub fn run(args: Args) -> Result<bool, String> {
         return Err("no fixture with job.toml and bounds.toml under fixtures/".into());
     }
     let mut build = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
-    build
-        .current_dir(&root)
-        .args(["build", "-q", "-p", "impeller-cam"]);
-    build.args(["--profile", if args.debug { "test" } else { "release" }]);
+    build.current_dir(&root);
+    if args.debug {
+        // The binary `cargo test --workspace` builds for the command-line tests: the same
+        // dependency features (dev-dependencies included), so right after the test suite
+        // nothing is compiled again.
+        build.args(["test", "-q", "--workspace", "--no-run"]);
+    } else {
+        build.args(["build", "-q", "--release", "-p", "impeller-cam"]);
+    }
     run_cmd(&mut build)?;
     let exe = target
         .join(if args.debug { "debug" } else { "release" })
