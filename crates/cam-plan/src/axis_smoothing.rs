@@ -939,6 +939,64 @@ mod tests {
         assert!(reversal_indices(&pa[31..]).is_empty());
     }
 
+    /// Each motion check receives, for each end, the measure the posture check returned for
+    /// that very posture (a turned one's from `posture_clear`, an unchanged one's from
+    /// `planned_clear`), and a planned posture is measured at most once per run although
+    /// several fits check motions to it: the motions to posture `W` are refused while it is
+    /// turned, so it is pinned and both segments beside it check their motions to it.
+    #[test]
+    fn motions_get_their_ends_measures_and_planned_postures_are_measured_once() {
+        use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+        let n = 41;
+        // A posture the smooth fit turns (the fit keeps every other one of this run).
+        const W: usize = 21;
+        let run = chattering_run(n);
+        struct Counting {
+            run: Vec<CutterLocation>,
+            planned_calls: Vec<AtomicUsize>,
+            wrong_measure: AtomicBool,
+        }
+        impl PostureCheck for Counting {
+            /// The posture measured.
+            type Clear = CutterLocation;
+            fn posture_clear(&self, _: usize, cl: &CutterLocation) -> Option<CutterLocation> {
+                Some(*cl)
+            }
+            fn planned_clear(&self, i: usize, cl: &CutterLocation) -> Option<CutterLocation> {
+                self.planned_calls[i].fetch_add(1, Ordering::Relaxed);
+                Some(*cl)
+            }
+            fn motion_clear(
+                &self,
+                i: usize,
+                (a, ma): (&CutterLocation, &CutterLocation),
+                (b, mb): (&CutterLocation, &CutterLocation),
+            ) -> bool {
+                if a != ma || b != mb {
+                    self.wrong_measure.store(true, Ordering::Relaxed);
+                }
+                let turned_w = (i + 1 == W && *b != self.run[W]) || (i == W && *a != self.run[W]);
+                !turned_w
+            }
+        }
+        let check = Counting {
+            run: run.clone(),
+            planned_calls: (0..n).map(|_| AtomicUsize::new(0)).collect(),
+            wrong_measure: AtomicBool::new(false),
+        };
+        let r = smooth_run(&run, &AxisSmoothing::ball_end(R), &check);
+        assert_eq!(r.postures[W], run[W], "posture {W} pinned");
+        assert!(r.fits >= 3, "{r:?}");
+        assert!(!check.wrong_measure.load(Ordering::Relaxed));
+        let calls: Vec<usize> = check
+            .planned_calls
+            .iter()
+            .map(|c| c.load(Ordering::Relaxed))
+            .collect();
+        assert_eq!(calls[W], 1, "{calls:?}");
+        assert!(calls.iter().all(|&c| c <= 1), "{calls:?}");
+    }
+
     /// The envelopes are monotone and stay on one side of the planned angles.
     #[test]
     fn envelopes_are_one_sided() {

@@ -976,7 +976,10 @@ impl cam_plan::PostureCheck for SidePlanner<'_, '_> {
         let clear = self.ctx.reaches(&cl.axis.into_inner())
             && self.posture_clearance(&centre, &cl.axis.into_inner())
                 >= -self.ctx.tolerances.machining_tol;
-        clear.then(|| self.planned_clear(i, cl)).flatten()
+        if !clear {
+            return None;
+        }
+        self.planned_clear(i, cl)
     }
     fn planned_clear(&self, _: usize, cl: &CutterLocation) -> Option<f64> {
         Some(self.motion.clearance(cl).distance_mm)
