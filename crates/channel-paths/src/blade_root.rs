@@ -8,7 +8,8 @@
 //! (outward unit normal `n`) that lies on the hub's offset surface, `d_hub(c) = ρ` — the
 //! intersection of the two offset surfaces of paper 004 Fig. 6, found per station by a
 //! bracketed Illinois regula-falsi root of `v ↦ d_hub(B(u, v) + ρ n(u, v)) − ρ` (the hub's
-//! signed distance is exact: closest point in the meridional half plane), to 1e-12 mm.
+//! signed distance is exact: closest point in the meridional half plane), to 1e-12 mm
+//! ([`impeller_model::fillet::FilletSection::solve`], the fillet's own cross-section).
 //! - `r ≥ R_f`: the ball centre is `c` itself, at distance `r` from both hub and blade side
 //!   (it leaves a corner radius `r ≥ R_f`: undercut only).
 //! - `r < R_f`: `c` is the centre of the fillet's rolling ball; the cutter's centre is moved
@@ -80,7 +81,8 @@ use cam_plan::{
     pattern, ClearanceOptions, DesignClearance, Metrics, Operation, OperationSpec, PartSet,
     PlanContext, PlanError, PlannedOperation, Plot, PlotKind, PlotSeries, Point3,
 };
-use impeller_model::{channel::edge_v, Blade, Impeller, Side};
+use impeller_model::fillet::FilletSection;
+use impeller_model::{Blade, Impeller, Side};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -97,8 +99,6 @@ pub const BLADE_ROOT_FINISHING: &str = "blade_root_finishing";
 const DEFAULT_STATIONS: usize = 120;
 /// Default turning step of the axis (paper 004: "about 1 ~ 2 degrees").
 const DEFAULT_STEP_DEG: f64 = 1.5;
-/// Iterations of the regula-falsi root and of the bisection for the largest ball.
-const ROOT_ITERS: usize = 200;
 /// Bisection levels of the stations inserted between two uniform ones (2^6 = 64 per gap).
 const MAX_REFINE_DEPTH: u32 = 6;
 /// Bisection levels of the end of a run of positions toward a station left out (2^10 = 1024
@@ -119,8 +119,6 @@ const MOTION_TOL_MM: f64 = 0.25;
 const MOTION_SAMPLE_TOL_MM: f64 = 0.05;
 /// Bisection steps of the largest accessible ball radius (2^-8 of the radius).
 const RADIUS_BISECTIONS: usize = 8;
-/// Samples of the v range searched for the spine bracket.
-const BRACKET_SAMPLES: usize = 64;
 /// Approach length above the first point (mm) before plunging at feed.
 const APPROACH_MM: f64 = 2.0;
 /// Samples of the design fillet arc for the undercut.
@@ -206,65 +204,13 @@ pub struct RootPosition {
 /// Ball centre data of one station: (centre, spine, blade normal, hub normal).
 type Station = (Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>);
 
-/// Ball centre data of one station.
+/// Ball centre data of one station: the fillet section of radius `max(r, R_f)`
+/// ([`impeller_model::fillet::FilletSection::solve`], module docs), its centre moved toward
+/// the corner by `R_f − r` when the ball is smaller than the fillet.
 fn spine(imp: &Impeller, blade: &Blade, side: Side, u: f64, r: f64) -> Option<Station> {
     let rf = imp.fillet_radius_mm();
-    let rho = r.max(rf);
-    let s = blade.side(side);
-    let (_, (v0, v1)) = s.domain();
-    let hub = imp.hub();
-    let off = |v: f64| -> Option<(Vector3<f64>, Vector3<f64>)> {
-        let n = blade.outward_normal(side, u, v)?;
-        Some((s.point(u, v) + n * rho, n))
-    };
-    let g = |v: f64| off(v).map(|(c, _)| hub.signed_distance(&c) - rho);
-    let v_root = edge_v(blade, side, hub, u).unwrap_or(v0);
-    // Bracket: first sign change of g above the root.
-    let mut a = v_root.max(v0);
-    let mut ga = g(a)?;
-    let mut bracket = None;
-    for k in 1..=BRACKET_SAMPLES {
-        let b = a + (v1 - v_root.max(v0)) * 1.0 / BRACKET_SAMPLES as f64;
-        let b = b.min(v1);
-        let gb = g(b)?;
-        if ga <= 0.0 && gb > 0.0 {
-            bracket = Some((a, b, ga, gb));
-            break;
-        }
-        a = b;
-        ga = gb;
-        if k == BRACKET_SAMPLES || b >= v1 {
-            break;
-        }
-    }
-    let (mut lo, mut hi, mut flo, mut fhi) = bracket?;
-    let mut last = 0i8;
-    let mut v = lo;
-    for _ in 0..ROOT_ITERS {
-        v = (lo * fhi - hi * flo) / (fhi - flo);
-        let fv = g(v)?;
-        if fv.abs() < 1e-13 || (hi - lo) < 1e-15 {
-            break;
-        }
-        if fv <= 0.0 {
-            lo = v;
-            flo = fv;
-            if last == -1 {
-                fhi *= 0.5;
-            }
-            last = -1;
-        } else {
-            hi = v;
-            fhi = fv;
-            if last == 1 {
-                flo *= 0.5;
-            }
-            last = 1;
-        }
-    }
-    let (c, nb) = off(v)?;
-    let (t, phi, _) = hub.closest(&c);
-    let nh = hub.normal(t, phi);
+    let s = FilletSection::solve(imp.hub(), blade, side, u, r.max(rf))?;
+    let (c, nb, nh) = (s.centre, s.blade_normal, s.hub_normal);
     let centre = if r < rf {
         let m = (nb + nh).try_normalize(1e-12)?;
         c - m * (rf - r)

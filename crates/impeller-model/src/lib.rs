@@ -16,6 +16,7 @@
 //! shroud), [`blade`] (sides, camber, rows), [`impeller`], [`stock`], [`channel`] (edges on
 //! hub/shroud, channels, widths), [`query`] (closest points, signed distances), [`summary`],
 //! [`ruled`] (ruled and sub-ruled approximation), [`fit`] (interpolation of sampled design),
+//! [`fillet`] (the rolling-ball blade-root fillet as geometry: sections, spine, distance),
 //! [`levels`] (depth levels between hub and shroud, boundaries of offset surfaces on a level).
 //!
 //! Conventions: the hub's channel-side normal points into the channel, the shroud's out of
@@ -33,6 +34,7 @@ pub mod builder;
 pub mod channel;
 pub mod error;
 pub mod export;
+pub mod fillet;
 pub mod fit;
 pub mod fixtures;
 pub mod impeller;

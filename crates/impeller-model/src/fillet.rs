@@ -1,0 +1,606 @@
+//! The blade-root fillet as geometry: the rolling-ball blend of radius `R` between the hub
+//! and each blade side.
+//!
+//! # Geometry
+//! A ball of radius `R` rolling in the corner between the hub and a blade side, touching
+//! both, sweeps the fillet. Its centre `c` lies on both offset surfaces (the *spine*):
+//! `c = B(u, v) + R·n_b(u, v)` with `n_b` the side's outward unit normal, and
+//! `d_hub(c) = R` with `d_hub` the hub's exact signed distance (channel side positive). Per
+//! blade station `u` the spine point is the root of the scalar function
+//! `g(v) = d_hub(B(u, v) + R·n_b(u, v)) − R` above the side's hub edge, found by a bracket
+//! (first sign change among [`BRACKET_SAMPLES`] samples of `v`, − to +) and the Illinois
+//! regula falsi ([`FilletSection::solve`], to `|g| < 1e-13` mm). The ball touches the side at
+//! `B(u, v)` and the hub at `c − R·n_h` (`n_h` the hub normal at the foot of `c`). Both
+//! contact points lie on the ball's characteristic circle (the spine's tangent is
+//! perpendicular to both normals: it is tangent to both offset surfaces), so the fillet's
+//! cross-section at `u` is the circular arc of radius `R` about `c` from the hub contact to
+//! the blade contact, of angle `π − β` where `β` is the angle of the corner between hub and
+//! side ([`FilletSection::arc`], exact rational quadratic NURBS).
+//!
+//! # The fillet of a blade side ([`BladeFillet`])
+//! Sections at stations uniform in `u` form *pieces*: maximal runs of stations whose ball
+//! fits, i.e. whose centre is `R` (within [`FIT_CHECK_MM`]) from the side by the global
+//! closest point and no nearer to the other side; a station whose offset surfaces do not
+//! meet, or whose ball would cross the blade (a concave region tighter than `R`, the nose of
+//! a thin edge), ends a piece. Each piece's spine is the cubic B-spline interpolating its
+//! centres with uniform parameters (NURBS Book A9.1; the stations are uniform in `u`, so the
+//! curve parameter is affine in `u`), and the two contact normals are interpolated the same
+//! way. The spine's error is measured against exact sections at every midpoint between
+//! stations; the stations are doubled until it is at most the tolerance (default
+//! [`DEFAULT_FILLET_TOL_MM`]) or [`MAX_STATIONS`] is reached ([`FilletPiece::fit_error_mm`]
+//! says what was reached).
+//!
+//! # Distance ([`BladeFillet::signed_distance`])
+//! The fillet material near a piece is the part of the corner outside the rolling balls. For
+//! a point `p` whose nearest spine point `c(t)` (certified global curve projection) is
+//! interior and whose direction from it lies in the wedge spanned by the two contact
+//! directions `−n_h`, `−n_b` (the arc's sector), the nearest fillet point is on that arc
+//! along `p − c(t)`, and the signed distance (positive in the air, as every design distance
+//! here) is `R − |p − c(t)|`. Elsewhere the fillet does not decide the distance (`None`):
+//! the nearest design point is on the hub or the side, or beyond the piece's ends. The
+//! design's distance with fillets is the minimum of the sharp design's signed distance and
+//! this one (the fillet adds material to the corner). Stated error: the spine fit's error
+//! (the distance is 1-Lipschitz in the spine's position), at most the tolerance.
+//!
+//! Cost: building a piece of `n` stations takes `O(n)` section solves (regula falsi, each
+//! `O(iterations)` exact hub distances) and `2n` global blade projections, plus the
+//! refinement's midpoint checks; a distance is one certified curve projection, O(log n).
+
+use crate::blade::{Blade, Side};
+use crate::channel::edge_v;
+use crate::error::ModelError;
+use crate::query::blade_side_distance;
+use crate::revolved::RevolvedSurface;
+use nalgebra::{SVector, Vector3};
+use nurbs::closest::CurveProjector;
+use nurbs::fit::{interpolate_curve, Parametrisation};
+use nurbs::NurbsCurve;
+
+/// Samples of `v` (hub edge to the side's top) searched for the first sign change of the
+/// spine function.
+pub const BRACKET_SAMPLES: usize = 64;
+
+/// Iterations of the regula falsi of a section.
+const ROOT_ITERS: usize = 200;
+
+/// Default largest error of a fillet's spine (mm).
+pub const DEFAULT_FILLET_TOL_MM: f64 = 1e-4;
+
+/// Largest number of stations of a blade side's fillet.
+pub const MAX_STATIONS: usize = 4097;
+
+/// First number of stations of a blade side's fillet (then doubled while the fit is coarser
+/// than the tolerance).
+const FIRST_STATIONS: usize = 129;
+
+/// How far a ball's centre may be from `R` of the blade side (global closest point) for its
+/// section to count (mm): the sections solve to 1e-13 mm, so more means the nearest side
+/// point is elsewhere (the ball crosses the blade).
+pub const FIT_CHECK_MM: f64 = 1e-6;
+
+/// One cross-section of the fillet: the rolling ball touching the hub and a blade side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FilletSection {
+    /// Station: the blade side's `u`.
+    pub u: f64,
+    /// The side's `v` of the blade contact.
+    pub v: f64,
+    /// Ball centre (spine point).
+    pub centre: Vector3<f64>,
+    /// Outward unit normal of the side at the blade contact.
+    pub blade_normal: Vector3<f64>,
+    /// Channel-side unit normal of the hub at the hub contact.
+    pub hub_normal: Vector3<f64>,
+    /// Ball (fillet) radius (mm).
+    pub radius: f64,
+}
+
+impl FilletSection {
+    /// The ball of radius `radius` touching the hub and `side` of `blade` at station `u`
+    /// (module docs): `None` when the side's offset surface does not reach the hub's within
+    /// the side's `v` range (no sign change of the spine function) or a normal is singular.
+    /// Cost: up to [`BRACKET_SAMPLES`] + `ROOT_ITERS` exact hub distances.
+    pub fn solve(
+        hub: &RevolvedSurface,
+        blade: &Blade,
+        side: Side,
+        u: f64,
+        radius: f64,
+    ) -> Option<Self> {
+        let s = blade.side(side);
+        let (_, (v0, v1)) = s.domain();
+        let off = |v: f64| -> Option<(Vector3<f64>, Vector3<f64>)> {
+            let n = blade.outward_normal(side, u, v)?;
+            Some((s.point(u, v) + n * radius, n))
+        };
+        let g = |v: f64| off(v).map(|(c, _)| hub.signed_distance(&c) - radius);
+        let v_root = edge_v(blade, side, hub, u).unwrap_or(v0);
+        // Bracket: the first sign change of g above the hub edge.
+        let mut a = v_root.max(v0);
+        let mut ga = g(a)?;
+        let mut bracket = None;
+        for k in 1..=BRACKET_SAMPLES {
+            let b = a + (v1 - v_root.max(v0)) * 1.0 / BRACKET_SAMPLES as f64;
+            let b = b.min(v1);
+            let gb = g(b)?;
+            if ga <= 0.0 && gb > 0.0 {
+                bracket = Some((a, b, ga, gb));
+                break;
+            }
+            a = b;
+            ga = gb;
+            if k == BRACKET_SAMPLES || b >= v1 {
+                break;
+            }
+        }
+        let (mut lo, mut hi, mut flo, mut fhi) = bracket?;
+        let mut last = 0i8;
+        let mut v = lo;
+        for _ in 0..ROOT_ITERS {
+            v = (lo * fhi - hi * flo) / (fhi - flo);
+            let fv = g(v)?;
+            if fv.abs() < 1e-13 || (hi - lo) < 1e-15 {
+                break;
+            }
+            if fv <= 0.0 {
+                lo = v;
+                flo = fv;
+                if last == -1 {
+                    fhi *= 0.5;
+                }
+                last = -1;
+            } else {
+                hi = v;
+                fhi = fv;
+                if last == 1 {
+                    flo *= 0.5;
+                }
+                last = 1;
+            }
+        }
+        let (centre, blade_normal) = off(v)?;
+        let (t, phi, _) = hub.closest(&centre);
+        Some(Self {
+            u,
+            v,
+            centre,
+            blade_normal,
+            hub_normal: hub.normal(t, phi),
+            radius,
+        })
+    }
+
+    /// The ball's contact with the blade side.
+    pub fn blade_foot(&self) -> Vector3<f64> {
+        self.centre - self.blade_normal * self.radius
+    }
+
+    /// The ball's contact with the hub.
+    pub fn hub_foot(&self) -> Vector3<f64> {
+        self.centre - self.hub_normal * self.radius
+    }
+
+    /// Angle of the fillet's arc (rad): `π` less the corner's angle between hub and side.
+    pub fn arc_angle(&self) -> f64 {
+        self.hub_normal.angle(&self.blade_normal)
+    }
+
+    /// The point of the arc at fraction `t ∈ [0, 1]` of its angle, from the hub contact
+    /// (`t = 0`) to the blade contact (`t = 1`); exactly `radius` from the centre.
+    pub fn arc_point(&self, t: f64) -> Vector3<f64> {
+        let (a, b) = (-self.hub_normal, -self.blade_normal);
+        let w = self.arc_angle();
+        let d = if w < 1e-12 {
+            a
+        } else {
+            (a * ((1.0 - t) * w).sin() + b * (t * w).sin()) / w.sin()
+        };
+        self.centre + d.normalize() * self.radius
+    }
+
+    /// The arc as an exact rational quadratic NURBS curve (hub contact at 0, blade contact
+    /// at 1). Errors when the contact directions are parallel (no corner).
+    pub fn arc(&self) -> Result<NurbsCurve<3>, ModelError> {
+        let a = -self.hub_normal;
+        let b = -self.blade_normal;
+        let y = b - a * a.dot(&b);
+        if y.norm() < 1e-12 {
+            return Err(ModelError::Geometry(format!(
+                "fillet section at u = {:.6}: hub and blade normals are parallel",
+                self.u
+            )));
+        }
+        Ok(NurbsCurve::circle_arc(
+            self.centre,
+            a,
+            y,
+            self.radius,
+            0.0,
+            self.arc_angle(),
+        )?)
+    }
+}
+
+/// A run of fitting stations of a blade side's fillet with its fitted spine.
+#[derive(Debug, Clone)]
+pub struct FilletPiece {
+    sections: Vec<FilletSection>,
+    spine: NurbsCurve<3>,
+    /// Hub normal (0..3) and blade normal (3..6) along the spine's parameter.
+    normals: NurbsCurve<6>,
+    projector: CurveProjector<3>,
+    fit_error_mm: f64,
+}
+
+impl FilletPiece {
+    /// The exact sections at the piece's stations (u increasing).
+    pub fn sections(&self) -> &[FilletSection] {
+        &self.sections
+    }
+
+    /// The fitted spine (ball centres; parameter affine in the side's `u` over the piece).
+    pub fn spine(&self) -> &NurbsCurve<3> {
+        &self.spine
+    }
+
+    /// Largest distance found between the fitted spine and exact sections solved at every
+    /// midpoint between stations (mm).
+    pub fn fit_error_mm(&self) -> f64 {
+        self.fit_error_mm
+    }
+
+    /// The side's `u` range the piece covers.
+    pub fn u_range(&self) -> (f64, f64) {
+        let n = self.sections.len();
+        (self.sections[0].u, self.sections[n - 1].u)
+    }
+
+    /// The fitted section at side parameter `u` within [`Self::u_range`] (centre and normals
+    /// from the fitted curves, normals renormalised).
+    pub fn section_at(&self, u: f64) -> FilletSection {
+        let (u0, u1) = self.u_range();
+        let t = ((u - u0) / (u1 - u0)).clamp(0.0, 1.0);
+        let n = self.normals.point(t);
+        let r = self.sections[0].radius;
+        let (nh, nb) = (
+            Vector3::new(n[0], n[1], n[2]).normalize(),
+            Vector3::new(n[3], n[4], n[5]).normalize(),
+        );
+        FilletSection {
+            u,
+            v: f64::NAN,
+            centre: self.spine.point(t),
+            blade_normal: nb,
+            hub_normal: nh,
+            radius: r,
+        }
+    }
+
+    /// Signed distance of `p` to the fillet material of this piece (module docs), `None`
+    /// where the fillet does not decide it.
+    fn signed_distance(&self, p: &Vector3<f64>) -> Option<f64> {
+        let q = self.projector.closest_point(p);
+        let d = p - q.point;
+        let tangent = q.tangent.try_normalize(1e-12)?;
+        if q.on_boundary || d.dot(&tangent).abs() > 1e-6 * (1.0 + d.norm()) {
+            return None;
+        }
+        let n = self.normals.point(q.u);
+        let a = -Vector3::new(n[0], n[1], n[2]).normalize();
+        let b = -Vector3::new(n[3], n[4], n[5]).normalize();
+        // d = λ a + μ b (+ a tangent part): the arc's sector when λ, μ ≥ 0.
+        let ab = a.dot(&b);
+        let det = 1.0 - ab * ab;
+        if det < 1e-12 {
+            return None;
+        }
+        let (da, db) = (d.dot(&a), d.dot(&b));
+        let lambda = (da - ab * db) / det;
+        let mu = (db - ab * da) / det;
+        let slack = -1e-9 * (1.0 + d.norm());
+        (lambda >= slack && mu >= slack).then(|| self.sections[0].radius - d.norm())
+    }
+}
+
+/// The fillet of one blade side with the hub (module docs).
+#[derive(Debug, Clone)]
+pub struct BladeFillet {
+    side: Side,
+    radius: f64,
+    pieces: Vec<FilletPiece>,
+    stations: usize,
+}
+
+impl BladeFillet {
+    /// The fillet of radius `radius` between `hub` and `side` of `blade`, its spine within
+    /// `tol_mm` where [`MAX_STATIONS`] allow (module docs). Errors: a radius that is not
+    /// positive and finite, a tolerance that is not positive, a fit that fails.
+    pub fn build(
+        hub: &RevolvedSurface,
+        blade: &Blade,
+        side: Side,
+        radius: f64,
+        tol_mm: f64,
+    ) -> Result<Self, ModelError> {
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(ModelError::invalid("fillet radius", "must be > 0"));
+        }
+        if !(tol_mm.is_finite() && tol_mm > 0.0) {
+            return Err(ModelError::invalid("fillet tolerance", "must be > 0"));
+        }
+        let ((u0, u1), _) = blade.side(side).domain();
+        let mut n = FIRST_STATIONS;
+        loop {
+            let stations: Vec<Option<FilletSection>> = (0..n)
+                .map(|k| {
+                    let u = u0 + (u1 - u0) * k as f64 / (n - 1) as f64;
+                    fitting_section(hub, blade, side, u, radius)
+                })
+                .collect();
+            let mut pieces = Vec::new();
+            let mut run: Vec<FilletSection> = Vec::new();
+            for s in stations.iter().chain(std::iter::once(&None)) {
+                match s {
+                    Some(s) => run.push(*s),
+                    None => {
+                        if run.len() >= 4 {
+                            pieces.push(fit_piece(hub, blade, side, std::mem::take(&mut run))?);
+                        }
+                        run.clear();
+                    }
+                }
+            }
+            let worst = pieces
+                .iter()
+                .map(FilletPiece::fit_error_mm)
+                .fold(0.0, f64::max);
+            if worst <= tol_mm || 2 * n - 1 > MAX_STATIONS {
+                return Ok(Self {
+                    side,
+                    radius,
+                    pieces,
+                    stations: n,
+                });
+            }
+            n = 2 * n - 1;
+        }
+    }
+
+    /// The blade side.
+    pub fn side(&self) -> Side {
+        self.side
+    }
+
+    /// Fillet radius (mm).
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// Runs of stations where the ball fits, u increasing.
+    pub fn pieces(&self) -> &[FilletPiece] {
+        &self.pieces
+    }
+
+    /// Stations sampled along the side (uniform in `u`).
+    pub fn stations(&self) -> usize {
+        self.stations
+    }
+
+    /// Largest spine error of any piece (mm).
+    pub fn fit_error_mm(&self) -> f64 {
+        self.pieces
+            .iter()
+            .map(FilletPiece::fit_error_mm)
+            .fold(0.0, f64::max)
+    }
+
+    /// Signed distance of `p` to the fillet material (positive in the air), where the fillet
+    /// decides the design's distance (module docs); `None` elsewhere.
+    pub fn signed_distance(&self, p: &Vector3<f64>) -> Option<f64> {
+        self.pieces
+            .iter()
+            .filter_map(|k| k.signed_distance(p))
+            .min_by(f64::total_cmp)
+    }
+}
+
+/// The section at `u` when its ball fits against the blade and the hub: it touches the hub
+/// inside its contour (not at an end), its centre is `R` outside `side` by
+/// the global closest point (within [`FIT_CHECK_MM`]) and at least `R` from the other side
+/// (unsigned: the ball does not reach it).
+fn fitting_section(
+    hub: &RevolvedSurface,
+    blade: &Blade,
+    side: Side,
+    u: f64,
+    radius: f64,
+) -> Option<FilletSection> {
+    let s = FilletSection::solve(hub, blade, side, u, radius)?;
+    // The ball must touch the hub surface, not roll over an end of its contour (the inlet
+    // rim beside a leading edge standing at the hub's end).
+    let (t, _) = hub
+        .meridional()
+        .closest(crate::MeridionalCurve::zr_of(&s.centre));
+    let (t0, t1) = hub.meridional().domain();
+    let end = 1e-9 * (t1 - t0);
+    if t <= t0 + end || t >= t1 - end {
+        return None;
+    }
+    let (own, d_own) = blade_side_distance(blade, side, &s.centre, Some((s.u, s.v)));
+    let (other, _) = blade_side_distance(blade, side.other(), &s.centre, None);
+    let fits = own.distance.is_finite()
+        && (d_own - radius).abs() <= FIT_CHECK_MM
+        && other.distance >= radius - FIT_CHECK_MM;
+    fits.then_some(s)
+}
+
+/// The piece through `sections` (at least 4, uniform in `u`): spine and normals
+/// interpolated (cubic, uniform parameters) and their error measured at every midpoint.
+fn fit_piece(
+    hub: &RevolvedSurface,
+    blade: &Blade,
+    side: Side,
+    sections: Vec<FilletSection>,
+) -> Result<FilletPiece, ModelError> {
+    let fit_err = |e: nurbs::fit::FitError| ModelError::Geometry(format!("fillet spine: {e}"));
+    let centres: Vec<SVector<f64, 3>> = sections.iter().map(|s| s.centre).collect();
+    let normals: Vec<SVector<f64, 6>> = sections
+        .iter()
+        .map(|s| {
+            let (h, b) = (s.hub_normal, s.blade_normal);
+            SVector::<f64, 6>::from([h.x, h.y, h.z, b.x, b.y, b.z])
+        })
+        .collect();
+    let spine = interpolate_curve(&centres, 3, Parametrisation::Uniform, None).map_err(fit_err)?;
+    let normals =
+        interpolate_curve(&normals, 3, Parametrisation::Uniform, None).map_err(fit_err)?;
+    let n = sections.len();
+    let radius = sections[0].radius;
+    let mut fit_error_mm: f64 = 0.0;
+    for k in 0..n - 1 {
+        let um = 0.5 * (sections[k].u + sections[k + 1].u);
+        let t = (k as f64 + 0.5) / (n - 1) as f64;
+        match FilletSection::solve(hub, blade, side, um, radius) {
+            Some(s) => fit_error_mm = fit_error_mm.max((spine.point(t) - s.centre).norm()),
+            None => fit_error_mm = f64::INFINITY,
+        }
+    }
+    let projector = CurveProjector::new(&spine);
+    Ok(FilletPiece {
+        sections,
+        spine,
+        normals,
+        projector,
+        fit_error_mm,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::blade::BladeKind;
+    use crate::meridional::MeridionalCurve;
+    use nurbs::NurbsSurface;
+
+    /// A plane patch through `o` spanned by `eu` (u, 0..1) and `ev` (v, 0..1), bilinear.
+    fn plane(o: Vector3<f64>, eu: Vector3<f64>, ev: Vector3<f64>) -> NurbsSurface {
+        let ctrl = vec![vec![o, o + ev], vec![o + eu, o + eu + ev]];
+        NurbsSurface::new(
+            1,
+            1,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![0.0, 0.0, 1.0, 1.0],
+            ctrl,
+            None,
+        )
+        .expect("plane")
+    }
+
+    /// The flat hub z = 0 from r = 5 to r = 80 (channel side +z).
+    fn flat_hub() -> RevolvedSurface {
+        let c = NurbsCurve::<2>::new(
+            1,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![SVector::from([0.0, 5.0]), SVector::from([0.0, 80.0])],
+            None,
+        )
+        .expect("line");
+        RevolvedSurface::new(MeridionalCurve::new(c).expect("contour")).expect("hub")
+    }
+
+    /// A radial blade at φ ≈ 0 whose pressure side (y = 0 at the hub, facing −y) leans by
+    /// `lean` (rad) toward −y with height, the suction side 2 mm away in +y.
+    fn leaning_blade(lean: f64) -> Blade {
+        let up = Vector3::new(0.0, -lean.sin(), lean.cos()) * 40.0;
+        let below = Vector3::new(0.0, lean.sin(), -lean.cos()) * 5.0;
+        let eu = Vector3::new(40.0, 0.0, 0.0);
+        let pressure = plane(Vector3::new(15.0, 0.0, 0.0) + below, eu, up);
+        let suction = plane(Vector3::new(15.0, 2.0, 0.0) + below, eu, up);
+        Blade::from_sides(BladeKind::Ruled, pressure, suction, None).expect("blade")
+    }
+
+    #[test]
+    fn section_in_a_planar_corner_matches_the_closed_form() {
+        let hub = flat_hub();
+        for lean_deg in [0.0_f64, 20.0, -25.0] {
+            let lean = lean_deg.to_radians();
+            let blade = leaning_blade(lean);
+            let r = 1.5;
+            // Corner angle between the hub (+z) and the pressure side in the air (−y side):
+            // β = 90° − lean (the side leans over the air). The ball centre is on the
+            // bisector, r / sin(β/2) from the corner line (the x axis), r above the hub and r
+            // from the side: c = (x, −r·(1 + sin(lean))/cos(lean), r).
+            let beta = std::f64::consts::FRAC_PI_2 - lean;
+            let s = FilletSection::solve(&hub, &blade, Side::Pressure, 0.5, r).expect("section");
+            let cy = -r * (1.0 + lean.sin()) / lean.cos();
+            assert!((s.centre.x - 35.0).abs() < 1e-9, "{s:?}");
+            assert!(
+                (s.centre.y - cy).abs() < 1e-9,
+                "lean {lean_deg}: {s:?} vs {cy}"
+            );
+            assert!((s.centre.z - r).abs() < 1e-12, "{s:?}");
+            let corner = Vector3::new(s.centre.x, 0.0, 0.0);
+            assert!(((s.centre - corner).norm() - r / (0.5 * beta).sin()).abs() < 1e-9);
+            // Contacts on the planes, the arc's angle π − β, every arc point r from c.
+            assert!(s.hub_foot().z.abs() < 1e-12);
+            let nb = blade
+                .outward_normal(Side::Pressure, 0.5, 0.5)
+                .expect("normal");
+            assert!(
+                (s.blade_foot() - Vector3::new(35.0, 0.0, 0.0))
+                    .dot(&nb)
+                    .abs()
+                    < 1e-9
+            );
+            assert!((s.arc_angle() - (std::f64::consts::PI - beta)).abs() < 1e-12);
+            let arc = s.arc().expect("arc");
+            for k in 0..=16 {
+                let t = k as f64 / 16.0;
+                assert!(((arc.point(t) - s.centre).norm() - r).abs() < 1e-12);
+                assert!(((s.arc_point(t) - s.centre).norm() - r).abs() < 1e-12);
+            }
+            assert!((arc.point(0.0) - s.hub_foot()).norm() < 1e-12);
+            assert!((arc.point(1.0) - s.blade_foot()).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn planar_fillet_distance_is_the_rolling_balls() {
+        let hub = flat_hub();
+        let lean = 10.0_f64.to_radians();
+        let blade = leaning_blade(lean);
+        let r = 2.0;
+        let f = BladeFillet::build(&hub, &blade, Side::Pressure, r, 1e-6).expect("fillet");
+        assert_eq!(f.pieces().len(), 1);
+        assert!(f.fit_error_mm() < 1e-9, "{}", f.fit_error_mm());
+        let cy = -r * (1.0 + lean.sin()) / lean.cos();
+        // In the corner's sector of the ball: R − |p − c|, inside the ball (air) and beyond
+        // it (fillet material) alike.
+        for (dy, dz) in [(0.3, -0.4), (0.5, -1.2), (0.1, -2.5), (0.8, -0.9)] {
+            let p = Vector3::new(30.0, cy + dy, r + dz);
+            let c = Vector3::new(30.0, cy, r);
+            let want = r - (p - c).norm();
+            let got = f.signed_distance(&p).expect("in the sector");
+            assert!((got - want).abs() < 1e-9, "{p:?}: {got} vs {want}");
+        }
+        // Above the ball's centre (the side is nearer) and away from the corner: not decided.
+        assert!(f
+            .signed_distance(&Vector3::new(30.0, cy - 1.0, r + 1.0))
+            .is_none());
+        assert!(f
+            .signed_distance(&Vector3::new(30.0, cy - 5.0, 0.5))
+            .is_none());
+        // Beyond the blade's ends.
+        assert!(f.signed_distance(&Vector3::new(60.0, cy, 0.5)).is_none());
+    }
+
+    #[test]
+    fn no_section_where_the_offsets_do_not_meet() {
+        let hub = flat_hub();
+        let blade = leaning_blade(0.0);
+        // A ball taller than the side (45 mm above the hub at most) never touches the hub
+        // and the side at once.
+        assert!(FilletSection::solve(&hub, &blade, Side::Pressure, 0.5, 60.0).is_none());
+        assert!(BladeFillet::build(&hub, &blade, Side::Pressure, 0.0, 1e-4).is_err());
+    }
+}

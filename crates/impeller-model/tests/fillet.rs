@@ -1,0 +1,114 @@
+//! The blade-root fillet on the fixture impellers: every section's rolling ball is the
+//! fillet radius from the hub (exact) and from its blade side (global closest point), and
+//! the fitted spine and the arcs stay within the fit tolerance of exact sections solved
+//! anywhere (not only at the stations the fit used).
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use impeller_model::fillet::{BladeFillet, FilletSection, DEFAULT_FILLET_TOL_MM};
+use impeller_model::query::blade_side_distance;
+use impeller_model::{fixtures, Impeller, Side};
+
+fn check(imp: &Impeller, name: &str) {
+    let r = imp.fillet_radius_mm();
+    assert!(r > 0.0);
+    let hub = imp.hub();
+    let mut rows = vec![("main", imp.main().blade())];
+    if let Some(s) = imp.splitter() {
+        rows.push(("splitter", s.blade()));
+    }
+    for (row, blade) in rows {
+        for side in [Side::Pressure, Side::Suction] {
+            let f = BladeFillet::build(hub, blade, side, r, DEFAULT_FILLET_TOL_MM)
+                .unwrap_or_else(|e| panic!("{name} {row} {side:?}: {e}"));
+            let ((u0, u1), _) = blade.side(side).domain();
+            let covered: f64 = f
+                .pieces()
+                .iter()
+                .map(|p| p.u_range().1 - p.u_range().0)
+                .sum();
+            eprintln!(
+                "{name} {row} {side:?}: {} pieces, {} stations, u covered {:.4} of {:.4}, \
+                 spine error {:.2e} mm",
+                f.pieces().len(),
+                f.stations(),
+                covered,
+                u1 - u0,
+                f.fit_error_mm()
+            );
+            assert!(!f.pieces().is_empty(), "{name} {row} {side:?}: no fillet");
+            assert!(
+                f.fit_error_mm() <= DEFAULT_FILLET_TOL_MM,
+                "{name} {row} {side:?}: spine error {} mm",
+                f.fit_error_mm()
+            );
+            for piece in f.pieces() {
+                let (a, b) = piece.u_range();
+                // Stations between the fit's (a third of the way between its midpoints).
+                for k in 0..97 {
+                    let u = a + (b - a) * (k as f64 + 1.0 / 3.0) / 97.0;
+                    let s = FilletSection::solve(hub, blade, side, u, r).expect("section");
+                    assert!((hub.signed_distance(&s.centre) - r).abs() < 1e-9);
+                    let (foot, d) = blade_side_distance(blade, side, &s.centre, None);
+                    assert!((d - r).abs() < 1e-6, "{name} {row} {side:?} u {u}: {d}");
+                    assert!((foot.point - s.blade_foot()).norm() < 1e-4);
+                    let fitted = piece.section_at(u);
+                    assert!(
+                        (fitted.centre - s.centre).norm() <= DEFAULT_FILLET_TOL_MM,
+                        "{name} {row} {side:?} u {u}: spine off by {}",
+                        (fitted.centre - s.centre).norm()
+                    );
+                    for j in 0..=8 {
+                        let t = j as f64 / 8.0;
+                        let p = s.arc_point(t);
+                        assert!(((p - s.centre).norm() - r).abs() < 1e-9);
+                        // On the arc the fillet's own distance is 0 (the fitted spine's
+                        // error at most).
+                        if let Some(d) = f.signed_distance(&p).filter(|_| (4..93).contains(&k)) {
+                            assert!(
+                                d.abs() <= 2.0 * DEFAULT_FILLET_TOL_MM,
+                                "{row} {side:?} u {u} t {t} k {k}: {d} range {a} {b}"
+                            );
+                        }
+                    }
+                    // Halfway between the ball centre and the arc's middle: R/2 in the air
+                    // (away from the piece's ends, where the spine turns around a blade
+                    // edge and such a point's nearest spine point is the end).
+                    let mid = 0.5 * (s.centre + s.arc_point(0.5));
+                    if (4..93).contains(&k) {
+                        let d = f.signed_distance(&mid).expect("in the sector");
+                        assert!((d - 0.5 * r).abs() <= 2.0 * DEFAULT_FILLET_TOL_MM, "{d}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn default_impeller_fillets_roll_on_hub_and_blades() {
+    check(
+        &fixtures::default_impeller().expect("default"),
+        "impeller-8+8",
+    );
+}
+
+fn fixture(name: &str) -> Impeller {
+    let path = format!(
+        "{}/../../fixtures/{name}/impeller.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    impeller_model::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+#[test]
+fn free_form_and_narrow_fixture_fillets_roll_on_hub_and_blades() {
+    for name in [
+        "impeller-5-freeform",
+        "impeller-11+11-freeform",
+        "impeller-30-narrow",
+        "impeller-plunge-400",
+    ] {
+        check(&fixture(name), name);
+    }
+}
