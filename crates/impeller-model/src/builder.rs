@@ -17,9 +17,17 @@
 //! stay flank-millable. Free-form sides interpolate the offset grid. The impeller turns toward
 //! −θ, so the pressure side faces −θ and a positive wrap angle sweeps the blade backward.
 //!
+//! **Reach.** Every side must run through the hub and the shroud (its bottom edge below the
+//! hub, its top edge beyond the shroud), or the blade would stand apart from the hub with no
+//! corner for a fillet. A strongly twisted side, offset along the camber normal, can end
+//! short of them at a small extension (impeller-11+11-freeform's pressure sides stopped
+//! 0.17–0.22 mm above the hub at 0.06), so the extension is doubled until
+//! [`reach_shortfall`] finds nothing, up to [`MAX_SPAN_EXTENSION`]; beyond that the spec is
+//! refused, naming the side, the contour and the shortfall.
+//!
 //! Cost: a few thousand contour evaluations and three dense LU solves of size ≤ 161 per blade.
 
-use crate::blade::{Blade, BladeDesign, BladeKind, BladeSet};
+use crate::blade::{Blade, BladeDesign, BladeKind, BladeSet, Side};
 use crate::error::ModelError;
 use crate::fit::{interpolate_surface, ruled_through};
 use crate::impeller::Impeller;
@@ -37,6 +45,48 @@ use std::f64::consts::TAU;
 pub const FLOW_SAMPLES: usize = 161;
 /// Span rows of free-form surfaces.
 pub const SPAN_SAMPLES: usize = 41;
+
+/// Largest span extension the builder grows a row's extension to when a side ends short of
+/// hub or shroud ([`reach_shortfall`]).
+pub const MAX_SPAN_EXTENSION: f64 = 0.5;
+
+/// Edge samples per side in [`reach_shortfall`].
+const REACH_SAMPLES: usize = 200;
+
+/// The largest distance by which a side of `blade` stops short of the hub (its bottom edge,
+/// `v` at the domain's start) or of the shroud (its top edge), as (side, contour name,
+/// distance mm, u), or `None` when every sampled edge point lies beyond the contour
+/// ([`REACH_SAMPLES`] + 1 per edge; samples whose nearest contour point is an end of the
+/// contour are skipped: beyond the ends no side is defined). Exact meridional projections.
+pub fn reach_shortfall(
+    blade: &Blade,
+    hub: &MeridionalCurve,
+    shroud: &MeridionalCurve,
+) -> Option<(Side, &'static str, f64, f64)> {
+    let short_of = |c: &MeridionalCurve, sign: f64, m: Vector2<f64>| -> Option<f64> {
+        let (t, d, _) = c.closest_point(m);
+        let (t0, t1) = c.domain();
+        let end = 1e-9 * (t1 - t0);
+        (t > t0 + end && t < t1 - end).then_some(sign * d)
+    };
+    let mut worst: Option<(Side, &'static str, f64, f64)> = None;
+    for side in [Side::Pressure, Side::Suction] {
+        let s = blade.side(side);
+        let ((u0, u1), (v0, v1)) = s.domain();
+        for (v, contour, sign, name) in [(v0, hub, 1.0, "hub"), (v1, shroud, -1.0, "shroud")] {
+            for i in 0..=REACH_SAMPLES {
+                let u = u0 + (u1 - u0) * i as f64 / REACH_SAMPLES as f64;
+                let m = MeridionalCurve::zr_of(&s.point(u, v));
+                if let Some(d) = short_of(contour, sign, m) {
+                    if d >= 0.0 && worst.is_none_or(|w| d > w.2) {
+                        worst = Some((side, name, d, u));
+                    }
+                }
+            }
+        }
+    }
+    worst
+}
 
 /// Builds the meridional contour of a spec.
 pub fn contour(spec: &ContourSpec) -> Result<MeridionalCurve, ModelError> {
@@ -268,26 +318,56 @@ pub fn build(spec: &ImpellerSpec) -> Result<Impeller, ModelError> {
         }
         None => None,
     };
-    let (main_blade, splitter_blade) = rayon::join(
-        || build_blade(&main_design, 0.0, main_thickness, ext),
-        || {
-            splitter_job
-                .map(|(start, offset, t)| {
-                    let d = CamberDesign {
-                        hub: &hub_m,
-                        shroud: &shroud_m,
-                        kind,
-                        spans: &laws.spans,
-                        wraps: &laws.wraps_rad,
-                        theta_offset: offset,
-                    };
-                    build_blade(&d, start, t, ext)
-                })
-                .transpose()
-        },
-    );
-    let main = BladeSet::new(count, main_blade?)?;
-    let splitter = splitter_blade?
+    // The sides must run through the hub and the shroud: a twisted blade's side, offset
+    // along the camber normal, can end short of them where the extension is small; the
+    // extension is doubled (up to MAX_SPAN_EXTENSION) until every side reaches both.
+    let mut ext = ext;
+    let (main_blade, splitter_blade) = loop {
+        let (main_blade, splitter_blade) = rayon::join(
+            || build_blade(&main_design, 0.0, main_thickness.clone(), ext),
+            || {
+                splitter_job
+                    .as_ref()
+                    .map(|(start, offset, t)| {
+                        let d = CamberDesign {
+                            hub: &hub_m,
+                            shroud: &shroud_m,
+                            kind,
+                            spans: &laws.spans,
+                            wraps: &laws.wraps_rad,
+                            theta_offset: *offset,
+                        };
+                        build_blade(&d, *start, t.clone(), ext)
+                    })
+                    .transpose()
+            },
+        );
+        let (main_blade, splitter_blade) = (main_blade?, splitter_blade?);
+        let short = [
+            Some(("main", &main_blade)),
+            splitter_blade.as_ref().map(|b| ("splitter", b)),
+        ]
+        .into_iter()
+        .flatten()
+        .find_map(|(row, b)| reach_shortfall(b, &hub_m, &shroud_m).map(|s| (row, s)));
+        match short {
+            None => break (main_blade, splitter_blade),
+            Some(_) if ext < MAX_SPAN_EXTENSION => {
+                ext = (2.0 * ext).clamp(0.01, MAX_SPAN_EXTENSION);
+            }
+            Some((row, (side, edge, d, u))) => {
+                return Err(ModelError::invalid(
+                    "main.span_extension",
+                    format!(
+                        "the {row} blade's {side:?} side ends {d:.3} mm short of the {edge} at \
+                         u = {u:.3} even extended by {MAX_SPAN_EXTENSION} of the span"
+                    ),
+                ));
+            }
+        }
+    };
+    let main = BladeSet::new(count, main_blade)?;
+    let splitter = splitter_blade
         .map(|b| BladeSet::new(count, b))
         .transpose()?;
     let profile = spec.stock.validate()?;

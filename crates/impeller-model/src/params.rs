@@ -120,7 +120,9 @@ pub struct BladeSpec {
     pub leading_edge: EdgeShape,
     /// Trailing-edge shape.
     pub trailing_edge: EdgeShape,
-    /// How far blade surfaces extend beyond hub and shroud, as a fraction of the span.
+    /// How far blade surfaces extend beyond hub and shroud, as a fraction of the span: the
+    /// least extension; the builder doubles it (up to
+    /// [`crate::builder::MAX_SPAN_EXTENSION`]) while a side ends short of hub or shroud.
     #[serde(default = "default_span_extension")]
     pub span_extension: f64,
     /// Wrap angle at two (ruled) or three or more (free-form) spans, hub first.
