@@ -33,8 +33,10 @@
 //! # Distance ([`BladeFillet::signed_distance`])
 //! The fillet material near a piece is the part of the corner outside the rolling balls. For
 //! a point `p` whose nearest spine point `c(t)` (certified global curve projection) is
-//! interior and whose direction from it lies in the wedge spanned by the two contact
-//! directions `−n_h`, `−n_b` (the arc's sector), the nearest fillet point is on that arc
+//! interior, whose direction from it lies in the wedge spanned by the two contact
+//! directions `−n_h`, `−n_b` (the arc's sector) and which lies in the corner (on the air
+//! side of the walls' tangent planes at the contacts, within [`CORNER_SLACK`]`·R`: the
+//! sector goes on through hub and blade), the nearest fillet point is on that arc
 //! along `p − c(t)`, and the signed distance (positive in the air, as every design distance
 //! here) is `R − |p − c(t)|`. Elsewhere the fillet does not decide the distance (`None`):
 //! the nearest design point is on the hub or the side, or beyond the piece's ends. The
@@ -68,6 +70,12 @@ pub const DEFAULT_FILLET_TOL_MM: f64 = 1e-4;
 
 /// Largest number of stations of a blade side's fillet.
 pub const MAX_STATIONS: usize = 4097;
+
+/// How far behind a wall's tangent plane at the ball's contact a point may lie and still
+/// count as in the corner (fraction of `R`): the walls curve away from their tangent planes
+/// by about `R²/(2ρ)` across the fillet (`ρ` their radius of curvature, 0.014·R for a hub of
+/// 35 mm at R = 1 mm).
+pub const CORNER_SLACK: f64 = 0.1;
 
 /// First number of stations of a blade side's fillet (then doubled while the fit is coarser
 /// than the tolerance).
@@ -276,9 +284,9 @@ impl FilletPiece {
         }
     }
 
-    /// Signed distance of `p` to the fillet material of this piece (module docs), `None`
-    /// where the fillet does not decide it.
-    fn signed_distance(&self, p: &Vector3<f64>) -> Option<f64> {
+    /// Signed distance of `p` to the fillet material of this piece (module docs) and the
+    /// nearest point of the fillet surface, `None` where the fillet does not decide it.
+    fn closest(&self, p: &Vector3<f64>) -> Option<(f64, Vector3<f64>)> {
         let q = self.projector.closest_point(p);
         let d = p - q.point;
         let tangent = q.tangent.try_normalize(1e-12)?;
@@ -298,7 +306,17 @@ impl FilletPiece {
         let lambda = (da - ab * db) / det;
         let mu = (db - ab * da) / det;
         let slack = -1e-9 * (1.0 + d.norm());
-        (lambda >= slack && mu >= slack).then(|| self.sections[0].radius - d.norm())
+        // The corner: on the air side of both walls' tangent planes at the contacts (with
+        // CORNER_SLACK·R for the walls' curvature); the sector continues through the hub
+        // and the blade, where the fillet is not the nearest material.
+        let r = self.sections[0].radius;
+        let (hub_foot, blade_foot) = (q.point + a * r, q.point + b * r);
+        let inside = -CORNER_SLACK * r;
+        if (p - hub_foot).dot(&(-a)) < inside || (p - blade_foot).dot(&(-b)) < inside {
+            return None;
+        }
+        let dn = d.norm();
+        (lambda >= slack && mu >= slack && dn > 1e-12).then(|| (r - dn, q.point + d * (r / dn)))
     }
 }
 
@@ -397,10 +415,186 @@ impl BladeFillet {
     /// Signed distance of `p` to the fillet material (positive in the air), where the fillet
     /// decides the design's distance (module docs); `None` elsewhere.
     pub fn signed_distance(&self, p: &Vector3<f64>) -> Option<f64> {
+        self.closest(p).map(|(d, _)| d)
+    }
+
+    /// [`Self::signed_distance`] with the nearest point of the fillet surface (on the arc
+    /// through `p`'s direction from the ball centre).
+    pub fn closest(&self, p: &Vector3<f64>) -> Option<(f64, Vector3<f64>)> {
         self.pieces
             .iter()
-            .filter_map(|k| k.signed_distance(p))
-            .min_by(f64::total_cmp)
+            .filter_map(|k| k.closest(p))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    }
+
+    /// How far the fillet reaches from the blade side and how high up it (mm), the largest
+    /// over the sections: the hub contact's distance from the side's tangent plane at the
+    /// blade contact, and the blade contact's height above the hub's tangent plane at the hub
+    /// contact (`R·cot(β/2)` each in a planar corner of angle `β`).
+    pub fn extent_mm(&self) -> (f64, f64) {
+        self.pieces
+            .iter()
+            .flat_map(|k| k.sections.iter())
+            .map(|s| {
+                let (h, b) = (s.hub_foot(), s.blade_foot());
+                ((h - b).dot(&s.blade_normal), (b - h).dot(&s.hub_normal))
+            })
+            .fold((0.0, 0.0), |a, e| (a.0.max(e.0), a.1.max(e.1)))
+    }
+
+    /// Largest distance from a ball centre to its corner over the sections,
+    /// `R / sin(β/2)` (`β` the corner's angle), plus `R`: every point whose fillet distance
+    /// can be below both its hub and its side distance lies within this of the hub and of
+    /// the side (the arc's sector between the centre and the corner).
+    pub fn reach_mm(&self) -> f64 {
+        self.pieces
+            .iter()
+            .flat_map(|k| k.sections.iter())
+            .map(|s| {
+                let half = 0.5 * (std::f64::consts::PI - s.arc_angle());
+                s.radius / half.sin().max(1e-3) + s.radius
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The fillets of every blade of an impeller: each row's reference blade's pressure and
+/// suction fillets ([`BladeFillet`]) and every instance's rotation about +Z.
+///
+/// A query at `p` evaluates only the instances whose angular window holds `p`'s polar
+/// angle: the polar angles of the row's fillet spine (reference blade, unwrapped), turned by
+/// the instance's pitch, widened by `reach / r` (`reach` = [`BladeFillet::reach_mm`] + the
+/// radius, `r` the smallest spine radius): a point outside every window is farther than the
+/// reach from every fillet sector. Cost: O(blades) angle tests and two certified curve
+/// projections per instance in the window.
+#[derive(Debug, Clone)]
+pub struct ImpellerFillets {
+    radius: f64,
+    reach: f64,
+    /// Per row (main, splitter): the pressure and suction fillets, the angular window of
+    /// the reference blade's fillets (rad, unwrapped) and the row's pitch.
+    rows: Vec<([BladeFillet; 2], (f64, f64), f64)>,
+    /// Per blade in `+θ` order (main 0, splitter 0, main 1, ...): row and rotation.
+    instances: Vec<(usize, nalgebra::Rotation3<f64>)>,
+}
+
+impl ImpellerFillets {
+    /// The fillets of `impeller` (radius `Impeller::fillet_radius_mm`, spine within
+    /// `tol_mm`), or `None` for a radius of 0.
+    pub fn new(impeller: &crate::Impeller, tol_mm: f64) -> Result<Option<Self>, ModelError> {
+        let radius = impeller.fillet_radius_mm();
+        if radius <= 0.0 {
+            return Ok(None);
+        }
+        let mut sets = vec![impeller.main()];
+        sets.extend(impeller.splitter());
+        let mut rows = Vec::with_capacity(sets.len());
+        let mut reach: f64 = 0.0;
+        for set in &sets {
+            let blade = set.blade();
+            let build = |side| BladeFillet::build(impeller.hub(), blade, side, radius, tol_mm);
+            let (p, s) = rayon::join(|| build(Side::Pressure), || build(Side::Suction));
+            let pair = [p?, s?];
+            let mut phis: Vec<f64> = Vec::new();
+            let mut r_min = f64::INFINITY;
+            for f in &pair {
+                reach = reach.max(f.reach_mm());
+                for c in f.pieces().iter().flat_map(|k| k.sections().iter()) {
+                    phis.push(c.centre.y.atan2(c.centre.x));
+                    r_min = r_min.min(c.centre.x.hypot(c.centre.y));
+                }
+            }
+            // Unwrapped about the first angle (a fillet spans far less than a turn).
+            let base = phis.first().copied().unwrap_or(0.0);
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for phi in phis {
+                let d = (phi - base + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                    - std::f64::consts::PI;
+                lo = lo.min(base + d);
+                hi = hi.max(base + d);
+            }
+            let margin = (reach + radius) / r_min.max(1e-6);
+            rows.push((pair, (lo - margin, hi + margin), set.pitch_rad()));
+        }
+        let mut instances = Vec::new();
+        for k in 0..impeller.main().count() {
+            for (row, set) in sets.iter().enumerate() {
+                instances.push((row, set.rotation(k)));
+            }
+        }
+        Ok(Some(Self {
+            radius,
+            reach,
+            rows,
+            instances,
+        }))
+    }
+
+    /// Fillet radius (mm).
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// [`BladeFillet::reach_mm`] over every fillet.
+    pub fn reach_mm(&self) -> f64 {
+        self.reach
+    }
+
+    /// [`BladeFillet::extent_mm`] over every fillet: (from the side, up from the hub).
+    pub fn extent_mm(&self) -> (f64, f64) {
+        self.rows
+            .iter()
+            .flat_map(|r| r.0.iter())
+            .map(BladeFillet::extent_mm)
+            .fold((0.0, 0.0), |a, e| (a.0.max(e.0), a.1.max(e.1)))
+    }
+
+    /// Blades in `+θ` order.
+    pub fn instance_count(&self) -> usize {
+        self.instances.len()
+    }
+
+    /// Row (0 main, 1 splitter) and rotation of blade instance `i`.
+    pub fn instance(&self, i: usize) -> Option<(usize, &nalgebra::Rotation3<f64>)> {
+        self.instances.get(i).map(|(row, rot)| (*row, rot))
+    }
+
+    /// The fillet of `side` of row `row`'s reference blade.
+    pub fn fillet(&self, row: usize, side: Side) -> Option<&BladeFillet> {
+        let k = match side {
+            Side::Pressure => 0,
+            Side::Suction => 1,
+        };
+        self.rows.get(row).map(|r| &r.0[k])
+    }
+
+    /// The fillet distance of `p` and the fillet surface point deciding it (the smallest
+    /// over the instances whose window holds `p`), `None` where no fillet decides
+    /// ([`BladeFillet::closest`]).
+    pub fn closest(&self, p: &Vector3<f64>) -> Option<(f64, Vector3<f64>)> {
+        let phi = p.y.atan2(p.x);
+        let mut best: Option<(f64, Vector3<f64>)> = None;
+        for (row, rot) in &self.instances {
+            let (pair, (lo, hi), _) = &self.rows[*row];
+            // p's angle in the reference blade's frame, unwrapped into the window.
+            let a = phi - rot.angle() * rot.axis().map_or(1.0, |ax| ax.z.signum());
+            let mid = 0.5 * (lo + hi);
+            let a = mid
+                + ((a - mid + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                    - std::f64::consts::PI);
+            if a < *lo || a > *hi {
+                continue;
+            }
+            let q = rot.inverse() * p;
+            for f in pair {
+                if let Some((d, foot)) = f.closest(&q) {
+                    if best.is_none_or(|b| d < b.0) {
+                        best = Some((d, rot * foot));
+                    }
+                }
+            }
+        }
+        best
     }
 }
 
@@ -576,14 +770,18 @@ mod tests {
         let cy = -r * (1.0 + lean.sin()) / lean.cos();
         // In the corner's sector of the ball: R − |p − c|, inside the ball (air) and beyond
         // it (fillet material) alike.
-        for (dy, dz) in [(0.3, -0.4), (0.5, -1.2), (0.1, -2.5), (0.8, -0.9)] {
+        for (dy, dz) in [(0.3, -0.4), (0.5, -1.2), (0.4, -1.6), (0.8, -0.9)] {
             let p = Vector3::new(30.0, cy + dy, r + dz);
             let c = Vector3::new(30.0, cy, r);
             let want = r - (p - c).norm();
             let got = f.signed_distance(&p).expect("in the sector");
             assert!((got - want).abs() < 1e-9, "{p:?}: {got} vs {want}");
         }
-        // Above the ball's centre (the side is nearer) and away from the corner: not decided.
+        // Under the hub (the sector goes on through it), above the ball's centre (the side
+        // is nearer) and away from the corner: not decided.
+        assert!(f
+            .signed_distance(&Vector3::new(30.0, cy + 0.1, -0.5))
+            .is_none());
         assert!(f
             .signed_distance(&Vector3::new(30.0, cy - 1.0, r + 1.0))
             .is_none());

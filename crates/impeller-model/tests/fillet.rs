@@ -112,3 +112,37 @@ fn free_form_and_narrow_fixture_fillets_roll_on_hub_and_blades() {
         check(&fixture(name), name);
     }
 }
+
+/// Every blade of the impeller carries its row's fillet: a point in the corner of main blade
+/// k and of splitter k reads, through `ImpellerFillets`, the distance its reference blade's
+/// fillet gives to the point turned back by the blade's pitch angle; a point mid-channel
+/// reads none.
+#[test]
+fn every_blade_instance_carries_its_rows_fillet() {
+    use impeller_model::fillet::ImpellerFillets;
+    let imp = fixtures::default_impeller().unwrap();
+    let all = ImpellerFillets::new(&imp, DEFAULT_FILLET_TOL_MM)
+        .unwrap()
+        .unwrap();
+    assert_eq!(all.instance_count(), 16);
+    for (row, set) in [(0, imp.main()), (1, imp.splitter().unwrap())] {
+        let reference = all.fillet(row, Side::Suction).unwrap();
+        let s = FilletSection::solve(imp.hub(), set.blade(), Side::Suction, 0.5, 1.0).unwrap();
+        // 0.2 mm inside the fillet on the corner's bisector.
+        let into = -(s.hub_normal + s.blade_normal).normalize();
+        let p = s.centre + into * 1.2;
+        let want = reference.signed_distance(&p).unwrap();
+        assert!((want + 0.2).abs() < 1e-3, "{want}");
+        for k in 0..set.count() {
+            let q = set.rotation(k) * p;
+            let (got, foot) = all.closest(&q).unwrap();
+            assert!(
+                (got - want).abs() < 1e-9,
+                "row {row} blade {k}: {got} vs {want}"
+            );
+            assert!(((foot - q).norm() - 0.2).abs() < 1e-3);
+        }
+    }
+    let mid = imp.hub().point(0.5, 0.15) + imp.hub().normal(0.5, 0.15) * 0.4;
+    assert!(all.closest(&mid).is_none());
+}

@@ -15,10 +15,16 @@
 //! the wedge of the two sides' tangent planes and the edge face between them
 //! (`impeller_model::query::blunt_edge_distance`): behind a face whose sides splay apart both
 //! side signs are negative, and the sign rule alone would put such points inside the blade.
+//!
+//! With a fillet radius `R > 0` the blade-root fillets are part of the design
+//! ([`crate::fillet_design`]): outside the sharp material the distance is also at most the
+//! fillets' `R − |p − c|`, the fillet surfaces have their own map grids
+//! (`<blade>_fillet_<side>`), and hub and side samples under a fillet are left out.
 
 use crate::design::{DesignModel, SurfaceGrid, TriangleMesh};
 use crate::design_memo::{self, Visit};
 use crate::error::SimError;
+use crate::fillet_design::DesignFillets;
 use crate::stock_shape::RevolvedStock;
 use cam_core::{Point3, Vector3};
 use impeller_model::query::{blunt_edge_distance, closest_point, side_u_edge, SurfacePoint};
@@ -84,6 +90,8 @@ pub struct ImpellerDesign {
     far_mm: f64,
     hub_sd: ContourDistance,
     shroud_sd: ContourDistance,
+    /// The blade-root fillets (`None` for a fillet radius of 0), [`crate::fillet_design`].
+    fillets: Option<DesignFillets>,
     /// Identity in the per-thread memo of recent distance evaluations
     /// ([`crate::design_memo`]); a clone is the same design and keeps it.
     id: u64,
@@ -184,6 +192,7 @@ impl ImpellerDesign {
             }
         }
         let far_mm = 0.5 * t_max + 2.0 * chord + 0.05;
+        let fillets = DesignFillets::new(impeller)?;
         let m = impeller.hub().meridional();
         let (t0, t1) = m.domain();
         let (a, b) = (m.point(t0), m.point(t1));
@@ -199,6 +208,7 @@ impl ImpellerDesign {
             sides_mesh,
             tri_info,
             sampling,
+            fillets,
             id: crate::design_memo::next_design_id(),
         })
     }
@@ -316,14 +326,33 @@ impl ImpellerDesign {
         (proj.point, tri, (proj.point - q).length())
     }
 
+    /// The fillets' distance and surface point at `p` where they decide the design distance
+    /// (`hub`, `blade`: the sharp distances at `p`), [`crate::fillet_design`].
+    fn fillet_foot(&self, p: &Point3, hub: f64, blade: f64) -> Option<(f64, Point3)> {
+        let f = self.fillets.as_ref()?;
+        if hub < 0.0 || blade < 0.0 || hub > f.reach_mm() || blade > f.reach_mm() {
+            return None;
+        }
+        f.closest(p, hub, blade)
+    }
+
+    /// Whether a hub or blade-side sample lies under a fillet (its surface there is the
+    /// fillet's).
+    fn under_fillet(&self, p: &Point3) -> bool {
+        self.fillets.as_ref().is_some_and(|f| f.covers(p))
+    }
+
     /// The verifier's design distance with the point that decides it: the minimum of
-    /// [`Self::hub_signed_distance`] and [`Self::blade_signed_distance`] (see the module
-    /// docs).
+    /// [`Self::hub_signed_distance`], [`Self::blade_signed_distance`] and, outside the sharp
+    /// material, the fillets' (see the module docs).
     fn design_foot(&self, p: &Point3) -> (f64, Point3) {
         let h = self.hub_foot(p);
         let b = self.blade_foot(p);
         let (d, foot) = if h.0 <= b.0 { h } else { b };
-        (d, foot.resolve(p))
+        match self.fillet_foot(p, h.0, b.0) {
+            Some((df, ff)) if df < d => (df, ff),
+            _ => (d, foot.resolve(p)),
+        }
     }
 
     fn blade_grid(&self, name: &str, blade: &Blade, side: Side) -> SurfaceGrid {
@@ -347,7 +376,8 @@ impl ImpellerDesign {
                     .unwrap_or_else(Vector3::zeros);
                 // Keep samples on the real blade: above the hub, below the shroud.
                 let keep = self.hub_signed_distance(&Point3::from(p)) > 0.0
-                    && self.impeller.shroud().signed_distance(&p) < 0.0;
+                    && self.impeller.shroud().signed_distance(&p) < 0.0
+                    && !self.under_fillet(&Point3::from(p));
                 g.points.push(Point3::from(p));
                 g.normals.push(if keep { n } else { Vector3::zeros() });
             }
@@ -371,7 +401,7 @@ impl ImpellerDesign {
             for i in 0..np {
                 let phi = std::f64::consts::TAU * i as f64 / np as f64;
                 let p = Point3::from(hub.point(t, phi));
-                let inside_blade = self.blade_signed_distance(&p) < 0.0;
+                let inside_blade = self.blade_signed_distance(&p) < 0.0 || self.under_fillet(&p);
                 g.points.push(p);
                 g.normals.push(if inside_blade {
                     Vector3::zeros()
@@ -557,8 +587,8 @@ pub fn blank_of(impeller: &Impeller) -> Result<RevolvedStock, SimError> {
 /// against that vocabulary (clearance checks, tests that compare distance functions) can take
 /// it like any other shape. Sign: negative inside the part's material (hub body and blades
 /// below the shroud contour), as [`DesignModel::signed_distance`]. The point is on the face
-/// whose distance decides the answer (hub, a blade side, the shroud contour over the blade
-/// tips; far from every blade, the foot on the blade-side mesh). The answer is never
+/// whose distance decides the answer (hub, a blade side, a blade-root fillet, the shroud
+/// contour over the blade tips; far from every blade, the foot on the blade-side mesh). The answer is never
 /// `certified`: the blade is chosen on a triangle mesh and its sides are projected by a local
 /// Newton iteration, the contours are searched from samples, and beside blade edges and far
 /// from the blades the distance is a lower bound of its magnitude (module docs), which is
@@ -570,10 +600,16 @@ pub fn blank_of(impeller: &Impeller) -> Result<RevolvedStock, SimError> {
 /// let imp = impeller_model::fixtures::default_impeller().unwrap();
 /// let design = ImpellerDesign::new(&imp, ImpellerSampling::default()).unwrap();
 /// let hub = imp.hub();
-/// let p = hub.point(0.5, 0.02) + hub.normal(0.5, 0.02) * 0.4;
+/// // Mid-channel, 0.4 mm above the hub: the hub decides.
+/// let p = hub.point(0.5, 0.15) + hub.normal(0.5, 0.15) * 0.4;
 /// let a = design.query(&p, None);
 /// assert!((a.signed_distance - 0.4).abs() < 1e-6);
 /// assert!(((p - a.point).norm() - 0.4).abs() < 1e-6 && !a.certified);
+/// // 0.4 mm above the hub beside a blade's root: the 1 mm fillet is nearer.
+/// let q = hub.point(0.5, 0.033) + hub.normal(0.5, 0.033) * 0.4;
+/// let b = design.query(&q, None);
+/// assert!(b.signed_distance < 0.35);
+/// assert!(((q - b.point).norm() - b.signed_distance.abs()).abs() < 1e-6);
 /// ```
 impl nurbs::closest::PointQuery for ImpellerDesign {
     type Hint = ();
@@ -623,7 +659,11 @@ impl DesignModel for ImpellerDesign {
         let hub = self.hub_signed_distance(p);
         let blade = self.blade_signed_distance(p);
         design_memo::note_hub(self.id, &[p.x, p.y, p.z], hub);
-        hub.min(blade)
+        let sharp = hub.min(blade);
+        match self.fillet_foot(p, hub, blade) {
+            Some((df, _)) => sharp.min(df),
+            None => sharp,
+        }
     }
 
     /// The face nearest to `entry` among the hub, the shroud contour (blade tips) and the
@@ -661,6 +701,20 @@ impl DesignModel for ImpellerDesign {
             (d, blade, side, (u, v))
         });
         let at_p = design_memo::recall(self.id, &[p.x, p.y, p.z]);
+        // Entered through a fillet (its surface nearer the entry than hub, side and tip):
+        // the depth below the fillet surface, where the fillet decides at `p`.
+        if let Some(f) = &self.fillets {
+            let near = side.map_or(f64::INFINITY, |s| s.0).min(hub).min(shroud);
+            let entry_on_fillet = near <= f.reach_mm()
+                && f.closest(entry, hub, near)
+                    .is_some_and(|(d, _)| d.abs() < near);
+            if entry_on_fillet {
+                let (hp, bp) = (self.hub_signed_distance(p), self.blade_signed_distance(p));
+                if let Some((d, _)) = f.closest(p, hp.max(0.0), bp.max(0.0)) {
+                    return -d;
+                }
+            }
+        }
         match side {
             Some((d, blade, s, hint)) if d <= hub && d <= shroud => {
                 // Near a blunt edge one side's signed distance can read a point behind
@@ -716,6 +770,14 @@ impl DesignModel for ImpellerDesign {
         out.push(self.hub_grid());
         for (name, blade) in &self.blades {
             out.push(self.tip_grid(name, blade));
+        }
+        if let Some(f) = &self.fillets {
+            let nv = self.sampling.blade_u.max(2);
+            for (i, (name, blade)) in self.blades.iter().enumerate() {
+                for side in [Side::Pressure, Side::Suction] {
+                    out.push(f.grid(name, i, blade, side, nv));
+                }
+            }
         }
         out
     }

@@ -57,6 +57,7 @@ pub mod dexel;
 pub mod endpoints;
 pub mod error;
 pub mod export;
+pub mod fillet_design;
 pub mod impeller_design;
 pub mod measure;
 pub mod merge;

@@ -270,3 +270,64 @@ fn depth_under_a_tip_edge_is_the_depth_below_the_tip() {
     );
     assert!(-d.signed_distance(&deep) < dt - 0.05);
 }
+
+/// The blade-root fillet is design: a ball smaller than the fillet (0.5 mm against 1 mm),
+/// run along the root of a pressure side touching hub and side (as a blade-root pass that
+/// ignores the fillet would), cuts into the fillet by `(R − ρ)(1/sin(β/2) − 1)` on the
+/// corner's bisector (`β` the corner angle), and the verifier reports that overcut on the
+/// fillet's map. Against a sharp corner the same cut touches nothing (the ball is tangent to
+/// both walls), so this fails when the fillet is left out of the design.
+#[test]
+fn a_ball_smaller_than_the_fillet_in_the_root_corner_gouges_the_fillet() {
+    let imp = default_impeller().unwrap();
+    let big_r = imp.fillet_radius_mm();
+    assert!((big_r - 1.0).abs() < 1e-12);
+    let sampling = ImpellerSampling {
+        blade_u: 48,
+        ..coarse()
+    };
+    let design = ImpellerDesign::new(&imp, sampling).unwrap();
+    let blade = imp.main().instance(0);
+    let side = Side::Pressure;
+    let rho = 0.5;
+    let cutter = Cutter::new("b1", CutterShape::BallEnd { radius: rho }, 3.0, 0.5, 30.0).unwrap();
+    let mut path = ToolPath::new("root", "b1");
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    let mut want: f64 = 0.0;
+    let n_cl = 40;
+    for k in 0..=n_cl {
+        let u = 0.4 + 0.2 * k as f64 / n_cl as f64;
+        let small = impeller_model::fillet::FilletSection::solve(imp.hub(), &blade, side, u, rho)
+            .expect("section");
+        let fillet =
+            impeller_model::fillet::FilletSection::solve(imp.hub(), &blade, side, u, big_r)
+                .expect("section");
+        let beta = std::f64::consts::PI - fillet.arc_angle();
+        want = want.max((big_r - rho) * (1.0 / (0.5 * beta).sin() - 1.0));
+        let axis = small.hub_normal;
+        let tip = small.centre - axis * rho;
+        for i in 0..3 {
+            lo[i] = lo[i].min(small.centre[i] - 3.0);
+            hi[i] = hi[i].max(small.centre[i] + 3.0);
+        }
+        path.moves.push(Move {
+            kind: MoveKind::Feed,
+            cl: CutterLocation::new(Point3::from(tip), axis).unwrap(),
+            feed_mm_per_min: None,
+        });
+    }
+    let blank = machining_sim::BoxStock::new(lo, hi).unwrap();
+    let h = 0.05;
+    let mut stock = TriDexel::from_shape(&blank, h).unwrap();
+    let rep = simulate(
+        &mut stock,
+        &design,
+        &[(cutter, path)],
+        &SimOptions::default(),
+    )
+    .unwrap();
+    let e = rep.max_overcut.clone().unwrap();
+    assert!(want > 0.1, "{want}");
+    assert!((e.value_mm - want).abs() < 2.0 * h, "want {want}: {e:?}");
+    assert!(e.surface.contains("fillet"), "{e:?}");
+}

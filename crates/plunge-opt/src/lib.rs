@@ -16,6 +16,9 @@
 //!   longer fits"), suction-side, pressure-side and in-between rows, stations at the plunge
 //!   step, blade allowance checked with [`cam_plan::DesignClearance`] (blades only, cutter,
 //!   shank and holder);
+//! - [`fillet_clearance`]: every posture's flat end keeps the smaller allowance from the
+//!   blade-root fillets (sampled rim and side, Lipschitz margin), which fill the corner the
+//!   hub floor and the blade clearance leave open;
 //! - [`conventional_axes`]: the axis through the hub point `Mᵢ` and the isoparametric shroud
 //!   point `Wᵢ`; the posture (depth, start, α) on any axis line;
 //! - [`feed`]: signed α, and the row segments fed toward where their axes lean;
@@ -120,6 +123,7 @@ pub mod conventional_axes;
 pub mod entries;
 pub mod feed;
 pub mod feed_plan;
+pub mod fillet_clearance;
 pub mod interference;
 pub mod operation;
 pub mod rows;

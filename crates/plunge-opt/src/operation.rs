@@ -7,6 +7,7 @@ use crate::conventional_axes::{Posture, PostureBuilder};
 use crate::entries::{pilot_radius, EntryKind, EntryMode, PilotParams};
 use crate::feed::{is_increasing, signed_alpha, Feed};
 use crate::feed_plan::{plan_feed, stroke, FeedInput, FeedPlan};
+use crate::fillet_clearance::{cutter_clears_fillets, FILLET_TOL_MM};
 use crate::interference::{
     core_travel, depth_in_stock, interfering_count, travel_of, ClearedRegion, Material, Stroke,
     INTERFERENCE_TRAVEL_TOL_MM,
@@ -21,6 +22,7 @@ use cam_plan::{
     PlanContext, PlanError, PlannedOperation, PlannedStep, Plot, PlotKind, PlotSeries, StepTool,
     Tool,
 };
+use impeller_model::fillet::ImpellerFillets;
 use rayon::prelude::*;
 use serde::Deserialize;
 
@@ -314,6 +316,20 @@ impl PlungeRoughing {
         )?;
         let required =
             ctx.process.blade_allowance_mm + 0.5 * crate::rows::FINAL_CHECK_SAMPLE_TOL_MM;
+        // The blade-root fillets fill the corner the hub floor and the blade clearance leave
+        // open; the cutter keeps the smaller of the two allowances from them
+        // (crate::fillet_clearance).
+        let fillets = ImpellerFillets::new(impeller, FILLET_TOL_MM)
+            .map_err(|e| PlanError::geometry(op, "blade-root fillets", e.to_string()))?;
+        let fillet_allowance = ctx
+            .process
+            .blade_allowance_mm
+            .min(ctx.process.hub_allowance_mm);
+        let keeps_fillets = |p: &Posture, blade_clearance: f64| {
+            fillets.as_ref().is_none_or(|f| {
+                cutter_clears_fillets(f, &p.cl, radius, blade_clearance, fillet_allowance)
+            })
+        };
         let builder = PostureBuilder::new(
             impeller,
             ctx.stock,
@@ -388,7 +404,10 @@ impl PlungeRoughing {
         // (between the row table's stations the interpolated row may approach a blade by
         // more than the search margin) is moved across the channel toward its middle by
         // bisection, to the first place that keeps the allowance.
-        let clear = |p: &Posture| blades.clearance(&p.cl).distance_mm >= required;
+        let clear = |p: &Posture| {
+            let c = blades.clearance(&p.cl).distance_mm;
+            c >= required && keeps_fillets(p, c)
+        };
         let place = |m: f64, s0: f64| -> Result<Option<(Posture, bool)>, PlanError> {
             let p = builder.conventional(&frame, m, s0)?;
             if clear(&p) {
@@ -503,7 +522,8 @@ impl PlungeRoughing {
         lap("interference_before");
         // The plan: segments fed by lean, entries, pilots, walked axes.
         let admissible = |p: &Posture| {
-            blades.clearance(&p.cl).distance_mm >= required && stock_check.plunge_clear(p)
+            let c = blades.clearance(&p.cl).distance_mm;
+            c >= required && keeps_fillets(p, c) && stock_check.plunge_clear(p)
         };
         let feed = plan_feed(&FeedInput {
             rows: &conventional,
@@ -540,6 +560,19 @@ impl PlungeRoughing {
                     format!(
                         "blade clearance {c:.4} mm is below the blade allowance plus the query's \
                          sampling band, {required} mm"
+                    ),
+                ));
+            }
+            if !keeps_fillets(p, *c) {
+                return Err(PlanError::geometry(
+                    op,
+                    format!(
+                        "channel 0, plunge at meridional fraction {:.4}, row fraction {:.4}",
+                        p.m, p.s
+                    ),
+                    format!(
+                        "the cutter comes within the allowance {fillet_allowance} mm of a \
+                         blade-root fillet"
                     ),
                 ));
             }
