@@ -82,7 +82,13 @@ pub struct EndpointDepth {
 
 /// Every cut end point of `stock` lying more than [`ON_SURFACE_MM`] inside `design`, with its
 /// depth (see module docs). End points that `initial` (the blank) already had on the same ray
-/// are skipped. O(end points) design evaluations, parallel over rows.
+/// are skipped. The list runs grid by grid, row by row, ray by ray and end by end along
+/// each ray; each row asks the design about its end points slot by slot (the first end of
+/// every ray, back along the row for the second, …), so that consecutive questions lie a
+/// cell apart on one face and reuse what the design computed there ([`crate::design_memo`]:
+/// the answers are those of any order). On the default job at 0.1 mm (2.46 M end points
+/// evaluated, 356 k inside) the end-point depths took 11.1 → 10.3 s of CPU.
+/// O(end points) design evaluations, parallel over rows.
 pub fn endpoint_depths(
     stock: &TriDexel,
     initial: &TriDexel,
@@ -97,7 +103,8 @@ pub fn endpoint_depths(
         let found: Vec<EndpointDepth> = (0..nv)
             .into_par_iter()
             .flat_map_iter(|j| {
-                let mut row = Vec::new();
+                // The row's cut end points as (slot, i, segment, end): slot 2·segment + end.
+                let mut ends: Vec<(u32, u32, u32, u8)> = Vec::new();
                 for i in 0..nu {
                     let segs = g.ray(i, j).as_slice();
                     if segs.is_empty() {
@@ -107,52 +114,87 @@ pub fn endpoint_depths(
                     if segs == before {
                         continue;
                     }
-                    let (u, v) = g.ray_uv(i, j);
                     for (si, s) in segs.iter().enumerate() {
-                        for e in *s {
-                            if before.iter().any(|b| b[0] == e || b[1] == e) {
-                                continue;
-                            }
-                            let mut p = [0.0; 3];
-                            p[ua] = u;
-                            p[va] = v;
-                            p[d] = f64::from(e);
-                            let pt = Point3::new(p[0], p[1], p[2]);
-                            let sd = design.signed_distance(&pt);
-                            if sd < -ON_SURFACE_MM {
-                                // The removed side: below a segment's start, above its end.
-                                // The walk stays in the removed gap next to `e`.
-                                let (dir, gap) = if e == s[0] {
-                                    let prev = si.checked_sub(1).map(|k| segs[k][1]);
-                                    (-1.0, prev.map_or(f64::INFINITY, |x| f64::from(e - x)))
-                                } else {
-                                    let next = segs.get(si + 1).map(|n| n[0]);
-                                    (1.0, next.map_or(f64::INFINITY, |x| f64::from(x - e)))
-                                };
-                                let depth = match entry_point(design, &pt, d, dir, gap, sd) {
-                                    // The face's depth is its distance from `pt`, at most
-                                    // the way back to the entry (within ENTRY_TOL_MM of it).
-                                    Some(x) => (-sd).max(
-                                        design
-                                            .depth_below(&pt, &x)
-                                            .min((pt - x).norm() + ENTRY_TOL_MM),
-                                    ),
-                                    None => -sd,
-                                };
-                                row.push(EndpointDepth {
-                                    point: p,
-                                    depth_mm: depth,
-                                });
+                        for (k, e) in s.iter().enumerate() {
+                            if !before.iter().any(|b| b[0] == *e || b[1] == *e) {
+                                // Rows and segments number far fewer than 2³¹.
+                                ends.push(((2 * si + k) as u32, i as u32, si as u32, k as u8));
                             }
                         }
                     }
                 }
-                row
+                // Visit slot by slot, back and forth along the row, so that consecutive
+                // questions lie a cell apart on one face (`design_memo`'s bounded search).
+                ends.sort_unstable_by_key(|&(slot, i, _, _)| {
+                    (slot, if slot % 2 == 0 { i } else { u32::MAX - i })
+                });
+                let mut row: Vec<((u32, u32), EndpointDepth)> = Vec::new();
+                for &(slot, i, si, k) in &ends {
+                    let (i, si, k) = (i as usize, si as usize, k as usize);
+                    let segs = g.ray(i, j).as_slice();
+                    let (u, v) = g.ray_uv(i, j);
+                    let mut p = [0.0; 3];
+                    p[ua] = u;
+                    p[va] = v;
+                    p[d] = f64::from(segs[si][k]);
+                    if let Some(depth) = end_depth(design, segs, si, k, &p, d) {
+                        row.push((
+                            (i as u32, slot),
+                            EndpointDepth {
+                                point: p,
+                                depth_mm: depth,
+                            },
+                        ));
+                    }
+                }
+                // Ray by ray, end by end, as the rows are read.
+                row.sort_unstable_by_key(|r| r.0);
+                row.into_iter().map(|r| r.1)
             })
             .collect();
         out.extend(found);
     }
     out
+}
+
+/// The depth inside `design` of the cut end point `p`, end `k` (0: start, 1: end) of the
+/// material interval `si` of the ray `segs` along coordinate `d`, or `None` when it lies
+/// less than [`ON_SURFACE_MM`] inside (see module docs): `−sd`, or the depth below the face
+/// the walk toward the removed side enters through, when it finds one.
+fn end_depth(
+    design: &dyn DesignModel,
+    segs: &[[f32; 2]],
+    si: usize,
+    k: usize,
+    p: &[f64; 3],
+    d: usize,
+) -> Option<f64> {
+    let pt = Point3::new(p[0], p[1], p[2]);
+    let sd = design.signed_distance(&pt);
+    if sd >= -ON_SURFACE_MM {
+        return None;
+    }
+    let s = segs[si];
+    let e = s[k];
+    // The removed side: below a segment's start, above its end. The walk stays in the
+    // removed gap next to `e`.
+    let (dir, gap) = if e == s[0] {
+        let prev = si.checked_sub(1).map(|k| segs[k][1]);
+        (-1.0, prev.map_or(f64::INFINITY, |x| f64::from(e - x)))
+    } else {
+        let next = segs.get(si + 1).map(|n| n[0]);
+        (1.0, next.map_or(f64::INFINITY, |x| f64::from(x - e)))
+    };
+    Some(match entry_point(design, &pt, d, dir, gap, sd) {
+        // The face's depth is its distance from `pt`, at most the way back to the entry
+        // (within ENTRY_TOL_MM of it).
+        Some(x) => (-sd).max(
+            design
+                .depth_below(&pt, &x)
+                .min((pt - x).norm() + ENTRY_TOL_MM),
+        ),
+        None => -sd,
+    })
 }
 
 /// Where the ray through `p` along coordinate `d` in direction `dir` (±1) leaves the design
@@ -306,4 +348,110 @@ pub(crate) fn pool_deepest(points: &[EndpointDepth]) -> Vec<EndpointDepth> {
     let mut v: Vec<EndpointDepth> = m.into_values().collect();
     v.sort_by(|a, b| b.depth_mm.total_cmp(&a.depth_mm));
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::{SurfaceGrid, TriangleMesh};
+    use crate::impeller_design::{ImpellerDesign, ImpellerSampling};
+    use crate::simulate::{cut, SimOptions};
+    use crate::stock_shape::BoxStock;
+    use cam_core::{CutterLocation, Move, MoveKind, ToolPath};
+    use impeller_model::Side;
+
+    /// The impeller design with the per-thread memo forgotten before every question: the
+    /// answers of a design that has seen nothing before.
+    struct Forgetful<'a>(&'a ImpellerDesign);
+
+    impl DesignModel for Forgetful<'_> {
+        fn signed_distance(&self, p: &Point3) -> f64 {
+            crate::design_memo::forget();
+            self.0.signed_distance(p)
+        }
+        fn surface_grids(&self) -> Vec<SurfaceGrid> {
+            self.0.surface_grids()
+        }
+        fn triangle_mesh(&self) -> TriangleMesh {
+            self.0.triangle_mesh()
+        }
+        fn depth_below(&self, p: &Point3, entry: &Point3) -> f64 {
+            crate::design_memo::forget();
+            self.0.depth_below(p, entry)
+        }
+    }
+
+    /// The slot-by-slot order of the questions changes no answer and no place in the list:
+    /// a ball end run 0.3 mm into a blade side of the fixture impeller, its end points read
+    /// in the plain order (grid, row, ray, end) by a design without memory, give the same
+    /// list, bit for bit.
+    #[test]
+    fn slot_order_reads_what_the_plain_order_reads() {
+        let imp = impeller_model::fixtures::default_impeller().unwrap();
+        let design = ImpellerDesign::new(&imp, ImpellerSampling::default()).unwrap();
+        let blade = imp.main().instance(0);
+        let s = blade.side(Side::Suction);
+        let ((u0, u1), (v0, v1)) = s.domain();
+        let v = v0 + 0.5 * (v1 - v0);
+        let cutter =
+            Cutter::new("b3", CutterShape::BallEnd { radius: 1.5 }, 3.0, 1.0, 30.0).unwrap();
+        let mut path = ToolPath::new("gouge", "b3");
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for k in 0..=12 {
+            let u = u0 + (0.45 + 0.1 * f64::from(k) / 12.0) * (u1 - u0);
+            let p = s.point(u, v);
+            let n = blade.outward_normal(Side::Suction, u, v).unwrap();
+            for i in 0..3 {
+                lo[i] = lo[i].min(p[i] - 2.0);
+                hi[i] = hi[i].max(p[i] + 2.0);
+            }
+            path.moves.push(Move {
+                kind: MoveKind::Feed,
+                cl: CutterLocation::new(Point3::from(p - n * 0.3), n).unwrap(),
+                feed_mm_per_min: None,
+            });
+        }
+        let blank = BoxStock::new(lo, hi).unwrap();
+        let initial = TriDexel::from_shape(&blank, 0.1).unwrap();
+        let mut stock = initial.clone();
+        let options = SimOptions {
+            check_collisions: false,
+            ..SimOptions::default()
+        };
+        cut(&mut stock, None, &[(cutter, path)], &options).unwrap();
+
+        let got = endpoint_depths(&stock, &initial, &design);
+        let plain = Forgetful(&design);
+        let mut want = Vec::new();
+        for d in 0..3 {
+            let (g, g0) = (stock.grid(d), initial.grid(d));
+            let (nu, nv) = g.size();
+            for j in 0..nv {
+                for i in 0..nu {
+                    let (segs, before) = (g.ray(i, j).as_slice(), g0.ray(i, j).as_slice());
+                    let (u, v) = g.ray_uv(i, j);
+                    for (si, s) in segs.iter().enumerate() {
+                        for (k, e) in s.iter().enumerate() {
+                            if before.iter().any(|b| b[0] == *e || b[1] == *e) {
+                                continue;
+                            }
+                            let mut p = [0.0; 3];
+                            (p[(d + 1) % 3], p[(d + 2) % 3], p[d]) = (u, v, f64::from(*e));
+                            if let Some(depth_mm) = end_depth(&plain, segs, si, k, &p, d) {
+                                want.push(EndpointDepth { point: p, depth_mm });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(want.len() > 100, "{}", want.len());
+        let deepest = want.iter().fold(0.0f64, |m, e| m.max(e.depth_mm));
+        assert!((deepest - 0.3).abs() < 0.1, "{deepest}");
+        assert_eq!(got.len(), want.len());
+        for (a, b) in got.iter().zip(&want) {
+            assert_eq!(a.point.map(f64::to_bits), b.point.map(f64::to_bits));
+            assert_eq!(a.depth_mm.to_bits(), b.depth_mm.to_bits(), "{:?}", a.point);
+        }
+    }
 }
