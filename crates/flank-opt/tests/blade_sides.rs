@@ -182,8 +182,9 @@ fn splitter_rows_are_planned() {
 
 /// On a side that is strongly curved across the span the straight flutes of a lower strip's
 /// flank pass run into the side above the strip: the whole-tool check finds it (here
-/// 0.7 mm into the allowance), and the region is point-milled; every emitted posture and
-/// motion keeps the floors.
+/// 0.107 mm below the floor; 0.7 mm before the builder grew the bowed sides' span extension
+/// until they run through hub and shroud, which re-shaped the strips), and the region is
+/// point-milled; every emitted posture and motion keeps the floors.
 #[test]
 fn flutes_reaching_the_upper_blade_are_point_milled() {
     let imp = bowed();
@@ -225,7 +226,7 @@ fn flutes_reaching_the_upper_blade_are_point_milled() {
                 (worst > 0.0).then_some((strip, worst))
             })
             .expect("a strip whose flank pass runs its flutes into the blade");
-        assert!(worst > 0.2, "the flutes reach {worst} mm below the floor");
+        assert!(worst > 0.05, "the flutes reach {worst} mm below the floor");
         // The rule point-mills it, and what it emits is clear.
         let plan = regions::plan_side(ctx, Row::Main, Side::Suction, &st).unwrap();
         let point = plan
