@@ -63,32 +63,15 @@ pub fn edge_v(
         let b = v0 + (v1 - v0) * k as f64 / n as f64;
         let fb = f(b);
         if fa <= 0.0 && fb > 0.0 {
-            // Illinois regula falsi.
-            let (mut lo, mut hi, mut flo, mut fhi) = (a, b, fa, fb);
-            let mut side_kept = 0i8;
-            for _ in 0..100 {
-                let x = (lo * fhi - hi * flo) / (fhi - flo);
-                let fx = f(x);
-                if fx.abs() < 1e-10 || (hi - lo) < 1e-15 {
-                    return Ok(x);
-                }
-                if fx <= 0.0 {
-                    lo = x;
-                    flo = fx;
-                    if side_kept == -1 {
-                        fhi *= 0.5;
-                    }
-                    side_kept = -1;
+            // Illinois regula falsi; unconverged, the middle of the bracket left.
+            let r = crate::root::illinois(|x| Some(f(x)), (a, fa), (b, fb), 1e-10, 100);
+            return Ok(r.map_or(0.5 * (a + b), |r| {
+                if r.converged {
+                    r.x
                 } else {
-                    hi = x;
-                    fhi = fx;
-                    if side_kept == 1 {
-                        flo *= 0.5;
-                    }
-                    side_kept = 1;
+                    0.5 * (r.lo + r.hi)
                 }
-            }
-            return Ok(0.5 * (lo + hi));
+            }));
         }
         a = b;
         fa = fb;

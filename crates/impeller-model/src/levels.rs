@@ -230,31 +230,8 @@ fn level_root(
             if fb == 0.0 {
                 return Some((b, pb));
             }
-            let (mut lo, mut hi, mut flo, mut fhi) = (a, b, fa, fb);
-            let mut kept = 0i8;
-            let mut x = 0.5 * (lo + hi);
-            for _ in 0..200 {
-                x = (lo * fhi - hi * flo) / (fhi - flo);
-                let (fx, _) = f(x)?;
-                if fx.abs() < ROOT_TOL_MM || (hi - lo).abs() < 1e-15 {
-                    break;
-                }
-                if (fx < 0.0) == (flo < 0.0) {
-                    lo = x;
-                    flo = fx;
-                    if kept == -1 {
-                        fhi *= 0.5;
-                    }
-                    kept = -1;
-                } else {
-                    hi = x;
-                    fhi = fx;
-                    if kept == 1 {
-                        flo *= 0.5;
-                    }
-                    kept = 1;
-                }
-            }
+            let x =
+                crate::root::illinois(|x| f(x).map(|v| v.0), (a, fa), (b, fb), ROOT_TOL_MM, 200)?.x;
             // A sign change across the end of the open contour is no crossing: accept only a
             // converged root whose meridional foot lies inside the contour.
             let (fx, px) = f(x)?;

@@ -16,6 +16,7 @@
 //! shroud), [`blade`] (sides, camber, rows), [`impeller`], [`stock`], [`channel`] (edges on
 //! hub/shroud, channels, widths), [`query`] (closest points, signed distances), [`summary`],
 //! [`ruled`] (ruled and sub-ruled approximation), [`fit`] (interpolation of sampled design),
+//! [`root`] (bracketed scalar roots, Illinois regula falsi),
 //! [`fillet`] (the rolling-ball blade-root fillet as geometry: sections, spine, distance),
 //! [`levels`] (depth levels between hub and shroud, boundaries of offset surfaces on a level).
 //!
@@ -45,6 +46,7 @@ pub mod meridional;
 pub mod params;
 pub mod query;
 pub mod revolved;
+pub mod root;
 pub mod ruled;
 pub mod stock;
 pub mod summary;

@@ -544,36 +544,38 @@ impl PlungeRoughing {
         lap("feed_plan");
         // Every final position keeps the blade allowance (cutter, shank, holder).
         let finals: Vec<&Posture> = feed.segments.iter().flat_map(|s| &s.postures).collect();
-        let clear: Vec<f64> = finals
+        // (blade clearance, fillets kept) of each, in parallel: the fillet test samples the
+        // cutter where it comes near a blade.
+        let clear: Vec<(f64, bool)> = finals
             .par_iter()
-            .map(|p| blades.clearance(&p.cl).distance_mm)
+            .map(|p| {
+                let c = blades.clearance(&p.cl).distance_mm;
+                (c, keeps_fillets(p, c))
+            })
             .collect();
         let mut min_clear = f64::INFINITY;
-        for (p, c) in finals.iter().zip(&clear) {
-            if *c < required {
+        for (p, (c, kept)) in finals.iter().zip(&clear) {
+            let why = if *c < required {
+                format!(
+                    "blade clearance {c:.4} mm is below the blade allowance plus the query's \
+                     sampling band, {required} mm"
+                )
+            } else if !kept {
+                format!(
+                    "the cutter comes within the allowance {fillet_allowance} mm of a \
+                     blade-root fillet"
+                )
+            } else {
+                String::new()
+            };
+            if !why.is_empty() {
                 return Err(PlanError::geometry(
                     op,
                     format!(
                         "channel 0, plunge at meridional fraction {:.4}, row fraction {:.4}",
                         p.m, p.s
                     ),
-                    format!(
-                        "blade clearance {c:.4} mm is below the blade allowance plus the query's \
-                         sampling band, {required} mm"
-                    ),
-                ));
-            }
-            if !keeps_fillets(p, *c) {
-                return Err(PlanError::geometry(
-                    op,
-                    format!(
-                        "channel 0, plunge at meridional fraction {:.4}, row fraction {:.4}",
-                        p.m, p.s
-                    ),
-                    format!(
-                        "the cutter comes within the allowance {fillet_allowance} mm of a \
-                         blade-root fillet"
-                    ),
+                    why,
                 ));
             }
             min_clear = min_clear.min(*c);
