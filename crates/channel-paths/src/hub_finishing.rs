@@ -23,7 +23,12 @@
 //! blade-root finishing (paper 003 processes 8 → 10). Arcs are found by 120 samples of the
 //! distance across the channel and bisection of each sign change (50 steps). Stations with
 //! the same number of arcs form a *region*; each arc of a region is a *lane* (upstream of the
-//! splitter one lane, beside it two).
+//! splitter one lane, beside it two). Where the count changes between two stations, the
+//! station where it changes is found by bisection and the region with fewer arcs is extended
+//! to it; the gap left between it and the first station of the region with more arcs (beside
+//! the splitter nose) is crossed by *cross lines* along the free arcs at constant `t`, at
+//! most one step-over apart ([`runs`], [`cross_stations`]), so the whole hub between the
+//! stations is cut.
 //!
 //! # Flow lines and step-over
 //! In a lane with arcs `[φ_L(t), φ_R(t)]` the flow lines are `φ_f(t) = φ_L + f·(φ_R − φ_L)` at
@@ -33,8 +38,9 @@
 //! [`cam_core::ball_step_over`] of the circle–circle scallop), capped by the process'
 //! `width_of_cut_mm`. Between stations a line is subdivided in `(t, φ)` until the chord of the
 //! centres is within `tol/4` of the exact centre at the parameter midpoint (at most 2⁶ pieces).
-//! Lines are machined zig-zag; the step between line ends is a feed move when the certified
-//! motion check below passes, else a link over the safety surface.
+//! Lines are machined zig-zag (the cross lines after the flow lines); the step between line
+//! ends is a feed move when the certified motion check below passes, else a link over the
+//! safety surface.
 //!
 //! # Tool axis and accessibility
 //! The first axis at `(t, φ)` interpolates, at the point's angular fraction between the two
@@ -63,7 +69,8 @@
 //! `axis_smoothing_*` metrics; a plot of the run with the most direction changes).
 //!
 //! # Measured, not assumed
-//! `max_scallop_mm`: on a grid of every lane (40 stations × 4 samples between adjacent lines;
+//! `max_scallop_mm`: on a grid of every lane (40 stations × 4 samples between adjacent lines; the
+//! gaps crossed by cross lines are not on it: a test measures them independently;
 //! samples where a ball kept `ρ_b` from the blades cannot touch the hub are left out: that
 //! strip is blade-root finishing's) the residual height along the hub normal above each hub
 //! point, exact per ball (ray–sphere
@@ -291,6 +298,22 @@ struct LineResult {
     split_causes: [usize; 3],
     /// The axis smoothing of the line's runs.
     smoothing: cam_plan::SmoothingSummary,
+}
+
+impl LineResult {
+    /// Adds another line's counts and extremes to these (the axis smoothing summary apart).
+    fn absorb(&mut self, res: &LineResult) {
+        self.skipped += res.skipped;
+        self.split += res.split;
+        self.steps += res.steps;
+        self.max_rotation = self.max_rotation.max(res.max_rotation);
+        self.min_blade_clearance = self.min_blade_clearance.min(res.min_blade_clearance);
+        self.max_overcut = self.max_overcut.max(res.max_overcut);
+        self.max_offset_error = self.max_offset_error.max(res.max_offset_error);
+        for (acc, c) in self.split_causes.iter_mut().zip(res.split_causes) {
+            *acc += c;
+        }
+    }
 }
 
 /// Shared planning data of the reference channel.
@@ -534,13 +557,69 @@ impl Planner<'_> {
         self.subdivide(m, b, depth - 1, k, out);
     }
 
+    /// Appends `runs` to `path`: the step from the path's last location to a run's first is
+    /// a feed move when it is at most `near` mm long and the certified motion check passes,
+    /// else a link over the safety surface. Returns the number of steps made at feed.
+    fn join(
+        &self,
+        ctx: &PlanContext<'_>,
+        path: &mut ToolPath,
+        runs: Vec<Vec<Posture>>,
+        near: f64,
+    ) -> Result<usize, PlanError> {
+        let mut at_feed = 0;
+        for run in runs {
+            let Some(first) = run.first() else { continue };
+            match path.moves.last().copied() {
+                None => path.moves.push(Move::feed(first.cl)),
+                Some(last) => {
+                    let prev = self.posture_of(last.cl);
+                    if (last.cl.tip - first.cl.tip).norm() <= near
+                        && self.motion_clear(&prev, first)
+                    {
+                        path.moves.push(Move::feed(first.cl));
+                        at_feed += 1;
+                    } else {
+                        path.moves
+                            .extend(ctx.link(&last.cl, &first.cl, APPROACH_MM)?);
+                    }
+                }
+            }
+            path.moves
+                .extend(run.iter().skip(1).map(|p| Move::feed(p.cl)));
+        }
+        Ok(at_feed)
+    }
+
     /// Plans flow line `f` of `lane` (stations of the lane: `stations`).
     fn plan_line(&self, lane: &Lane, stations: &[Station], f: f64) -> LineResult {
+        self.plan_params(&self.line_params(lane, f), stations)
+    }
+
+    /// Plans the cross line along free arc `arc` of station `st` (constant `t`, `φ` from the
+    /// arc's left end to its right), subdivided like a flow line ([`Self::subdivide`]).
+    fn plan_cross_line(&self, st: &Station, arc: usize) -> LineResult {
+        let (a, b) = st.arcs[arc];
+        let mid = 0.5 * (a + b);
+        let mut params = vec![(st.t, a, 0, mid)];
+        self.subdivide(
+            (st.t, a, mid),
+            (st.t, b, mid),
+            MAX_SUBDIVISION,
+            0,
+            &mut params,
+        );
+        params.push((st.t, b, 0, mid));
+        self.plan_params(&params, std::slice::from_ref(st))
+    }
+
+    /// Plans the locations `params` (`(t, φ, index into stations, mid angle)`) as one line:
+    /// postures, certified motions (split where one fails), exactness figures, smoothed axes.
+    fn plan_params(&self, params: &[LineParam], stations: &[Station]) -> LineResult {
         let mut res = LineResult {
             min_blade_clearance: f64::INFINITY,
             ..LineResult::default()
         };
-        let params = self.line_params(lane, f);
         let hub = self.ctx.impeller.hub();
         let mut hint = 0.0;
         let postures: Vec<Option<(Posture, LineParam)>> = params
@@ -850,30 +929,111 @@ fn blade_extent(imp: &Impeller) -> Option<(f64, f64)> {
     (hi > lo).then_some((lo, hi))
 }
 
-/// Lanes: runs of stations with the same (non-zero) number of free arcs, one lane per arc.
-fn lanes(stations: &[Station]) -> Vec<(Lane, Vec<Station>)> {
+/// Bisection steps locating where the number of free arcs changes between two stations.
+const BOUNDARY_BISECTIONS: usize = 30;
+
+/// Runs of stations with the same non-zero number of free arcs, in `t` order, and the gaps
+/// between them, where the count changes from one non-zero count to another (at the
+/// splitter's leading edge: one arc upstream, two beside it). The station where the count
+/// changes is found by bisection of `t` between the two stations, to `2⁻³⁰` of their
+/// spacing: the last station with the smaller count ends (or starts) the run with fewer arcs,
+/// whose arcs still span the channel whole there. The *gap* is what is left: from the first
+/// station with the larger count (where the splitter nose's keep-out just divides the
+/// channel) to the nearest station of the run with more arcs, returned as that pair of
+/// stations; the plan crosses it with cross lines ([`cross_stations`]). Without the boundary
+/// stations and the cross lines, the hub between the last station of one run and the first of
+/// the next belonged to no lane and was never machined (the default job left a ring up to
+/// 0.47 mm high all around the hub just upstream of the splitters). Flow lines there instead
+/// (a short lane from the boundary to the next station) would wrap around the nose: on the
+/// AutoGrid design they cost 36 more flow lines per channel, most of them linked over the
+/// safety surface, and twice the split motions. Cost: `BOUNDARY_BISECTIONS` stations per
+/// change of count.
+#[allow(clippy::type_complexity)]
+fn runs(p: &Planner<'_>, stations: &[Station]) -> (Vec<Vec<Station>>, Vec<(Station, Station)>) {
+    let mut runs: Vec<Vec<Station>> = Vec::new();
+    for st in stations {
+        match runs.last_mut() {
+            Some(run) if run[0].arcs.len() == st.arcs.len() => run.push(st.clone()),
+            _ => runs.push(vec![st.clone()]),
+        }
+    }
+    let bounds: Vec<Option<(Station, Station)>> = runs
+        .windows(2)
+        .map(|w| boundary(p, &w[0][w[0].len() - 1], &w[1][0]))
+        .collect();
+    let mut gaps = Vec::new();
+    for (k, b) in bounds.into_iter().enumerate() {
+        let Some((lo, hi)) = b else { continue };
+        if lo.arcs.len() < hi.arcs.len() {
+            // Fewer arcs upstream: extend that run down to the boundary.
+            gaps.push((hi, runs[k + 1][0].clone()));
+            runs[k].push(lo);
+        } else {
+            let last = runs[k][runs[k].len() - 1].clone();
+            gaps.push((lo, last));
+            runs[k + 1].insert(0, hi);
+        }
+    }
+    runs.retain(|r| !r[0].arcs.is_empty());
+    (runs, gaps)
+}
+
+/// The stations of the cross lines over a gap `(g, s)` of [`runs`]: `g`, `s` and stations
+/// between them, evenly spaced in meridional arc length at most `step` apart, each with the
+/// same number of free arcs as `g` (one where the count differs is left out). Consecutive
+/// cross lines are then no farther apart than the flow lines, so the gap is left with at
+/// most the scallop the flow lines leave between them.
+fn cross_stations(p: &Planner<'_>, gap: &(Station, Station), step: f64) -> Vec<Station> {
+    let m = p.ctx.impeller.hub().meridional();
+    let (g, s) = gap;
+    let w = (m.arc_length_at(s.t) - m.arc_length_at(g.t)).abs();
+    let n = (w / step).ceil().max(1.0) as usize;
+    let mut out = vec![g.clone()];
+    out.extend((1..n).filter_map(|k| {
+        let st = station(p, g.t + (s.t - g.t) * k as f64 / n as f64)?;
+        (st.arcs.len() == g.arcs.len()).then_some(st)
+    }));
+    out.push(s.clone());
+    out
+}
+
+/// Where the number of free arcs changes between stations `a` and `b` (both with arcs, in
+/// different numbers): the last station with `a`'s count and the first with `b`'s, by
+/// bisection of `t` ([`BOUNDARY_BISECTIONS`] steps); `None` when the counts agree, either is
+/// zero, or a station between them cannot be made.
+fn boundary(p: &Planner<'_>, a: &Station, b: &Station) -> Option<(Station, Station)> {
+    let (na, nb) = (a.arcs.len(), b.arcs.len());
+    if na == 0 || nb == 0 || na == nb {
+        return None;
+    }
+    let (mut lo, mut hi) = (a.clone(), b.clone());
+    for _ in 0..BOUNDARY_BISECTIONS {
+        let mid = station(p, 0.5 * (lo.t + hi.t))?;
+        if mid.arcs.len() == na {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    // Only the counts of the two stations found may differ from their runs'.
+    (lo.t > a.t && hi.t < b.t && lo.arcs.len() == na && hi.arcs.len() == nb).then_some((lo, hi))
+}
+
+/// Lanes: one per free arc of every run of two or more stations (the runs of [`runs`]).
+fn lanes(runs: &[Vec<Station>]) -> Vec<(Lane, Vec<Station>)> {
     let mut out = Vec::new();
-    let mut k = 0;
-    while k < stations.len() {
-        let n = stations[k].arcs.len();
-        let mut e = k;
-        while e + 1 < stations.len() && stations[e + 1].arcs.len() == n {
-            e += 1;
+    for run in runs.iter().filter(|r| r.len() > 1) {
+        for a in 0..run[0].arcs.len() {
+            out.push((
+                Lane {
+                    rows: run
+                        .iter()
+                        .map(|s| (s.t, s.arcs[a].0, s.arcs[a].1))
+                        .collect(),
+                },
+                run.clone(),
+            ));
         }
-        if n > 0 && e > k {
-            for a in 0..n {
-                out.push((
-                    Lane {
-                        rows: stations[k..=e]
-                            .iter()
-                            .map(|s| (s.t, s.arcs[a].0, s.arcs[a].1))
-                            .collect(),
-                    },
-                    stations[k..=e].to_vec(),
-                ));
-            }
-        }
-        k = e + 1;
     }
     out
 }
@@ -1047,7 +1207,8 @@ impl Operation for HubFinishing {
                 station(&planner, m.param_at_fraction(s / len))
             })
             .collect();
-        let lanes = lanes(&stations);
+        let (runs, gaps) = runs(&planner, &stations);
+        let lanes = lanes(&runs);
         if lanes.is_empty() {
             return Err(PlanError::geometry(
                 &self.name,
@@ -1112,18 +1273,7 @@ impl Operation for HubFinishing {
                 heat = lane_heat;
             }
             for (j, res) in results.into_iter().enumerate() {
-                metrics_acc.skipped += res.skipped;
-                metrics_acc.split += res.split;
-                metrics_acc.steps += res.steps;
-                metrics_acc.max_rotation = metrics_acc.max_rotation.max(res.max_rotation);
-                metrics_acc.min_blade_clearance =
-                    metrics_acc.min_blade_clearance.min(res.min_blade_clearance);
-                metrics_acc.max_overcut = metrics_acc.max_overcut.max(res.max_overcut);
-                metrics_acc.max_offset_error =
-                    metrics_acc.max_offset_error.max(res.max_offset_error);
-                for (acc, c) in metrics_acc.split_causes.iter_mut().zip(res.split_causes) {
-                    *acc += c;
-                }
+                metrics_acc.absorb(&res);
                 smoothing.merge(&res.smoothing);
                 n_lines += 1;
                 if j == 0 || j + 1 == n || j % 4 == 0 {
@@ -1148,26 +1298,34 @@ impl Operation for HubFinishing {
                         run.reverse();
                     }
                 }
-                for run in runs {
-                    let Some(first) = run.first() else { continue };
-                    match path.moves.last().copied() {
-                        None => path.moves.push(Move::feed(first.cl)),
-                        Some(last) => {
-                            let prev = planner.posture_of(last.cl);
-                            let near = (last.cl.tip - first.cl.tip).norm() <= 2.0 * step + r;
-                            if near && planner.motion_clear(&prev, first) {
-                                path.moves.push(Move::feed(first.cl));
-                                cross_links += 1;
-                            } else {
-                                path.moves
-                                    .extend(ctx.link(&last.cl, &first.cl, APPROACH_MM)?);
-                            }
-                        }
-                    }
-                    path.moves
-                        .extend(run.iter().skip(1).map(|p| Move::feed(p.cl)));
+                cross_links += planner.join(ctx, &mut path, runs, 2.0 * step + r)?;
+            }
+        }
+        // Cross lines over the gaps where the number of lanes changes ([`runs`]): per gap and
+        // free arc, the arc at each cross station in turn, zig-zag.
+        let mut crossings: Vec<(Station, usize)> = Vec::new();
+        for gap in &gaps {
+            let sts = cross_stations(&planner, gap, step);
+            for a in 0..gap.0.arcs.len() {
+                crossings.extend(sts.iter().map(|st| (st.clone(), a)));
+            }
+        }
+        let cross: Vec<LineResult> = crossings
+            .par_iter()
+            .map(|(st, a)| planner.plan_cross_line(st, *a))
+            .collect();
+        let n_cross = cross.len();
+        for (j, res) in cross.into_iter().enumerate() {
+            metrics_acc.absorb(&res);
+            smoothing.merge(&res.smoothing);
+            let mut runs = res.runs;
+            if j % 2 == 1 {
+                runs.reverse();
+                for run in &mut runs {
+                    run.reverse();
                 }
             }
+            cross_links += planner.join(ctx, &mut path, runs, 2.0 * step + r)?;
         }
         if metrics_acc.max_offset_error > 1e-6 {
             return Err(PlanError::geometry(
@@ -1191,7 +1349,7 @@ impl Operation for HubFinishing {
             .number("step_over_mm", step)
             .number("max_overcut_mm", metrics_acc.max_overcut)
             .number("min_blade_clearance_mm", metrics_acc.min_blade_clearance)
-            .count("paths", n_lines * count)
+            .count("paths", (n_lines + n_cross) * count)
             .count("lanes", lanes.len())
             .count("skipped_locations", metrics_acc.skipped * count)
             .count("split_motions", metrics_acc.split * count)
@@ -1203,7 +1361,7 @@ impl Operation for HubFinishing {
         let smoothing = smoothing.times(count);
         smoothing.add_metrics(&mut metrics);
         let mut notes = vec![format!(
-            "{} lanes, {n_lines} flow lines per channel at ≤ {step:.3} mm; ball centres kept {:.3} mm from the blades (the strip to the root is blade-root finishing's); {cross_links} line-to-line steps at feed",
+            "{} lanes, {n_lines} flow lines and {n_cross} cross lines (where the number of lanes changes) per channel at ≤ {step:.3} mm; ball centres kept {:.3} mm from the blades (the strip to the root is blade-root finishing's); {cross_links} line-to-line steps at feed",
             lanes.len(),
             planner.rho_b
         )];
