@@ -5,7 +5,8 @@
 mod import_common;
 
 use impeller_model::export::{
-    mesh_parts, stl_bytes, tessellate, tessellate_compact, write_stl, ExportError, Part,
+    mesh_fillets, mesh_parts, stl_bytes, tessellate, tessellate_compact, write_stl, ExportError,
+    Part,
 };
 use impeller_model::fixtures::default_impeller;
 use impeller_model::meridional::MeridionalCurve;
@@ -136,7 +137,12 @@ fn whole_impeller_written_atomically() {
     assert_eq!(len, 84 + 50 * stats.triangles);
     let parts = mesh_parts(
         &imp,
-        &[Part::Hub, Part::MainBlades, Part::SplitterBlades],
+        &[
+            Part::Hub,
+            Part::MainBlades,
+            Part::SplitterBlades,
+            Part::Fillets,
+        ],
         0.05,
     )
     .unwrap();
@@ -173,4 +179,72 @@ fn imported_centrifugal_exports_stl() {
         .fold(0.0, f64::max);
     // Hub trimmed 10 % beyond the 0.20 m trailing edge.
     assert!(r_max > 200.0 && r_max < 240.0, "{r_max}");
+}
+
+/// The blade-root fillets of impeller-8+8 (R = 1 mm) in the export: every vertex on the
+/// fillet (the exact arc of a fitted section: within the spine's 1e-4 mm), every triangle's
+/// centroid and edge midpoints within the chord tolerance, triangles facing the air (a point
+/// 0.01 mm along the normal from the centroid is outside the fillet material), a fillet on
+/// every blade of both rows, and in the whole-impeller export.
+#[test]
+fn fillets_are_exported_on_the_fillet_within_the_chord_tolerance() {
+    let imp = default_impeller().unwrap();
+    let tol = 0.02;
+    let mesh = mesh_fillets(&imp, tol).unwrap();
+    assert!(!mesh.triangles.is_empty());
+    let fillets = impeller_model::fillet::ImpellerFillets::new(&imp, 1e-4)
+        .unwrap()
+        .unwrap();
+    // The fillet's distance is not defined at a piece's first and last section (the
+    // projection onto the spine lands on its end): those vertices are left out, no others.
+    let dist = |q: &Vector3<f64>| fillets.closest(q).map_or(0.0, |(d, _)| d.abs());
+    let undecided = mesh
+        .vertices
+        .iter()
+        .filter(|v| fillets.closest(v).is_none())
+        .count();
+    assert!(
+        undecided * 20 < mesh.vertices.len(),
+        "{undecided} of {} vertices",
+        mesh.vertices.len()
+    );
+    let on = mesh.vertices.iter().map(dist).fold(0.0, f64::max);
+    assert!(on <= 1e-4 + 1e-9, "vertex {on} mm off the fillet");
+    let chord = largest_chord_deviation(&mesh, dist);
+    assert!(chord <= tol, "chord deviation {chord} mm > {tol} mm");
+    let mut facing_air = 0;
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+        let n = (b - a).cross(&(c - a));
+        let Some(n) = n.try_normalize(1e-15) else {
+            continue;
+        };
+        let q = (a + b + c) / 3.0 + n * 0.01;
+        if fillets.closest(&q).is_some_and(|(d, _)| d > 0.0) {
+            facing_air += 1;
+        } else {
+            panic!("triangle at {q:?} faces into the fillet material");
+        }
+    }
+    assert!(facing_air > mesh.triangles.len() / 2);
+    // Every blade of both rows carries its fillets: 16 blades with 2 sides each.
+    let n_blades = imp.main().count() + imp.splitter().map_or(0, |s| s.count());
+    assert_eq!(n_blades, 16);
+    let angles: std::collections::BTreeSet<i64> = mesh
+        .vertices
+        .iter()
+        .map(|v| (v.y.atan2(v.x).to_degrees() / 5.0).floor() as i64)
+        .collect();
+    assert!(angles.len() > 40, "{} angular bins of 72", angles.len());
+    let all = mesh_parts(&imp, &[Part::Impeller], tol).unwrap();
+    let bare = mesh_parts(
+        &imp,
+        &[Part::Hub, Part::MainBlades, Part::SplitterBlades],
+        tol,
+    )
+    .unwrap();
+    assert_eq!(
+        all.triangles.len(),
+        bare.triangles.len() + mesh.triangles.len()
+    );
 }

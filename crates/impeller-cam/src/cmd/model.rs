@@ -1,7 +1,7 @@
 //! `impeller-cam model [IMPELLER] [--json] [--fit-tol MM] [--stl FILE] [--curves DIR]`: build an impeller,
-//! print its measured summary, and optionally export it as a binary STL (hub and blades,
-//! within `--chord-tol`) and as TurboGrid curve files (`impeller.inf`, hub, shroud and
-//! profile curves, which `model` reads back).
+//! print its measured summary, and optionally export it as a binary STL (hub, blades and
+//! their blade-root fillets, within `--chord-tol`) and as TurboGrid curve files
+//! (`impeller.inf`, hub, shroud and profile curves, which `model` reads back).
 
 use crate::error::CliError;
 use impeller_model::export::{write_curves, write_stl, CurveSampling, Part};

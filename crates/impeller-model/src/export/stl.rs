@@ -12,7 +12,17 @@
 //!
 //! Blades are tessellated once per row and rotated to every copy. The file is a surface
 //! model (a triangle soup of the chosen faces, normals from the vertex order), not a closed
-//! solid: blade sides extend through hub and shroud as the model does.
+//! solid: blade sides extend through hub and shroud as the model does, and the hub and the
+//! sides run on behind the blade-root fillets.
+//!
+//! **Fillets.** Each piece of a blade-root fillet ([`crate::fillet::FilletPiece`]) is a grid
+//! of (side parameter `u`, arc fraction) points on its exact circular sections: the arc is
+//! cut into `⌈θ / (2·acos(1 − chord_tol/(2R)))⌉` equal angles (each chord then within
+//! `chord_tol/2` of its arc, `θ` the largest arc angle of the piece), and the `u` intervals
+//! (starting from the fit's stations) are halved while the fitted section at an interval's
+//! midpoint lies farther than `chord_tol/2` from the chord between its ends, at the arc's
+//! ends and middle; a cell's centre is then within about `chord_tol` of the fillet. The fillet is built to [`crate::fillet::DEFAULT_FILLET_TOL_MM`];
+//! triangles face the air (toward the rolling ball's centre).
 
 use super::atomic::write_atomic;
 use super::error::ExportError;
@@ -35,7 +45,9 @@ pub enum Part {
     MainBlades,
     /// Both sides of every splitter blade.
     SplitterBlades,
-    /// Hub and all blades: the machined part.
+    /// The blade-root fillets of every blade (none when the fillet radius is 0).
+    Fillets,
+    /// Hub, all blades and their fillets: the machined part.
     Impeller,
 }
 
@@ -254,6 +266,144 @@ pub fn mesh_parts(imp: &Impeller, parts: &[Part], chord_tol: f64) -> Result<TriM
             let rot = row.rotation(k);
             mesh.append_mapped(&p, |q| rot * q);
             mesh.append_mapped(&s, |q| rot * q);
+        }
+    }
+    if want(Part::Fillets) {
+        mesh.append_mapped(&mesh_fillets(imp, chord_tol)?, |p| *p);
+    }
+    Ok(mesh)
+}
+
+/// Triangulates the blade-root fillets of every blade within `chord_tol` mm (module docs);
+/// empty when the impeller has no fillet radius.
+pub fn mesh_fillets(imp: &Impeller, chord_tol: f64) -> Result<TriMesh, ExportError> {
+    check_tol(chord_tol)?;
+    let fillets = crate::fillet::ImpellerFillets::new(imp, crate::fillet::DEFAULT_FILLET_TOL_MM)
+        .map_err(|e| ExportError::Tessellation {
+            part: "blade-root fillet".into(),
+            reason: e.to_string(),
+        })?;
+    let mut mesh = TriMesh::default();
+    let Some(fillets) = fillets else {
+        return Ok(mesh);
+    };
+    let sides = [crate::Side::Pressure, crate::Side::Suction];
+    let rows = if imp.splitter().is_some() { 2 } else { 1 };
+    let mut per_row = Vec::with_capacity(rows);
+    for row in 0..rows {
+        let mut m = TriMesh::default();
+        for side in sides {
+            if let Some(f) = fillets.fillet(row, side) {
+                for piece in f.pieces() {
+                    m.append_mapped(&tessellate_fillet_piece(piece, chord_tol)?, |p| *p);
+                }
+            }
+        }
+        per_row.push(m);
+    }
+    for i in 0..fillets.instance_count() {
+        if let Some((row, rot)) = fillets.instance(i) {
+            if let Some(m) = per_row.get(row) {
+                mesh.append_mapped(m, |q| rot * q);
+            }
+        }
+    }
+    Ok(mesh)
+}
+
+fn check_tol(chord_tol: f64) -> Result<(), ExportError> {
+    if chord_tol.is_finite() && chord_tol > 0.0 {
+        Ok(())
+    } else {
+        Err(ExportError::Invalid {
+            field: "chord_tol_mm",
+            reason: format!("{chord_tol} is not a positive length"),
+        })
+    }
+}
+
+/// Triangulates one fillet piece within `chord_tol` mm (module docs), triangles facing the
+/// air. Cost O(n_u · n_arc) section evaluations per refinement pass.
+pub fn tessellate_fillet_piece(
+    piece: &crate::fillet::FilletPiece,
+    chord_tol: f64,
+) -> Result<TriMesh, ExportError> {
+    check_tol(chord_tol)?;
+    let secs = piece.sections();
+    let radius = secs.first().map_or(0.0, |c| c.radius);
+    let theta = secs
+        .iter()
+        .map(crate::fillet::FilletSection::arc_angle)
+        .fold(0.0, f64::max);
+    // Half the tolerance across the arc and half along it: a cell's centre then deviates
+    // by at most their sum.
+    let half = (1.0 - (0.5 * chord_tol / radius.max(1e-300)).min(1.0)).acos();
+    let n_arc = ((theta / (2.0 * half.max(1e-9))).ceil() as usize).clamp(1, MAX_INTERVALS);
+    let (u0, u1) = piece.u_range();
+    let mut us: Vec<f64> = secs.iter().map(|c| c.u).collect();
+    if us.len() < 2 {
+        us = vec![u0, u1];
+    }
+    let at = |u: f64, f: f64| piece.section_at(u).arc_point(f);
+    loop {
+        let flags: Vec<bool> = us
+            .windows(2)
+            .map(|w| {
+                let m = 0.5 * (w[0] + w[1]);
+                [0.0, 0.5, 1.0].iter().any(|&f| {
+                    (at(m, f) - 0.5 * (at(w[0], f) + at(w[1], f))).norm() > 0.5 * chord_tol
+                })
+            })
+            .collect();
+        if !flags.iter().any(|&x| x) {
+            break;
+        }
+        if us.len() > MAX_INTERVALS {
+            return Err(ExportError::Tessellation {
+                part: "blade-root fillet".into(),
+                reason: format!("more than {MAX_INTERVALS} intervals for {chord_tol} mm"),
+            });
+        }
+        let mut out = Vec::with_capacity(us.len() * 2);
+        for (k, w) in us.windows(2).enumerate() {
+            out.push(w[0]);
+            if flags[k] {
+                out.push(0.5 * (w[0] + w[1]));
+            }
+        }
+        out.extend(us.last().copied());
+        us = out;
+    }
+    let nf = n_arc + 1;
+    let mut mesh = TriMesh::default();
+    let mut centres = Vec::with_capacity(us.len());
+    for &u in &us {
+        let sec = piece.section_at(u);
+        centres.push(sec.centre);
+        for j in 0..nf {
+            mesh.vertices.push(sec.arc_point(j as f64 / n_arc as f64));
+        }
+    }
+    // Orientation: the first cell's normal toward the ball centre (the air side).
+    let flip = if us.len() > 1 {
+        let (a, b, c) = (mesh.vertices[0], mesh.vertices[nf], mesh.vertices[nf + 1]);
+        (b - a).cross(&(c - a)).dot(&(centres[0] - a)) < 0.0
+    } else {
+        false
+    };
+    for i in 0..us.len().saturating_sub(1) {
+        for j in 0..n_arc {
+            let a = (i * nf + j) as u32;
+            let b = ((i + 1) * nf + j) as u32;
+            let c = ((i + 1) * nf + j + 1) as u32;
+            let d = (i * nf + j + 1) as u32;
+            if flip {
+                mesh.triangles.push([a, c, b]);
+                mesh.triangles.push([a, d, c]);
+            } else {
+                mesh.triangles.push([a, b, c]);
+                mesh.triangles.push([a, c, d]);
+            }
         }
     }
     Ok(mesh)
