@@ -26,8 +26,9 @@
 //! and the hub and blade-side samples that the fillet covers (inside the filleted
 //! material) are left out of their maps: there the design surface is the fillet.
 //!
-//! Not in the collision mesh: a non-cutting tool part in the corner under-reads its depth
-//! by at most `R(√2 − 1)` for a right-angled corner.
+//! In the collision mesh: every fillet triangulated within [`FILLET_MESH_CHORD_MM`]
+//! ([`impeller_model::export::fillets_mesh`], triangles facing the air), so a non-cutting
+//! tool part in the corner meets the fillet as it meets hub and blades.
 //!
 //! Stated error: the spine fit's (≤ [`FILLET_TOL_MM`] where [`MAX_STATIONS`] allow; the
 //! build reports what it reached), on top of the sharp design's. Where a side's fillet has
@@ -45,6 +46,9 @@ use impeller_model::{Blade, Impeller, Side};
 /// Largest spine error of the verifier's fillets (mm).
 pub const FILLET_TOL_MM: f64 = 1e-4;
 
+/// Chord tolerance of the fillets' triangles in the collision mesh (mm).
+pub const FILLET_MESH_CHORD_MM: f64 = 0.02;
+
 /// Arc samples across a fillet in its surface grid.
 const ARC_SAMPLES: usize = 4;
 
@@ -52,15 +56,37 @@ const ARC_SAMPLES: usize = 4;
 #[derive(Debug, Clone)]
 pub struct DesignFillets {
     fillets: ImpellerFillets,
+    /// Every blade's fillet triangulated within [`FILLET_MESH_CHORD_MM`], facing the air
+    /// (for the collision mesh).
+    mesh: impeller_model::export::TriMesh,
 }
 
 impl DesignFillets {
     /// The fillets of `impeller`'s rows, or `None` when its fillet radius is 0. Instances in
     /// the order of `Impeller::blades_in_order`.
     pub fn new(impeller: &Impeller) -> Result<Option<Self>, SimError> {
-        Ok(ImpellerFillets::new(impeller, FILLET_TOL_MM)
+        let Some(fillets) = ImpellerFillets::new(impeller, FILLET_TOL_MM)
             .map_err(|e| SimError::Design(format!("blade-root fillet: {e}")))?
-            .map(|fillets| Self { fillets }))
+        else {
+            return Ok(None);
+        };
+        let mesh = impeller_model::export::fillets_mesh(&fillets, FILLET_MESH_CHORD_MM)
+            .map_err(|e| SimError::Design(format!("blade-root fillet mesh: {e}")))?;
+        Ok(Some(Self { fillets, mesh }))
+    }
+
+    /// Appends every blade's fillet, triangulated within [`FILLET_MESH_CHORD_MM`] and facing
+    /// the air, to a collision mesh.
+    pub fn append_mesh(&self, m: &mut crate::design::TriangleMesh) {
+        let base = m.vertices.len() as u32;
+        m.vertices
+            .extend(self.mesh.vertices.iter().map(|v| [v.x, v.y, v.z]));
+        m.triangles.extend(
+            self.mesh
+                .triangles
+                .iter()
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
     }
 
     /// Fillet radius (mm).

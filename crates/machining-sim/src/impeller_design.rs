@@ -785,7 +785,8 @@ impl DesignModel for ImpellerDesign {
     /// The collision mesh: blade sides trimmed at the shroud contour (each column of the
     /// side grid ends where the side crosses the contour, found by bisection to 1e-12 of the
     /// parameter range; the blades' span extension beyond the contour, there only to be
-    /// trimmed, is not design) and the hub as a revolved grid.
+    /// trimmed, is not design), the hub as a revolved grid, and the blade-root fillets
+    /// ([`DesignFillets::append_mesh`]).
     fn triangle_mesh(&self) -> TriangleMesh {
         let mut m = TriangleMesh {
             vertices: Vec::new(),
@@ -846,6 +847,9 @@ impl DesignModel for ImpellerDesign {
             }
         }
         grid_tris(np, nt, base, &mut m.triangles);
+        if let Some(f) = &self.fillets {
+            f.append_mesh(&mut m);
+        }
         m
     }
 }
@@ -853,6 +857,69 @@ impl DesignModel for ImpellerDesign {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The blade-root fillets are in the collision mesh: the middle of every fillet arc
+    /// (sections of the main and splitter fillets, both sides, rotated to blade instances)
+    /// lies within the fillet mesh's chord tolerance of the mesh, where the sharp hub and
+    /// side meshes alone leave it about `R(1 − sin(β/2))`-ish away (0.2-0.3 mm for R = 1).
+    #[test]
+    fn fillets_are_in_the_collision_mesh() {
+        use parry3d_f64::query::PointQuery;
+        let imp = impeller_model::fixtures::default_impeller().unwrap();
+        let design = ImpellerDesign::new(&imp, ImpellerSampling::default()).unwrap();
+        let to_parry = |m: &TriangleMesh| {
+            let v = m
+                .vertices
+                .iter()
+                .map(|p| PVec::new(p[0], p[1], p[2]))
+                .collect();
+            TriMesh::new(v, m.triangles.clone()).unwrap()
+        };
+        let with = to_parry(&design.triangle_mesh());
+        let mut sharp = design.triangle_mesh();
+        let fillet_tris = {
+            let mut only = TriangleMesh {
+                vertices: Vec::new(),
+                triangles: Vec::new(),
+            };
+            design.fillets.as_ref().unwrap().append_mesh(&mut only);
+            only.triangles.len()
+        };
+        sharp
+            .triangles
+            .truncate(sharp.triangles.len() - fillet_tris);
+        let without = to_parry(&sharp);
+        let fillets = impeller_model::fillet::ImpellerFillets::new(&imp, 1e-4)
+            .unwrap()
+            .unwrap();
+        let (mut worst_with, mut least_without, mut n) = (0.0_f64, f64::INFINITY, 0);
+        for i in 0..fillets.instance_count() {
+            let (row, rot) = fillets.instance(i).unwrap();
+            for side in [Side::Pressure, Side::Suction] {
+                let f = fillets.fillet(row, side).unwrap();
+                for piece in f.pieces() {
+                    for sec in piece.sections().iter().step_by(7) {
+                        let q = rot * sec.arc_point(0.5);
+                        let q = parry3d_f64::math::Vector::new(q.x, q.y, q.z);
+                        let pose = parry3d_f64::math::Pose::IDENTITY;
+                        worst_with = worst_with.max(with.distance_to_point(&pose, q, true));
+                        least_without =
+                            least_without.min(without.distance_to_point(&pose, q, true));
+                        n += 1;
+                    }
+                }
+            }
+        }
+        assert!(n > 200, "{n} arc midpoints");
+        assert!(
+            worst_with <= crate::fillet_design::FILLET_MESH_CHORD_MM + 1e-4,
+            "{worst_with} mm from the mesh with fillets"
+        );
+        assert!(
+            least_without > 0.1,
+            "{least_without} mm from the sharp mesh"
+        );
+    }
 
     /// The per-thread memo (`design_memo`: bounded nearest-triangle search, values recalled
     /// at the same point) changes no answer: along rows of points a cell apart beside the

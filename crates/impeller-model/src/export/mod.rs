@@ -10,6 +10,6 @@ pub use atomic::write_atomic;
 pub use curves::{write_curves, CurveFiles, CurveSampling};
 pub use error::ExportError;
 pub use stl::{
-    mesh_fillets, mesh_parts, stl_bytes, tessellate, tessellate_compact, tessellate_fillet_piece,
-    write_stl, Part, StlStats, TriMesh,
+    fillets_mesh, mesh_fillets, mesh_parts, stl_bytes, tessellate, tessellate_compact,
+    tessellate_fillet_piece, write_stl, Part, StlStats, TriMesh,
 };

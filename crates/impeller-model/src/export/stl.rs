@@ -283,24 +283,36 @@ pub fn mesh_fillets(imp: &Impeller, chord_tol: f64) -> Result<TriMesh, ExportErr
             part: "blade-root fillet".into(),
             reason: e.to_string(),
         })?;
-    let mut mesh = TriMesh::default();
-    let Some(fillets) = fillets else {
-        return Ok(mesh);
-    };
+    match fillets {
+        Some(f) => fillets_mesh(&f, chord_tol),
+        None => Ok(TriMesh::default()),
+    }
+}
+
+/// Triangulates already built fillets within `chord_tol` mm (module docs): each row's
+/// pieces once, rotated to every blade instance.
+pub fn fillets_mesh(
+    fillets: &crate::fillet::ImpellerFillets,
+    chord_tol: f64,
+) -> Result<TriMesh, ExportError> {
+    check_tol(chord_tol)?;
     let sides = [crate::Side::Pressure, crate::Side::Suction];
-    let rows = if imp.splitter().is_some() { 2 } else { 1 };
-    let mut per_row = Vec::with_capacity(rows);
-    for row in 0..rows {
+    let mut per_row = Vec::new();
+    for row in 0.. {
+        let row_fillets: Vec<_> = sides
+            .iter()
+            .filter_map(|&s| fillets.fillet(row, s))
+            .collect();
+        if row_fillets.is_empty() {
+            break;
+        }
         let mut m = TriMesh::default();
-        for side in sides {
-            if let Some(f) = fillets.fillet(row, side) {
-                for piece in f.pieces() {
-                    m.append_mapped(&tessellate_fillet_piece(piece, chord_tol)?, |p| *p);
-                }
-            }
+        for piece in row_fillets.iter().flat_map(|f| f.pieces()) {
+            m.append_mapped(&tessellate_fillet_piece(piece, chord_tol)?, |p| *p);
         }
         per_row.push(m);
     }
+    let mut mesh = TriMesh::default();
     for i in 0..fillets.instance_count() {
         if let Some((row, rot)) = fillets.instance(i) {
             if let Some(m) = per_row.get(row) {
