@@ -28,6 +28,15 @@ pub(crate) fn collocate<const D: usize>(
     n_ctrl: usize,
     rows: &[(f64, usize, SVector<f64, D>)],
 ) -> Result<Vec<SVector<f64, D>>, FitError> {
+    // Plain interpolation (values only, as many sites as control points): the banded
+    // elimination ([`super::banded`]); the dense QR where it declines.
+    if rows.len() == n_ctrl && rows.iter().all(|r| r.1 == 0) {
+        let sites: Vec<f64> = rows.iter().map(|r| r.0).collect();
+        let values: Vec<SVector<f64, D>> = rows.iter().map(|r| r.2).collect();
+        if let Some(x) = super::banded::solve_collocation(kv, &sites, &values) {
+            return Ok(x);
+        }
+    }
     let mut a = Mat::<f64>::zeros(rows.len(), n_ctrl);
     let mut b = Mat::<f64>::zeros(rows.len(), D);
     let mut row = vec![0.0; n_ctrl];
@@ -55,8 +64,10 @@ pub(crate) fn collocate<const D: usize>(
 /// [0, 1] parameter, §9.2.2, knots by eq. 9.22). A useful scale for the derivative
 /// magnitudes is the total chord length.
 ///
-/// The system is solved with column-pivoted QR; the curve passes through every point to
-/// round-off (1e-12 relative for well-spaced data). Cost O(n·p²) assembly + O(n³) dense solve.
+/// Without end derivatives the banded system is solved by elimination without pivoting
+/// (stable for this totally positive matrix, [`super::banded`]), O(n·p²); with them, or
+/// where a pivot is too small, by column-pivoted QR, O(n³). The curve passes through every
+/// point to round-off (1e-12 relative for well-spaced data).
 ///
 /// Errors: degree 0, fewer than `degree + 1` points (`degree - 1` with end derivatives, and
 /// at least two), non-finite data, coincident consecutive points (chord-based

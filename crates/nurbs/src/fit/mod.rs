@@ -14,6 +14,7 @@
 //! system is reported as [`FitError::SingularSystem`] instead of producing garbage).
 
 mod adaptive;
+mod banded;
 mod curve_approx;
 mod curve_interp;
 mod error;
