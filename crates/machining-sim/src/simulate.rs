@@ -156,8 +156,12 @@ pub struct Collision {
 pub struct SimStats {
     /// Moves simulated.
     pub moves: usize,
-    /// Cutter positions applied.
+    /// Cutter positions applied (sampled positions, including those kept as shank and
+    /// holder checks inside swept segments).
     pub positions: usize,
+    /// Swept segments cut ([`crate::segments`]).
+    #[serde(default)]
+    pub swept_segments: usize,
     /// Dexel cell size (mm).
     pub resolution_mm: f64,
     /// Sweep tolerance used (mm).
@@ -288,7 +292,9 @@ pub fn cut(
                  design_ms: &mut f64| {
         let out = apply_batch(stock, &bodies, batch, options.check_collisions, ctol);
         stats.removed_volume_mm3 += out.removed_volume;
-        stats.positions += batch.len();
+        let segments = batch.iter().filter(|p| p.role == Role::Cut).count();
+        stats.swept_segments += segments;
+        stats.positions += batch.len() - segments;
         for h in out.hits {
             let (op, mv) = meta[h.placement];
             acc.add((op, mv, h.part, CollisionTarget::Stock), h.depth, h.point);

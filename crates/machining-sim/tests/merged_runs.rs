@@ -50,7 +50,10 @@ fn run(path: ToolPath, merge: bool) -> (f64, usize) {
         .unwrap()
         .volume();
     let (dexel, out) = simulate(path, stock, merge);
-    (before - dexel.volume(), out.stats.positions)
+    (
+        before - dexel.volume(),
+        out.stats.positions + out.stats.swept_segments,
+    )
 }
 
 #[test]
@@ -148,7 +151,7 @@ fn floor_against_exact(wiggle: f64, merge: bool) -> (usize, usize) {
             checked += 1;
         }
     }
-    (checked, out.stats.positions)
+    (checked, out.stats.positions + out.stats.swept_segments)
 }
 
 #[test]
