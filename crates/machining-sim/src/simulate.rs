@@ -5,7 +5,10 @@
 //! tolerance default `h/4` for cell `h`), except that runs of feed blocks that stay within a
 //! quarter of that tolerance of one straight chord get positions spaced along the run as a
 //! whole, on the actual motion ([`crate::merge`]: the swept volume is under-read by at most
-//! the tolerance either way, never over-read);
+//! the tolerance either way, never over-read); a run (or each of its blocks) that is a
+//! pure translation within a quarter of the tolerance is cut as its exact swept solid
+//! instead, its positions kept for the shank and holder checks ([`crate::segments`]: the
+//! swept solid lies within that quarter of the true one, either way);
 //! positions are applied in batches with
 //! [`crate::removal::apply_batch`] (parallel over ray rows, exact sequential semantics, rays
 //! culled where provably untouched), and each batch's shank/holder placements are checked
