@@ -55,7 +55,7 @@ pub(crate) fn solve_collocation<const D: usize>(
         let row_k = &band[k * w..(k + 1) * w];
         let scale = row_k.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let piv = row_k[ok];
-        if !(piv.abs() > PIVOT_TOL * scale) {
+        if piv.is_nan() || piv.abs() <= PIVOT_TOL * scale {
             return None;
         }
         let pivot_row: Vec<f64> = row_k.to_vec();
