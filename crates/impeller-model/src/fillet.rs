@@ -531,6 +531,15 @@ impl ImpellerFillets {
         self.radius
     }
 
+    /// Largest spine error of any row's fillet (mm), [`BladeFillet::fit_error_mm`].
+    pub fn fit_error_mm(&self) -> f64 {
+        self.rows
+            .iter()
+            .flat_map(|r| r.0.iter())
+            .map(BladeFillet::fit_error_mm)
+            .fold(0.0, f64::max)
+    }
+
     /// [`BladeFillet::reach_mm`] over every fillet.
     pub fn reach_mm(&self) -> f64 {
         self.reach

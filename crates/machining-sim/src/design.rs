@@ -42,6 +42,12 @@ pub trait DesignModel: Sync {
     fn surface_grids(&self) -> Vec<SurfaceGrid>;
     /// Closed triangle mesh of the design boundary for collision queries.
     fn triangle_mesh(&self) -> TriangleMesh;
+    /// How far this model's surface may lie from the design it stands for (mm): a fitted
+    /// surface's stated fit error (a blade-root fillet's spine), added to the overcut error
+    /// bound ([`crate::endpoints::overcut_error_bound`]). Default 0 (exact models).
+    fn model_error_mm(&self) -> f64 {
+        0.0
+    }
     /// Whether `p` is inside the design material.
     fn contains(&self, p: &Point3) -> bool {
         self.signed_distance(p) < 0.0
@@ -271,6 +277,13 @@ impl<D: DesignModel> DesignModel for UnionDesign<D> {
             }
         }
         out
+    }
+
+    fn model_error_mm(&self) -> f64 {
+        self.parts
+            .iter()
+            .map(|p| p.model_error_mm())
+            .fold(0.0, f64::max)
     }
 
     fn triangle_mesh(&self) -> TriangleMesh {

@@ -94,6 +94,11 @@ impl DesignFillets {
         self.fillets.radius()
     }
 
+    /// Largest spine error of the fillets (mm): the design distance's stated error here.
+    pub fn fit_error_mm(&self) -> f64 {
+        self.fillets.fit_error_mm()
+    }
+
     /// Beyond this distance from the hub or from the sharp blade no fillet decides the
     /// design distance (mm).
     pub fn reach_mm(&self) -> f64 {

@@ -655,6 +655,12 @@ impl ImpellerDesign {
 }
 
 impl DesignModel for ImpellerDesign {
+    fn model_error_mm(&self) -> f64 {
+        self.fillets
+            .as_ref()
+            .map_or(0.0, DesignFillets::fit_error_mm)
+    }
+
     fn signed_distance(&self, p: &Point3) -> f64 {
         let hub = self.hub_signed_distance(p);
         let blade = self.blade_signed_distance(p);
@@ -857,6 +863,21 @@ impl DesignModel for ImpellerDesign {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The design's stated model error is its fillets' spine error (default impeller: within
+    /// the 1e-4 mm tolerance, and not zero: the spine is a fit).
+    #[test]
+    fn model_error_is_the_fillet_fit_error() {
+        let imp = impeller_model::fixtures::default_impeller().unwrap();
+        let design = ImpellerDesign::new(&imp, ImpellerSampling::default()).unwrap();
+        let fit =
+            impeller_model::fillet::ImpellerFillets::new(&imp, crate::fillet_design::FILLET_TOL_MM)
+                .unwrap()
+                .unwrap()
+                .fit_error_mm();
+        assert_eq!(design.model_error_mm(), fit);
+        assert!(fit > 0.0 && fit <= 1e-4, "{fit}");
+    }
 
     /// The blade-root fillets are in the collision mesh: the middle of every fillet arc
     /// (sections of the main and splitter fillets, both sides, rotated to blade instances)

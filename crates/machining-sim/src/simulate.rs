@@ -120,7 +120,8 @@ pub struct Metrics {
     pub collisions: usize,
     /// How much `max_overcut_mm` may under-read the true overcut (mm): ray spacing against
     /// the cutter curvature plus the sweep tolerance
-    /// ([`crate::endpoints::overcut_error_bound`]).
+    /// ([`crate::endpoints::overcut_error_bound`]) plus the design model's stated error
+    /// ([`crate::DesignModel::model_error_mm`]).
     pub overcut_error_bound_mm: f64,
 }
 
@@ -628,7 +629,7 @@ pub fn simulate(
             stats.resolution_mm,
             stats.sweep_tol_mm,
             ops.iter().map(|(c, _)| c),
-        ),
+        ) + design.model_error_mm(),
     };
     Ok(Report {
         metrics,
