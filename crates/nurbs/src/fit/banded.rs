@@ -153,6 +153,32 @@ mod tests {
         }
     }
 
+    /// The public interpolation takes the banded path from `BANDED_MIN_POINTS` points on: a
+    /// helix of 1100 points is interpolated through every point (1e-9 mm) and agrees with
+    /// the dense QR's control points (1e-9 of its size).
+    #[test]
+    fn large_interpolation_is_banded_and_exact() {
+        let n = 1100;
+        assert!(n >= crate::fit::BANDED_MIN_POINTS);
+        let points: Vec<SVector<f64, 3>> = (0..n)
+            .map(|k| {
+                let t = k as f64 * 0.03;
+                SVector::<f64, 3>::new(20.0 * t.cos(), 20.0 * t.sin(), 3.0 * t)
+            })
+            .collect();
+        let curve =
+            crate::fit::interpolate_curve(&points, 3, Parametrisation::ChordLength, None).unwrap();
+        let sites = parameters(&points, Parametrisation::ChordLength).unwrap();
+        for (u, q) in sites.iter().zip(&points) {
+            assert!((curve.point(*u) - q).amax() <= 1e-9);
+        }
+        let kv = curve.knots().clone();
+        let qr = dense(&kv, &sites, &points);
+        for (a, b) in curve.control_points().iter().zip(&qr) {
+            assert!((a - b).amax() <= 1e-9 * 100.0, "{a:?} vs {b:?}");
+        }
+    }
+
     /// Sites out of order are declined (the caller solves densely).
     #[test]
     fn unordered_sites_are_declined() {

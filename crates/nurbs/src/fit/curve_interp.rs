@@ -22,15 +22,22 @@ pub(crate) fn basis_row(kv: &KnotVector, u: f64, order: usize, row: &mut [f64]) 
     }
 }
 
+/// Smallest plain interpolation solved by the banded elimination. Below it the dense QR is
+/// kept: it costs little there, and it keeps every smaller fit bit for bit what it was (the
+/// banded solve agrees to round-off only, and round-off in the roughing's depth levels was
+/// enough to move an AutoGrid fixture's level count from 8 to 9).
+pub const BANDED_MIN_POINTS: usize = 1024;
+
 /// Solves the collocation system `Σ_i N_i^{(k_r)}(u_r) P_i = b_r` for the control points.
 pub(crate) fn collocate<const D: usize>(
     kv: &KnotVector,
     n_ctrl: usize,
     rows: &[(f64, usize, SVector<f64, D>)],
 ) -> Result<Vec<SVector<f64, D>>, FitError> {
-    // Plain interpolation (values only, as many sites as control points): the banded
-    // elimination ([`super::banded`]); the dense QR where it declines.
-    if rows.len() == n_ctrl && rows.iter().all(|r| r.1 == 0) {
+    // Plain interpolation (values only, as many sites as control points) of
+    // `BANDED_MIN_POINTS` or more: the banded elimination ([`super::banded`]); the dense QR
+    // where it declines and for smaller systems, where it costs little.
+    if rows.len() == n_ctrl && n_ctrl >= BANDED_MIN_POINTS && rows.iter().all(|r| r.1 == 0) {
         let sites: Vec<f64> = rows.iter().map(|r| r.0).collect();
         let values: Vec<SVector<f64, D>> = rows.iter().map(|r| r.2).collect();
         if let Some(x) = super::banded::solve_collocation(kv, &sites, &values) {
@@ -64,9 +71,10 @@ pub(crate) fn collocate<const D: usize>(
 /// [0, 1] parameter, §9.2.2, knots by eq. 9.22). A useful scale for the derivative
 /// magnitudes is the total chord length.
 ///
-/// Without end derivatives the banded system is solved by elimination without pivoting
-/// (stable for this totally positive matrix, [`super::banded`]), O(n·p²); with them, or
-/// where a pivot is too small, by column-pivoted QR, O(n³). The curve passes through every
+/// Without end derivatives and with [`BANDED_MIN_POINTS`] points or more the banded system
+/// is solved by elimination without pivoting (stable for this totally positive matrix,
+/// [`super::banded`]), O(n·p²); otherwise, or where a pivot is too small, by column-pivoted
+/// QR, O(n³). The curve passes through every
 /// point to round-off (1e-12 relative for well-spaced data).
 ///
 /// Errors: degree 0, fewer than `degree + 1` points (`degree - 1` with end derivatives, and

@@ -28,7 +28,7 @@ pub use adaptive::{approximate_compatible, CompatibleFit, FitMiss, DEFAULT_KINK_
 pub use curve_approx::{
     approximate_curve, approximate_curve_to_tolerance, smooth_curve, CurveFit, Energy,
 };
-pub use curve_interp::interpolate_curve;
+pub use curve_interp::{interpolate_curve, BANDED_MIN_POINTS};
 pub use error::FitError;
 pub use params::{averaged_knots, parameters, Parametrisation};
 pub use skin::skin;
