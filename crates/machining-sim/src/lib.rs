@@ -5,9 +5,7 @@
 //! (`cam_core::Cutter`), cutter locations / tool paths and a [`DesignModel`].
 //!
 //! Pipeline: [`TriDexel::from_shape`] samples the blank ([`BoxStock`], [`RevolvedStock`]);
-//! [`simulate()`] sweeps every move's cutter through the stock ([`removal`]: sampled
-//! positions, and straight pieces of pure translation as their exact swept solid,
-//! [`swept`] and [`segments`]) and checks the
+//! [`simulate()`] sweeps every move's cutter through the stock ([`removal`]) and checks the
 //! non-cutting parts against the stock in process (on the dexels, exact along each ray) and
 //! against the design mesh (parry BVH, [`collision`]); [`endpoints`] reads the overcut at
 //! the dexel segment end points (exact ray–cutter intersections: the depth of every cut end
@@ -66,11 +64,9 @@ pub mod merge;
 pub mod motion;
 mod reach;
 pub mod removal;
-pub mod segments;
 pub mod simulate;
 pub mod stock_shape;
 pub mod surface_mesh;
-pub mod swept;
 pub mod synthetic;
 pub mod tool_solid;
 mod witness;

@@ -55,22 +55,6 @@ enum PieceReach {
 pub(crate) struct Reach {
     pieces: [PieceReach; MAX_PIECES],
     n: usize,
-    /// Translation `(u, v, d)` over which the solid is swept from where its pieces are
-    /// placed (zero: one position).
-    sw: [f64; 3],
-}
-
-/// The rectangle `[a, b]` of base coordinates that a point swept by `s·w`, `s ∈ [0, 1]`,
-/// into `[a, b]` can come from: `[a − max(w, 0), b − min(w, 0)]`.
-#[inline]
-fn unsweep((a, b): (f64, f64), w: f64) -> (f64, f64) {
-    (a - w.max(0.0), b - w.min(0.0))
-}
-
-/// An interval widened by the sweep `s·w`, `s ∈ [0, 1]`.
-#[inline]
-fn sweep_out((a, b): (f64, f64), w: f64) -> (f64, f64) {
-    (a + w.min(0.0), b + w.max(0.0))
 }
 
 /// Heights of `[lo, hi]` where `α + β·h ≤ 0`; empty when `lo > hi`.
@@ -120,11 +104,7 @@ impl Reach {
         }; MAX_PIECES];
         if pieces.len() > MAX_PIECES {
             out[0] = cone(solid.h_min(), solid.h_max(), solid.r_max(), solid.r_max());
-            return Self {
-                pieces: out,
-                n: 1,
-                sw: [0.0; 3],
-            };
+            return Self { pieces: out, n: 1 };
         }
         for (o, p) in out.iter_mut().zip(pieces) {
             *o = match *p {
@@ -148,32 +128,13 @@ impl Reach {
         Self {
             pieces: out,
             n: pieces.len(),
-            sw: [0.0; 3],
         }
-    }
-
-    /// The reach of `solid` swept by pure translation from `start` (tip) to
-    /// `start + sweep` with unit `axis` ([`crate::swept`]): a point of the swept solid on
-    /// the ray `(u, v)` is a point of the solid at `start` on the ray `(u − s·w_u, v − s·w_v)`
-    /// moved by `s·w_d` along it, so every bound is taken over the rectangle widened
-    /// against the sweep and the extent widened by it.
-    pub(crate) fn swept(
-        solid: &RevolvedSolid,
-        start: &[f64; 3],
-        axis: &[f64; 3],
-        d: usize,
-        sweep: &[f64; 3],
-    ) -> Self {
-        let mut r = Self::new(solid, start, axis, d);
-        r.sw = [sweep[(d + 1) % 3], sweep[(d + 2) % 3], sweep[d]];
-        r
     }
 
     /// An interval along the rays containing every point of the solid on the rays with
     /// `u ∈ us`, `v ∈ vs`; `None` when the solid provably meets none of them.
     #[inline]
     pub(crate) fn extent(&self, us: (f64, f64), vs: (f64, f64)) -> Option<(f64, f64)> {
-        let (us, vs) = (unsweep(us, self.sw[0]), unsweep(vs, self.sw[1]));
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
         for p in &self.pieces[..self.n] {
@@ -212,7 +173,7 @@ impl Reach {
                 }
             }
         }
-        (lo <= hi).then_some(sweep_out((lo, hi), self.sw[2]))
+        (lo <= hi).then_some((lo, hi))
     }
 }
 
@@ -245,8 +206,6 @@ pub(crate) struct RowReach {
     n: usize,
     /// The interval of `u` holding every ray of the row the solid can meet.
     pub(crate) span: (f64, f64),
-    /// The sweep along `u` and `d` ([`Reach::swept`]).
-    sw: (f64, f64),
 }
 
 impl Reach {
@@ -261,11 +220,10 @@ impl Reach {
         }; MAX_PIECES];
         let mut n = 0;
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        let vs = unsweep((v, v), self.sw[1]);
         for p in &self.pieces[..self.n] {
             match *p {
                 PieceReach::Ball { c, r2 } => {
-                    let dv = outside(c[1], vs);
+                    let dv = v - c[1];
                     let q0 = r2 - dv * dv;
                     if q0 >= 0.0 {
                         let w = q0.sqrt() + CULL_SLACK_MM;
@@ -289,8 +247,8 @@ impl Reach {
                     k,
                 } => {
                     let mut hs = (h0, h1);
-                    hs = clip_linear(vs.0 - t[1] - c0 * s[1], -a[1] - k * s[1], hs);
-                    hs = clip_linear(t[1] - vs.1 - c0 * s[1], a[1] - k * s[1], hs);
+                    hs = clip_linear(v - t[1] - c0 * s[1], -a[1] - k * s[1], hs);
+                    hs = clip_linear(t[1] - v - c0 * s[1], a[1] - k * s[1], hs);
                     if hs.0 <= hs.1 {
                         for h in [hs.0, hs.1] {
                             let (x, w) = (t[0] + h * a[0], (c0 + k * h).max(0.0) * s[0]);
@@ -316,8 +274,7 @@ impl Reach {
         (n > 0 && lo <= hi).then_some(RowReach {
             pieces,
             n,
-            span: sweep_out((lo, hi), self.sw[0]),
-            sw: (self.sw[0], self.sw[2]),
+            span: (lo, hi),
         })
     }
 }
@@ -327,7 +284,6 @@ impl RowReach {
     /// row with `u ∈ us`; `None` when it meets none of them.
     #[inline]
     pub(crate) fn extent(&self, us: (f64, f64)) -> Option<(f64, f64)> {
-        let us = unsweep(us, self.sw.0);
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
         for p in &self.pieces[..self.n] {
@@ -365,7 +321,7 @@ impl RowReach {
                 }
             }
         }
-        (lo <= hi).then_some(sweep_out((lo, hi), self.sw.1))
+        (lo <= hi).then_some((lo, hi))
     }
 }
 

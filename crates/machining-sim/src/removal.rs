@@ -28,7 +28,6 @@
 use crate::cull::{AirSpan, ChunkBound, TileBounds, CHUNK, TILE};
 use crate::dexel::{GridGeometry, Segments, TriDexel};
 use crate::reach::Reach;
-use crate::swept::SweptSolid;
 use crate::tool_solid::{Piece, RayLocal, RevolvedSolid};
 use crate::witness::Witness;
 use cam_core::Cutter;
@@ -44,9 +43,6 @@ pub struct ToolBody {
     pub shank: RevolvedSolid,
     /// Holder segments.
     pub holder: RevolvedSolid,
-    /// The cutting part's swept-segment kernel; `None` for a cutter with a torus piece
-    /// (bull-nose corner), whose segments keep sampled positions.
-    pub swept: Option<SweptSolid>,
 }
 
 impl ToolBody {
@@ -61,10 +57,8 @@ impl ToolBody {
                 holder.push(*p);
             }
         }
-        let cutting = RevolvedSolid::cutting_part(cutter);
         Self {
-            swept: SweptSolid::new(&cutting),
-            cutting,
+            cutting: RevolvedSolid::cutting_part(cutter),
             shank: RevolvedSolid::new(shank),
             holder: RevolvedSolid::new(holder),
         }
@@ -83,21 +77,10 @@ pub enum PartKind {
     RapidMove,
 }
 
-/// What a placement does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Role {
-    /// Cuts with the cutting part and checks the shank and holder (a sampled position).
-    CutAndCheck,
-    /// Cuts with the cutting part only (a swept segment, see [`Placement::sweep`]).
-    Cut,
-    /// Checks the shank and holder only (a position inside a swept segment).
-    Check,
-}
-
-/// One cutter position (or swept segment) of a batch.
+/// One cutter position of a batch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Placement {
-    /// Tool tip (the segment's end for a swept placement).
+    /// Tool tip.
     pub tip: [f64; 3],
     /// Unit tool axis.
     pub axis: [f64; 3],
@@ -105,37 +88,6 @@ pub struct Placement {
     pub tool: usize,
     /// Rapid move: no cutting, any material contact is a collision.
     pub rapid: bool,
-    /// The cutting part is swept by pure translation from `tip − sweep` to `tip`
-    /// ([`crate::swept`]); zero: this position only. Only for a tool with a swept kernel.
-    pub sweep: [f64; 3],
-    /// What the placement does.
-    pub role: Role,
-}
-
-impl Placement {
-    /// A sampled position (cuts and checks; a rapid one only checks, with the whole tool).
-    pub fn at(tip: [f64; 3], axis: [f64; 3], tool: usize, rapid: bool) -> Self {
-        Self {
-            tip,
-            axis,
-            tool,
-            rapid,
-            sweep: [0.0; 3],
-            role: Role::CutAndCheck,
-        }
-    }
-
-    /// Whether the cutting part is swept over a segment.
-    #[inline]
-    pub fn is_swept(&self) -> bool {
-        self.sweep != [0.0; 3]
-    }
-
-    /// The tip where the swept segment starts.
-    #[inline]
-    pub fn start_tip(&self) -> [f64; 3] {
-        [0, 1, 2].map(|k| self.tip[k] - self.sweep[k])
-    }
 }
 
 /// A material contact of a non-cutting part found on one row of rays.
@@ -317,27 +269,10 @@ fn prepare(
     for pl in batch {
         let body = &bodies[pl.tool];
         let mut cut_box = None;
-        if !pl.rapid && pl.role != Role::Check {
-            if pl.is_swept() {
-                // The box of the swept solid is the hull of its end boxes, cut to the
-                // stock box (no ray holds material outside it).
-                let t0 = pl.start_tip();
-                for p in body.cutting.pieces() {
-                    merge_box(&mut cut_box, piece_box(p, &t0, &pl.axis));
-                    merge_box(&mut cut_box, piece_box(p, &pl.tip, &pl.axis));
-                }
-                cut_box = cut_box.and_then(|(mut a, mut b)| {
-                    for k in 0..3 {
-                        a[k] = a[k].max(lo[k]);
-                        b[k] = b[k].min(hi[k]);
-                    }
-                    (0..3).all(|k| a[k] <= b[k]).then_some((a, b))
-                });
-            } else {
-                for p in body.cutting.pieces() {
-                    if let Some(c) = clip_piece(p, &pl.tip, &pl.axis, &lo, &hi) {
-                        merge_box(&mut cut_box, piece_box(&c, &pl.tip, &pl.axis));
-                    }
+        if !pl.rapid {
+            for p in body.cutting.pieces() {
+                if let Some(c) = clip_piece(p, &pl.tip, &pl.axis, &lo, &hi) {
+                    merge_box(&mut cut_box, piece_box(&c, &pl.tip, &pl.axis));
                 }
             }
         }
@@ -345,7 +280,7 @@ fn prepare(
         let mut coll_box = None;
         let mut coll_radius: f64 = 0.0;
         let mut coll_span = (f64::INFINITY, f64::NEG_INFINITY);
-        if (check_collisions || pl.rapid) && pl.role != Role::Cut {
+        if check_collisions || pl.rapid {
             let parts: [(&RevolvedSolid, PartKind); 3] = if pl.rapid {
                 [
                     (&body.cutting, PartKind::RapidMove),
@@ -658,28 +593,11 @@ fn ray_work(
         );
     }
     if cut {
-        if let Some((s, e)) = cut_interval(body, pl, d, (u - pl.tip[ua], v - pl.tip[va]), rl) {
+        if let Some((s, e)) = body.cutting.ray_hull(rl) {
             return ray.subtract(s + pl.tip[d], e + pl.tip[d]);
         }
     }
     0.0
-}
-
-/// The cutting part's interval on the ray along `d` at offset `(du, dv)` from the tip (seen
-/// from the tip as `rl`), as λ from the tip's coordinate along the ray: the swept
-/// segment's ([`crate::swept`]) for a swept placement, the position's otherwise.
-#[inline]
-fn cut_interval(
-    body: &ToolBody,
-    pl: &Placement,
-    d: usize,
-    (du, dv): (f64, f64),
-    rl: &RayLocal,
-) -> Option<(f64, f64)> {
-    match (&body.swept, pl.is_swept()) {
-        (Some(k), true) => k.ray_interval(d, du, dv, &pl.axis, &pl.sweep),
-        _ => body.cutting.ray_hull(rl),
-    }
 }
 
 /// Applies a batch of placements to the stock: removes the cutting part's volume at each
@@ -745,17 +663,7 @@ pub fn apply_batch(
             .zip(&preps)
             .map(|(pl, p)| {
                 let cut = p.cut_box.as_ref().and_then(|bx| {
-                    let reach = if pl.is_swept() {
-                        Reach::swept(
-                            &bodies[pl.tool].cutting,
-                            &pl.start_tip(),
-                            &pl.axis,
-                            d,
-                            &pl.sweep,
-                        )
-                    } else {
-                        Reach::new(&bodies[pl.tool].cutting, &pl.tip, &pl.axis, d)
-                    };
+                    let reach = Reach::new(&bodies[pl.tool].cutting, &pl.tip, &pl.axis, d);
                     CutFootprint::new(&geo, bx, reach)?.shrink(tiles, (u0, v0), cell)
                 });
                 let coll = Footprint::new(&geo, &p.coll_box, p.coll_radius, p.coll_span, pl)
@@ -955,7 +863,6 @@ impl RowContext<'_> {
             let body = &self.bodies[pl.tool];
             let pieces = &self.coll_pieces[self.preps[k].coll.clone()];
             let dv = v - pl.tip[va];
-            let swept = pl.is_swept() && body.swept.is_some();
 
             let mut best: [Option<StockHit>; 3] = [None; 3];
             let in_cols =
@@ -1033,11 +940,10 @@ impl RowContext<'_> {
                     }
                     if in_cut {
                         let w = &mut scratch.witness[i];
-                        // A witness proves a gap against one position only.
-                        if !swept && w.holds(&rl, pl.tip[d], &body.cutting, self.margin) {
+                        if w.holds(&rl, pl.tip[d], &body.cutting, self.margin) {
                             continue;
                         }
-                        let r = match cut_interval(body, pl, d, (u - pl.tip[ua], dv), &rl) {
+                        let r = match body.cutting.ray_hull(&rl) {
                             Some((s, e)) => {
                                 let (s, e) = (s + pl.tip[d], e + pl.tip[d]);
                                 let r = ray.subtract(s, e);

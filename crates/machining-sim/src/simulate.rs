@@ -5,10 +5,7 @@
 //! tolerance default `h/4` for cell `h`), except that runs of feed blocks that stay within a
 //! quarter of that tolerance of one straight chord get positions spaced along the run as a
 //! whole, on the actual motion ([`crate::merge`]: the swept volume is under-read by at most
-//! the tolerance either way, never over-read); a run (or each of its blocks) that is a
-//! pure translation within a quarter of the tolerance is cut as its exact swept solid
-//! instead, its positions kept for the shank and holder checks ([`crate::segments`]: the
-//! swept solid lies within that quarter of the true one, either way);
+//! the tolerance either way, never over-read);
 //! positions are applied in batches with
 //! [`crate::removal::apply_batch`] (parallel over ray rows, exact sequential semantics, rays
 //! culled where provably untouched), and each batch's shank/holder placements are checked
@@ -28,8 +25,7 @@ use crate::motion::{
     has_flat_face, positions_for_move, positions_for_samples, scallop_radius, sub_positions,
     Interpolation,
 };
-use crate::removal::{apply_batch, PartKind, Placement, Role, ToolBody};
-use crate::segments;
+use crate::removal::{apply_batch, PartKind, Placement, ToolBody};
 use cam_core::{Cutter, MoveKind, ToolPath};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -160,12 +156,8 @@ pub struct Collision {
 pub struct SimStats {
     /// Moves simulated.
     pub moves: usize,
-    /// Cutter positions applied (sampled positions, including those kept as shank and
-    /// holder checks inside swept segments).
+    /// Cutter positions applied.
     pub positions: usize,
-    /// Swept segments cut ([`crate::segments`]).
-    #[serde(default)]
-    pub swept_segments: usize,
     /// Dexel cell size (mm).
     pub resolution_mm: f64,
     /// Sweep tolerance used (mm).
@@ -296,9 +288,7 @@ pub fn cut(
                  design_ms: &mut f64| {
         let out = apply_batch(stock, &bodies, batch, options.check_collisions, ctol);
         stats.removed_volume_mm3 += out.removed_volume;
-        let segments = batch.iter().filter(|p| p.role == Role::Cut).count();
-        stats.swept_segments += segments;
-        stats.positions += batch.len() - segments;
+        stats.positions += batch.len();
         for h in out.hits {
             let (op, mv) = meta[h.placement];
             acc.add((op, mv, h.part, CollisionTarget::Stock), h.depth, h.point);
@@ -314,9 +304,6 @@ pub fn cut(
                     let mut caches = vec![ClearanceCache::new(); 2 * shapes.len()];
                     let mut found = Vec::new();
                     for (k, pl) in chunk.iter().enumerate() {
-                        if pl.role == Role::Cut {
-                            continue;
-                        }
                         let (parts, slot) = if pl.rapid {
                             (&shapes[pl.tool].1, 2 * pl.tool + 1)
                         } else {
@@ -364,11 +351,7 @@ pub fn cut(
         };
         // Positions of the pending run of blocks (one block: its own positions, as the
         // controller moves; several: spaced along the run, on the motion).
-        // Runs of pure translations are cut as swept segments (`segments`), their sampled
-        // positions kept as shank and holder checks.
-        let sweepable = bodies[oi].swept.is_some();
         let emit = |run: &mut Run, batch: &mut Vec<Placement>, meta: &mut Vec<(usize, usize)>| {
-            let first = batch.len();
             match (run.start, run.blocks.as_slice()) {
                 (Some(from), &[(mi, _, cl, _)]) => {
                     let n = if run.samples().len() == sub_positions(&options.interpolation) {
@@ -406,30 +389,6 @@ pub fn cut(
                         .is_some_and(|p| p.tip == [end.tip.x, end.tip.y, end.tip.z]));
                 }
                 _ => {}
-            }
-            let pieces = if sweepable && batch.len() > first {
-                segments::translations(run, &reach, sub, 0.25 * tol)
-            } else {
-                Vec::new()
-            };
-            if !pieces.is_empty()
-                && segments::cut_count(&pieces, reach.radius_mm) <= batch.len() - first
-            {
-                let mut checks = batch.split_off(first);
-                let mut labels = meta.split_off(first);
-                if !options.check_collisions {
-                    checks.clear();
-                    labels.clear();
-                }
-                segments::interleave(
-                    &pieces,
-                    &checks,
-                    &labels,
-                    (oi, oi),
-                    reach.radius_mm,
-                    batch,
-                    meta,
-                );
             }
             run.clear();
         };
@@ -543,12 +502,12 @@ pub fn cut(
 
 /// The placement of tool `tool` at `c`.
 fn placement(c: &cam_core::CutterLocation, tool: usize, rapid: bool) -> Placement {
-    Placement::at(
-        [c.tip.x, c.tip.y, c.tip.z],
-        [c.axis.x, c.axis.y, c.axis.z],
+    Placement {
+        tip: [c.tip.x, c.tip.y, c.tip.z],
+        axis: [c.axis.x, c.axis.y, c.axis.z],
         tool,
         rapid,
-    )
+    }
 }
 
 /// The `n` positions of move `mi` of operation `oi` from `from` to `to` as the controller

@@ -5,35 +5,22 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use cam_core::{Cutter, CutterShape, HolderSegment, MoveKind, Point3, UnitVector3, Vector3};
-use machining_sim::removal::{
-    apply_batch, apply_batch_reference, Placement, Role, StockHit, ToolBody,
-};
+use machining_sim::removal::{apply_batch, apply_batch_reference, Placement, StockHit, ToolBody};
 use machining_sim::synthetic::{workload_cutter, zigzag_path};
 use machining_sim::{BoxStock, RevolvedStock, StockShape, TriDexel};
 
 fn placements(radius: f64, top: f64) -> Vec<Placement> {
     let path = zigzag_path(420, radius, top);
-    let mut out: Vec<Placement> = Vec::new();
-    for (k, m) in path.moves.iter().enumerate() {
-        let tip = [m.cl.tip.x, m.cl.tip.y, m.cl.tip.z];
-        let axis = [m.cl.axis.x, m.cl.axis.y, m.cl.axis.z];
-        let rapid = m.kind == MoveKind::Rapid;
-        let prev = k.checked_sub(1).map(|j| path.moves[j].cl.tip);
-        match prev {
-            // Every other feed move as a swept segment (with the previous tip and this
-            // axis) followed by a check-only position.
-            Some(p) if !rapid && k % 2 == 0 => {
-                let mut cut = Placement::at(tip, axis, 0, false);
-                cut.sweep = [tip[0] - p.x, tip[1] - p.y, tip[2] - p.z];
-                cut.role = Role::Cut;
-                out.push(cut);
-                let mut check = Placement::at(tip, axis, 0, false);
-                check.role = Role::Check;
-                out.push(check);
-            }
-            _ => out.push(Placement::at(tip, axis, 0, rapid)),
-        }
-    }
+    let mut out: Vec<Placement> = path
+        .moves
+        .iter()
+        .map(|m| Placement {
+            tip: [m.cl.tip.x, m.cl.tip.y, m.cl.tip.z],
+            axis: [m.cl.axis.x, m.cl.axis.y, m.cl.axis.z],
+            tool: 0,
+            rapid: m.kind == MoveKind::Rapid,
+        })
+        .collect();
     // Plunges deep enough for the shank (r 3 mm above 25 mm of flutes) and the holder to
     // touch the stock, strongly tilted, and a rapid through the material.
     for k in 0..40 {
@@ -48,12 +35,12 @@ fn placements(radius: f64, top: f64) -> Vec<Placement> {
             radius * 0.5 * (6.0 * t).sin(),
             top - 28.0 + 4.0 * t,
         );
-        out.push(Placement::at(
-            [tip.x, tip.y, tip.z],
-            [a.x, a.y, a.z],
-            0,
-            k % 13 == 12,
-        ));
+        out.push(Placement {
+            tip: [tip.x, tip.y, tip.z],
+            axis: [a.x, a.y, a.z],
+            tool: 0,
+            rapid: k % 13 == 12,
+        });
     }
     // Axes along each coordinate (degenerate projected bands) and an antiparallel one.
     for axis in [
@@ -62,7 +49,12 @@ fn placements(radius: f64, top: f64) -> Vec<Placement> {
         [0.0, 0.0, 1.0],
         [0.0, 0.0, -1.0],
     ] {
-        out.push(Placement::at([1.0, 2.0, top - 3.0], axis, 0, false));
+        out.push(Placement {
+            tip: [1.0, 2.0, top - 3.0],
+            axis,
+            tool: 0,
+            rapid: false,
+        });
     }
     out
 }
