@@ -557,16 +557,24 @@ impl Planner<'_> {
         self.subdivide(m, b, depth - 1, k, out);
     }
 
-    /// Appends `runs` to `path`: the step from the path's last location to a run's first is
-    /// a feed move when it is at most `near` mm long and the certified motion check passes,
+    /// Appends `runs` to `path` (in reverse order, each run reversed, when `reverse`: the
+    /// zig-zag's odd lines): the step from the path's last location to a run's first is a
+    /// feed move when it is at most `near` mm long and the certified motion check passes,
     /// else a link over the safety surface. Returns the number of steps made at feed.
     fn join(
         &self,
         ctx: &PlanContext<'_>,
         path: &mut ToolPath,
-        runs: Vec<Vec<Posture>>,
+        mut runs: Vec<Vec<Posture>>,
+        reverse: bool,
         near: f64,
     ) -> Result<usize, PlanError> {
+        if reverse {
+            runs.reverse();
+            for run in &mut runs {
+                run.reverse();
+            }
+        }
         let mut at_feed = 0;
         for run in runs {
             let Some(first) = run.first() else { continue };
@@ -1291,14 +1299,8 @@ impl Operation for HubFinishing {
                             .collect(),
                     });
                 }
-                let mut runs = res.runs;
-                if j % 2 == 1 {
-                    runs.reverse();
-                    for run in &mut runs {
-                        run.reverse();
-                    }
-                }
-                cross_links += planner.join(ctx, &mut path, runs, 2.0 * step + r)?;
+                cross_links +=
+                    planner.join(ctx, &mut path, res.runs, j % 2 == 1, 2.0 * step + r)?;
             }
         }
         // Cross lines over the gaps where the number of lanes changes ([`runs`]): per gap and
@@ -1318,14 +1320,7 @@ impl Operation for HubFinishing {
         for (j, res) in cross.into_iter().enumerate() {
             metrics_acc.absorb(&res);
             smoothing.merge(&res.smoothing);
-            let mut runs = res.runs;
-            if j % 2 == 1 {
-                runs.reverse();
-                for run in &mut runs {
-                    run.reverse();
-                }
-            }
-            cross_links += planner.join(ctx, &mut path, runs, 2.0 * step + r)?;
+            cross_links += planner.join(ctx, &mut path, res.runs, j % 2 == 1, 2.0 * step + r)?;
         }
         if metrics_acc.max_offset_error > 1e-6 {
             return Err(PlanError::geometry(

@@ -200,17 +200,7 @@ fn tessellate_grid(
         if !split_u.iter().any(|&x| x) {
             break;
         }
-        let split = |breaks: &mut Vec<f64>, flags: &[bool]| {
-            let mut out = Vec::with_capacity(breaks.len() * 2);
-            for (k, w) in breaks.windows(2).enumerate() {
-                out.push(w[0]);
-                if flags[k] {
-                    out.push(0.5 * (w[0] + w[1]));
-                }
-            }
-            out.extend(breaks.last().copied());
-            *breaks = out;
-        };
+        let split = |breaks: &mut Vec<f64>, flags: &[bool]| *breaks = halved(breaks, flags);
         split(&mut us, &split_u);
         split(&mut vs, &split_v);
     }
@@ -232,6 +222,19 @@ fn tessellate_grid(
         }
     }
     Ok(mesh)
+}
+
+/// `breaks` with the midpoint inserted into every interval `k` whose `flags[k]` is set.
+fn halved(breaks: &[f64], flags: &[bool]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(breaks.len() * 2);
+    for (k, w) in breaks.windows(2).enumerate() {
+        out.push(w[0]);
+        if flags.get(k).copied().unwrap_or(false) {
+            out.push(0.5 * (w[0] + w[1]));
+        }
+    }
+    out.extend(breaks.last().copied());
+    out
 }
 
 /// Triangulates the chosen parts of an impeller within `chord_tol` mm.
@@ -376,15 +379,7 @@ pub fn tessellate_fillet_piece(
                 reason: format!("more than {MAX_INTERVALS} intervals for {chord_tol} mm"),
             });
         }
-        let mut out = Vec::with_capacity(us.len() * 2);
-        for (k, w) in us.windows(2).enumerate() {
-            out.push(w[0]);
-            if flags[k] {
-                out.push(0.5 * (w[0] + w[1]));
-            }
-        }
-        out.extend(us.last().copied());
-        us = out;
+        us = halved(&us, &flags);
     }
     let nf = n_arc + 1;
     let mut mesh = TriMesh::default();
