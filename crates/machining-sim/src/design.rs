@@ -22,6 +22,19 @@ pub struct SurfaceGrid {
     pub normals: Vec<Vector3>,
 }
 
+impl SurfaceGrid {
+    /// A grid of `nu × nv` samples with nothing sampled yet (room reserved for them).
+    pub fn empty(name: String, nu: usize, nv: usize) -> Self {
+        Self {
+            name,
+            nu,
+            nv,
+            points: Vec::with_capacity(nu * nv),
+            normals: Vec::with_capacity(nu * nv),
+        }
+    }
+}
+
 /// Indexed triangle mesh (mm).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct TriangleMesh {
@@ -97,13 +110,7 @@ impl DesignModel for BoxDesign {
                 let (ua, va) = ((d + 1) % 3, (d + 2) % 3);
                 let nu = samples(self.max[ua] - self.min[ua], self.sample_spacing);
                 let nv = samples(self.max[va] - self.min[va], self.sample_spacing);
-                let mut g = SurfaceGrid {
-                    name: format!("{}_{side}", names[d]),
-                    nu,
-                    nv,
-                    points: Vec::with_capacity(nu * nv),
-                    normals: Vec::with_capacity(nu * nv),
-                };
+                let mut g = SurfaceGrid::empty(format!("{}_{side}", names[d]), nu, nv);
                 let mut n = Vector3::zeros();
                 n[d] = sign;
                 for j in 0..nv {

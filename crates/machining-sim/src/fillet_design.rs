@@ -39,12 +39,13 @@
 
 use crate::design::SurfaceGrid;
 use crate::error::SimError;
+use crate::impeller_design::side_name;
 use cam_core::{Point3, Vector3};
 use impeller_model::fillet::ImpellerFillets;
 use impeller_model::{Blade, Impeller, Side};
 
-/// Largest spine error of the verifier's fillets (mm).
-pub const FILLET_TOL_MM: f64 = 1e-4;
+/// Largest spine error of the verifier's fillets (mm): the model's default.
+pub const FILLET_TOL_MM: f64 = impeller_model::fillet::DEFAULT_FILLET_TOL_MM;
 
 /// Chord tolerance of the fillets' triangles in the collision mesh (mm).
 pub const FILLET_MESH_CHORD_MM: f64 = 0.02;
@@ -138,13 +139,7 @@ impl DesignFillets {
         nv: usize,
     ) -> SurfaceGrid {
         let nu = ARC_SAMPLES;
-        let mut g = SurfaceGrid {
-            name: format!("{name}_fillet_{}", side_name(side)),
-            nu,
-            nv,
-            points: Vec::with_capacity(nu * nv),
-            normals: Vec::with_capacity(nu * nv),
-        };
+        let mut g = SurfaceGrid::empty(format!("{name}_fillet_{}", side_name(side)), nu, nv);
         let Some((row, rot)) = self.fillets.instance(instance) else {
             return g;
         };
@@ -175,12 +170,5 @@ impl DesignFillets {
             }
         }
         g
-    }
-}
-
-fn side_name(side: Side) -> &'static str {
-    match side {
-        Side::Pressure => "pressure",
-        Side::Suction => "suction",
     }
 }

@@ -359,13 +359,7 @@ impl ImpellerDesign {
         let s = blade.side(side);
         let ((u0, u1), (v0, v1)) = s.domain();
         let (nu, nv) = (self.sampling.blade_u.max(2), self.sampling.blade_v.max(2));
-        let mut g = SurfaceGrid {
-            name: format!("{name}_{}", side_name(side)),
-            nu,
-            nv,
-            points: Vec::with_capacity(nu * nv),
-            normals: Vec::with_capacity(nu * nv),
-        };
+        let mut g = SurfaceGrid::empty(format!("{name}_{}", side_name(side)), nu, nv);
         for j in 0..nv {
             let v = v0 + (v1 - v0) * (j as f64 + 0.5) / nv as f64;
             for i in 0..nu {
@@ -389,13 +383,7 @@ impl ImpellerDesign {
         let hub = self.impeller.hub();
         let (t0, t1) = hub.meridional().domain();
         let (nt, np) = (self.sampling.hub_t.max(2), self.sampling.hub_phi.max(4));
-        let mut g = SurfaceGrid {
-            name: "hub".into(),
-            nu: np,
-            nv: nt,
-            points: Vec::with_capacity(nt * np),
-            normals: Vec::with_capacity(nt * np),
-        };
+        let mut g = SurfaceGrid::empty("hub".into(), np, nt);
         for j in 0..nt {
             let t = t0 + (t1 - t0) * (j as f64 + 0.5) / nt as f64;
             for i in 0..np {
@@ -417,13 +405,7 @@ impl ImpellerDesign {
         let shroud = self.impeller.shroud();
         let nu = self.sampling.blade_u.max(2);
         let nw = self.sampling.tip_w.max(1);
-        let mut g = SurfaceGrid {
-            name: format!("{name}_tip"),
-            nu: nw,
-            nv: nu,
-            points: Vec::with_capacity(nu * nw),
-            normals: Vec::with_capacity(nu * nw),
-        };
+        let mut g = SurfaceGrid::empty(format!("{name}_tip"), nw, nu);
         let tip_point = |side: Side, u: f64| -> Option<Vector3> {
             let s = blade.side(side);
             let ((_, _), (v0, v1)) = s.domain();
@@ -562,7 +544,8 @@ fn edge_wedge(
     blunt_edge_distance(blade, &p.coords, pressure, suction)
 }
 
-fn side_name(side: Side) -> &'static str {
+/// The map-grid name of a blade side.
+pub(crate) fn side_name(side: Side) -> &'static str {
     match side {
         Side::Pressure => "pressure",
         Side::Suction => "suction",

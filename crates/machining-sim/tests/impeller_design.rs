@@ -22,6 +22,47 @@ fn coarse() -> ImpellerSampling {
     }
 }
 
+/// Appends a feed move to the tool tip `tip` with tool axis `axis`, and grows the blank box
+/// `lo..hi` to hold a 3 mm cube around `around`.
+fn feed_to(
+    path: &mut ToolPath,
+    tip: Vector3,
+    axis: Vector3,
+    around: Vector3,
+    lo: &mut [f64; 3],
+    hi: &mut [f64; 3],
+) {
+    for i in 0..3 {
+        lo[i] = lo[i].min(around[i] - 3.0);
+        hi[i] = hi[i].max(around[i] + 3.0);
+    }
+    path.moves.push(Move {
+        kind: MoveKind::Feed,
+        cl: CutterLocation::new(Point3::from(tip), axis).unwrap(),
+        feed_mm_per_min: None,
+    });
+}
+
+/// Simulates `path` with `cutter` on the box blank `lo..hi` at cell `h` (default options).
+fn simulate_on_box(
+    design: &ImpellerDesign,
+    cutter: Cutter,
+    path: ToolPath,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    h: f64,
+) -> machining_sim::Report {
+    let blank = machining_sim::BoxStock::new(lo, hi).unwrap();
+    let mut stock = TriDexel::from_shape(&blank, h).unwrap();
+    simulate(
+        &mut stock,
+        design,
+        &[(cutter, path)],
+        &SimOptions::default(),
+    )
+    .unwrap()
+}
+
 #[test]
 fn signed_distance_signs_and_samples_on_surfaces() {
     let imp = default_impeller().unwrap();
@@ -90,27 +131,10 @@ fn gouge_into_a_blade_of_the_fixture_is_located() {
         let u = u0 + (0.45 + 0.3 * k as f64 / n_cl as f64) * (u1 - u0);
         let p = s.point(u, v);
         let n = blade.outward_normal(Side::Suction, u, v).unwrap();
-        let tip = p - n * gouge;
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i] - 3.0);
-            hi[i] = hi[i].max(p[i] + 3.0);
-        }
-        path.moves.push(Move {
-            kind: MoveKind::Feed,
-            cl: CutterLocation::new(Point3::from(tip), n).unwrap(),
-            feed_mm_per_min: None,
-        });
+        feed_to(&mut path, p - n * gouge, n, p, &mut lo, &mut hi);
     }
-    let blank = machining_sim::BoxStock::new(lo, hi).unwrap();
     let h = 0.1;
-    let mut stock = TriDexel::from_shape(&blank, h).unwrap();
-    let rep = simulate(
-        &mut stock,
-        &design,
-        &[(cutter, path)],
-        &SimOptions::default(),
-    )
-    .unwrap();
+    let rep = simulate_on_box(&design, cutter, path, lo, hi, h);
     let e = rep.max_overcut.clone().unwrap();
     assert!((e.value_mm - gouge).abs() < h, "{e:?}");
     assert!(e.surface == "main0_suction", "{e:?}");
@@ -306,26 +330,10 @@ fn a_ball_smaller_than_the_fillet_in_the_root_corner_gouges_the_fillet() {
         want = want.max((big_r - rho) * (1.0 / (0.5 * beta).sin() - 1.0));
         let axis = small.hub_normal;
         let tip = small.centre - axis * rho;
-        for i in 0..3 {
-            lo[i] = lo[i].min(small.centre[i] - 3.0);
-            hi[i] = hi[i].max(small.centre[i] + 3.0);
-        }
-        path.moves.push(Move {
-            kind: MoveKind::Feed,
-            cl: CutterLocation::new(Point3::from(tip), axis).unwrap(),
-            feed_mm_per_min: None,
-        });
+        feed_to(&mut path, tip, axis, small.centre, &mut lo, &mut hi);
     }
-    let blank = machining_sim::BoxStock::new(lo, hi).unwrap();
     let h = 0.05;
-    let mut stock = TriDexel::from_shape(&blank, h).unwrap();
-    let rep = simulate(
-        &mut stock,
-        &design,
-        &[(cutter, path)],
-        &SimOptions::default(),
-    )
-    .unwrap();
+    let rep = simulate_on_box(&design, cutter, path, lo, hi, h);
     let e = rep.max_overcut.clone().unwrap();
     assert!(want > 0.1, "{want}");
     assert!((e.value_mm - want).abs() < 2.0 * h, "want {want}: {e:?}");

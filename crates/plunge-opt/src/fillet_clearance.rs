@@ -23,8 +23,8 @@
 use cam_core::{CutterLocation, Vector3};
 use impeller_model::fillet::ImpellerFillets;
 
-/// Largest spine error of the fillets the plunges are held to (mm).
-pub const FILLET_TOL_MM: f64 = 1e-4;
+/// Largest spine error of the fillets the plunges are held to (mm): the model's default.
+pub const FILLET_TOL_MM: f64 = impeller_model::fillet::DEFAULT_FILLET_TOL_MM;
 
 /// Spacing of the cutter samples (mm).
 pub const SAMPLE_MM: f64 = 1.0;
