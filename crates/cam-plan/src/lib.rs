@@ -21,7 +21,9 @@
 //!   along the tool axis;
 //! - [`pattern`]: rotational copy of one channel's or blade's paths to every channel/blade
 //!   (paper 003's "object transformation");
-//! - [`order`]: channel and blade ordering that keeps rapids short.
+//! - [`order`]: channel and blade ordering that keeps rapids short;
+//! - [`remaining`]: the stock the job's earlier operations leave above the design, for the
+//!   operations that machine what is left.
 //!
 //! Job-file vocabulary shared by the pipeline and the operation crates: [`Tool`] (a cutter with
 //! its number, teeth, holder and gauge length), [`Process`] (the shop-sheet row: spindle speed,
@@ -44,6 +46,7 @@ pub mod params;
 pub mod pass_check;
 pub mod pattern;
 pub mod process;
+pub mod remaining;
 pub mod tool;
 
 pub use axis_smoothing::{AxisSmoothing, KeptReason, PostureCheck, RunSmoothing, SmoothingSummary};
@@ -59,6 +62,7 @@ pub use operation::{
 };
 pub use pass_check::{PassCheck, PassFloors, PassViolation, PostureClearance};
 pub use process::Process;
+pub use remaining::{RemainingMaterial, RestGrid};
 pub use tool::Tool;
 
 /// Point in the workpiece frame (mm).

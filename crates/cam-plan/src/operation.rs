@@ -5,7 +5,7 @@
 //! a boxed operation. Each operation crate exports one builder per kind.
 
 use crate::linking::{widening_profile, LinkCheck, LinkStats, DEFAULT_LINK_QUERIES};
-use crate::{DesignClearance, Linker, Metrics, PlanError, Plot, Process, Tool};
+use crate::{DesignClearance, Linker, Metrics, PlanError, Plot, Process, RemainingMaterial, Tool};
 use cam_core::{CutterLocation, Move, Rates, Tolerances, ToolPath};
 use impeller_model::{Impeller, Stock};
 
@@ -32,6 +32,9 @@ pub struct PlanContext<'a> {
     /// The tool axes the job's machine can take (its rotary travel), when known: operations
     /// that search for an axis skip the ones it cannot reach ([`PlanContext::reaches`]).
     pub reach: Option<&'a dyn AxisReach>,
+    /// The stock the job's earlier operations leave, measured above the design: given to
+    /// the operations that ask for it ([`Operation::needs_remaining`]), `None` otherwise.
+    pub remaining: Option<&'a RemainingMaterial>,
 }
 
 /// Which tool axes (unit vectors in the workpiece frame, from the tip toward the spindle) a
@@ -123,6 +126,13 @@ pub trait Operation: std::fmt::Debug + Send + Sync {
     fn tool(&self) -> &str;
     /// Plans the operation.
     fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError>;
+
+    /// Whether the operation plans from the stock the job's earlier operations leave
+    /// ([`PlanContext::remaining`]): the pipeline then plans it after them, with their cuts
+    /// simulated. Default: no.
+    fn needs_remaining(&self) -> bool {
+        false
+    }
 
     /// Further tools of the job the operation plans steps of its own with (a pilot drill
     /// before plunge roughing), with the keys that name them. Default: none.

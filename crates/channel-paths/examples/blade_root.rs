@@ -66,6 +66,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         linker: &linker,
         links: &cam_plan::LinkStats::default(),
         reach: None,
+        remaining: None,
     };
     let op = channel_paths::build_blade_root_finishing(&OperationSpec {
         name: "root".into(),

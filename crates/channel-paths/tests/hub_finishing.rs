@@ -116,6 +116,7 @@ fn hub_axes_stay_within_the_machines_reach() {
         linker: &c.linker,
         links: &links,
         reach: Some(&cone),
+        remaining: None,
     };
     let held = op.plan(&ctx).unwrap();
     let t = tilts(&held);

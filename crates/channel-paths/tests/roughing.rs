@@ -72,6 +72,7 @@ fn plan_rough(
         linker: &linker,
         links: &cam_plan::LinkStats::default(),
         reach: None,
+        remaining: None,
     };
     build_channel_roughing(&spec(params))
         .unwrap()

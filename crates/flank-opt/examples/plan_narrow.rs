@@ -73,6 +73,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         linker: &linker,
         links: &cam_plan::LinkStats::default(),
         reach: None,
+        remaining: None,
     };
     let spec = OperationSpec {
         name: "flank".into(),

@@ -95,6 +95,7 @@ fn with_ctx<T>(
         linker: &linker,
         links: &links,
         reach: None,
+        remaining: None,
     };
     f(&ctx)
 }

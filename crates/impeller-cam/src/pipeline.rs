@@ -2,8 +2,10 @@
 //!
 //! 1. [`model`]: the impeller (design geometry and blank);
 //! 2. [`plan`]: every `[[operations]]` entry planned through its kind's
-//!    [`cam_plan::Operation`] (independent operations in parallel with rayon), its paths
-//!    linked over the safety surface into one CL operation, then the job's CL files;
+//!    [`cam_plan::Operation`] (independent operations in parallel with rayon; then, in job
+//!    order, the operations that plan from the stock the earlier ones leave, with that stock
+//!    simulated on their CL paths), its paths linked over the safety surface into one CL
+//!    operation, then the job's CL files;
 //! 3. [`post`]: `toolpath.cls` (APT CLDATA) and the program for the machine and dialect, with
 //!    reverse-motion removal checked against the design ([`GougeCheck`]);
 //! 4. [`verify`]: independent stock simulation of the operations as posted;
@@ -412,120 +414,70 @@ pub fn plan(
     // The machine's rotary travel, for the operations that search for a tool axis.
     let reach = crate::travel::MachineReach(load_machine(job)?);
     let progress = Progress::new(job.quiet);
-    let planned: Vec<Result<Vec<JobOperation>, CliError>> = job
+    let built: Vec<Box<dyn cam_plan::Operation>> = job
+        .operations
+        .iter()
+        .enumerate()
+        .map(|(i, spec)| registry::build(registry, spec).map_err(|e| job.operation_error(i, &e)))
+        .collect::<Result<_, _>>()?;
+    let shared = Shared {
+        job,
+        impeller,
+        linker: &linker,
+        mesh: mesh.as_ref(),
+        reach: &reach,
+        progress: &progress,
+    };
+    // Operations that plan from the design alone, in parallel; then, in job order, those that
+    // plan from the stock the operations before them leave (simulated here).
+    let mut planned: Vec<Option<Vec<JobOperation>>> = job
         .operations
         .par_iter()
         .enumerate()
         .map(|(i, spec)| {
-            let fail = |e: PlanError| job.operation_error(i, &e);
-            let tool = job.tool(&spec.tool).ok_or_else(|| {
-                fail(PlanError::tool(
-                    &spec.name,
-                    &spec.tool,
-                    "not a tool of the job",
-                ))
-            })?;
-            let op = registry::build(registry, spec).map_err(fail)?;
-            // Further tools the operation plans steps with (a pilot drill).
-            let step_tools: Vec<&Tool> = op
-                .step_tools()
-                .iter()
-                .map(|st| {
-                    job.tool(&st.tool).ok_or_else(|| {
-                        fail(PlanError::param(
-                            &spec.name,
-                            &st.key,
-                            format!("\"{}\" is not a tool of the job", st.tool),
-                        ))
-                    })
-                })
-                .collect::<Result<_, _>>()?;
-            let t = Instant::now();
-            let task = progress.task(format!("planning {} ({})", spec.name, spec.kind));
-            let mesh = mesh
-                .clone()
-                .ok_or_else(|| fail(PlanError::geometry(&spec.name, "design mesh", "not built")))?;
-            let clearance =
-                DesignClearance::with_mesh(impeller, mesh.clone(), tool, clearance_options(job))
-                    .map_err(|e| fail(rename(e, &spec.name)))?;
-            let links = LinkStats::default();
-            let ctx = PlanContext {
-                impeller,
-                stock: impeller.stock(),
-                tool,
-                tolerances: &job.tolerances,
-                process: &spec.process,
-                clearance: &clearance,
-                linker: &linker,
-                links: &links,
-                reach: Some(&reach),
-            };
-            let (planned, steps) = op.plan_with_steps(&ctx, &step_tools).map_err(fail)?;
-            let mut main =
-                job_operation(&ctx, spec.name.as_str(), &spec.kind, planned).map_err(fail)?;
-            let plan_ms = ms(t);
-            main.plan_ms = plan_ms;
-            task.done(format!(
-                "planned {} ({}): {} moves in {:.1} s",
-                spec.name,
-                spec.kind,
-                main.cl.path.moves.len(),
-                plan_ms / 1e3
-            ));
-            // Each step is its own operation with its own tool: linked, checked and fed
-            // with that tool, machined before or after the operation.
-            let (mut before, mut after) = (Vec::new(), Vec::new());
-            for step in steps {
-                let step_tool = job.tool(&step.tool).ok_or_else(|| {
-                    fail(PlanError::tool(
-                        &step.name,
-                        &step.tool,
-                        "a step's tool must be one of the job's tools",
-                    ))
-                })?;
-                let clearance = DesignClearance::with_mesh(
-                    impeller,
-                    mesh.clone(),
-                    step_tool,
-                    clearance_options(job),
-                )
-                .map_err(|e| fail(rename(e, &step.name)))?;
-                let links = LinkStats::default();
-                let step_ctx = PlanContext {
-                    tool: step_tool,
-                    process: &step.process,
-                    clearance: &clearance,
-                    links: &links,
-                    ..ctx
-                };
-                // Planned with the operation: its planning time is the operation's.
-                let op =
-                    job_operation(&step_ctx, &step.name, &step.kind, step.planned).map_err(fail)?;
-                if step.before {
-                    before.push(op);
-                } else {
-                    after.push(op);
-                }
+            if built[i].needs_remaining() {
+                Ok(None)
+            } else {
+                shared.plan_one(i, spec, built[i].as_ref(), None).map(Some)
             }
-            before.push(main);
-            before.extend(after);
-            for op in &mut before {
-                op.cl.coolant = job.coolant.get(i).copied().unwrap_or_default();
-            }
-            Ok(before)
         })
-        .collect();
-    let mut operations: Vec<JobOperation> = planned
-        .into_iter()
-        .collect::<Result<Vec<_>, _>>()?
-        .into_iter()
-        .flatten()
-        .collect();
+        .collect::<Result<_, CliError>>()?;
+    for (i, spec) in job.operations.iter().enumerate() {
+        if !built[i].needs_remaining() {
+            continue;
+        }
+        let earlier: Vec<&JobOperation> = planned[..i].iter().flatten().flatten().collect();
+        let t = Instant::now();
+        let task = progress.task(format!("simulating the stock {} plans from", spec.name));
+        let remaining = remaining_after(job, impeller, &earlier)?;
+        task.done(format!(
+            "simulated the stock {} plans from in {:.1} s",
+            spec.name,
+            t.elapsed().as_secs_f64()
+        ));
+        let mut ops = shared.plan_one(i, spec, built[i].as_ref(), Some(&remaining))?;
+        // The simulation is part of this operation's planning (its steps, if any, are
+        // timed with it and keep 0).
+        for op in ops.iter_mut().filter(|op| op.plan_ms > 0.0) {
+            op.plan_ms = ms(t);
+        }
+        planned[i] = Some(ops);
+    }
+    let mut operations: Vec<JobOperation> = planned.into_iter().flatten().flatten().collect();
     for op in &operations {
         for n in &op.cl.comments {
             notes.push(format!("{}: {n}", op.cl.path.name));
         }
     }
+    // An operation that found nothing to cut (a rest operation after a complete job) is not
+    // posted; its notes say why.
+    operations.retain(|op| {
+        let keep = !op.cl.path.moves.is_empty();
+        if !keep {
+            notes.push(format!("{}: planned no moves, not posted", op.cl.path.name));
+        }
+        keep
+    });
 
     // CL data given by the job (from any CAM system).
     let rates = Rates::default();
@@ -557,6 +509,171 @@ pub fn plan(
         }
     }
     Ok(operations)
+}
+
+/// What every operation of a job plans with (the design mesh, the linker, the machine's
+/// reach), shared by [`plan`]'s parallel and ordered passes.
+struct Shared<'a> {
+    job: &'a Job,
+    impeller: &'a Impeller,
+    linker: &'a Linker,
+    mesh: Option<&'a Arc<DesignMesh>>,
+    reach: &'a crate::travel::MachineReach,
+    progress: &'a Progress,
+}
+
+impl Shared<'_> {
+    /// Plans operation `i` of the job (`spec`, built as `op`) and its steps, each linked into
+    /// one CL operation, in machining order; `remaining` is the stock the operations before
+    /// it leave, for the operations that ask for it.
+    fn plan_one(
+        &self,
+        i: usize,
+        spec: &cam_plan::OperationSpec,
+        op: &dyn cam_plan::Operation,
+        remaining: Option<&cam_plan::RemainingMaterial>,
+    ) -> Result<Vec<JobOperation>, CliError> {
+        let (job, impeller, linker, progress) =
+            (self.job, self.impeller, self.linker, self.progress);
+        let fail = |e: PlanError| job.operation_error(i, &e);
+        let tool = job.tool(&spec.tool).ok_or_else(|| {
+            fail(PlanError::tool(
+                &spec.name,
+                &spec.tool,
+                "not a tool of the job",
+            ))
+        })?;
+        // Further tools the operation plans steps with (a pilot drill).
+        let step_tools: Vec<&Tool> = op
+            .step_tools()
+            .iter()
+            .map(|st| {
+                job.tool(&st.tool).ok_or_else(|| {
+                    fail(PlanError::param(
+                        &spec.name,
+                        &st.key,
+                        format!("\"{}\" is not a tool of the job", st.tool),
+                    ))
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        let t = Instant::now();
+        let task = progress.task(format!("planning {} ({})", spec.name, spec.kind));
+        let mesh = self
+            .mesh
+            .cloned()
+            .ok_or_else(|| fail(PlanError::geometry(&spec.name, "design mesh", "not built")))?;
+        let clearance =
+            DesignClearance::with_mesh(impeller, mesh.clone(), tool, clearance_options(job))
+                .map_err(|e| fail(rename(e, &spec.name)))?;
+        let links = LinkStats::default();
+        let ctx = PlanContext {
+            impeller,
+            stock: impeller.stock(),
+            tool,
+            tolerances: &job.tolerances,
+            process: &spec.process,
+            clearance: &clearance,
+            linker,
+            links: &links,
+            reach: Some(self.reach),
+            remaining,
+        };
+        let (planned, steps) = op.plan_with_steps(&ctx, &step_tools).map_err(fail)?;
+        let mut main =
+            job_operation(&ctx, spec.name.as_str(), &spec.kind, planned).map_err(fail)?;
+        let plan_ms = ms(t);
+        main.plan_ms = plan_ms;
+        task.done(format!(
+            "planned {} ({}): {} moves in {:.1} s",
+            spec.name,
+            spec.kind,
+            main.cl.path.moves.len(),
+            plan_ms / 1e3
+        ));
+        // Each step is its own operation with its own tool: linked, checked and fed
+        // with that tool, machined before or after the operation.
+        let (mut before, mut after) = (Vec::new(), Vec::new());
+        for step in steps {
+            let step_tool = job.tool(&step.tool).ok_or_else(|| {
+                fail(PlanError::tool(
+                    &step.name,
+                    &step.tool,
+                    "a step's tool must be one of the job's tools",
+                ))
+            })?;
+            let clearance = DesignClearance::with_mesh(
+                impeller,
+                mesh.clone(),
+                step_tool,
+                clearance_options(job),
+            )
+            .map_err(|e| fail(rename(e, &step.name)))?;
+            let links = LinkStats::default();
+            let step_ctx = PlanContext {
+                tool: step_tool,
+                process: &step.process,
+                clearance: &clearance,
+                links: &links,
+                ..ctx
+            };
+            // Planned with the operation: its planning time is the operation's.
+            let op =
+                job_operation(&step_ctx, &step.name, &step.kind, step.planned).map_err(fail)?;
+            if step.before {
+                before.push(op);
+            } else {
+                after.push(op);
+            }
+        }
+        before.push(main);
+        before.extend(after);
+        for op in &mut before {
+            op.cl.coolant = job.coolant.get(i).copied().unwrap_or_default();
+        }
+        Ok(before)
+    }
+}
+
+/// The stock the planned operations `earlier` leave on the job's blank, simulated at the
+/// job's verification resolution on their CL paths (machining-sim's tri-dexel stock) and
+/// measured above the design at the verifier's samples: what a rest operation plans from.
+/// Cost: one stock simulation of `earlier` (as [`verify`]'s, without its progress bar).
+fn remaining_after(
+    job: &Job,
+    impeller: &Impeller,
+    earlier: &[&JobOperation],
+) -> Result<cam_plan::RemainingMaterial, CliError> {
+    let paths: Vec<(Cutter, ToolPath)> = earlier
+        .iter()
+        .filter_map(|op| op.cl.cutter.clone().map(|c| (c, op.cl.path.clone())))
+        .collect();
+    let (design, stock) = rayon::join(
+        || ImpellerDesign::new(impeller, ImpellerSampling::default()),
+        || {
+            machining_sim::blank_of(impeller)
+                .and_then(|b| TriDexel::from_shape(&b, job.verification.resolution_mm))
+        },
+    );
+    let design = design.map_err(msg)?;
+    let mut stock = stock.map_err(msg)?;
+    let rep = machining_sim::simulate(&mut stock, &design, &paths, &SimOptions::default())
+        .map_err(msg)?;
+    Ok(cam_plan::RemainingMaterial {
+        after: earlier.iter().map(|op| op.cl.path.name.clone()).collect(),
+        resolution_mm: job.verification.resolution_mm,
+        grids: rep
+            .maps
+            .into_iter()
+            .map(|m| cam_plan::RestGrid {
+                surface: m.name,
+                nu: m.nu,
+                nv: m.nv,
+                points: m.points,
+                residual_mm: m.residual_mm,
+            })
+            .collect(),
+    })
 }
 
 /// The CL operation of `planned` (an operation or one of its steps) in `ctx`: its paths

@@ -35,6 +35,10 @@ pub static OPERATIONS: &Registry = &[
         flank_opt::BLADE_POINT_FINISHING,
         flank_opt::build_blade_point_finishing,
     ),
+    (
+        channel_paths::REST_FINISHING,
+        channel_paths::build_rest_finishing,
+    ),
 ];
 
 /// The builder of `kind`, if registered.

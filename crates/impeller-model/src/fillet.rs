@@ -272,6 +272,12 @@ impl FilletPiece {
         }
     }
 
+    /// Distance from `p` to the piece's spine (the curve of rolling-ball centres, its ends
+    /// included): the global closest point of the certified projection. O(projection).
+    pub fn spine_distance(&self, p: &Vector3<f64>) -> f64 {
+        (p - self.projector.closest_point(p).point).norm()
+    }
+
     /// Signed distance of `p` to the fillet material of this piece (module docs) and the
     /// nearest point of the fillet surface, `None` where the fillet does not decide it.
     fn closest(&self, p: &Vector3<f64>) -> Option<(f64, Vector3<f64>)> {
@@ -571,6 +577,38 @@ impl ImpellerFillets {
             Side::Suction => 1,
         };
         self.rows.get(row).map(|r| &r.0[k])
+    }
+
+    /// Calls `visit` with the distance from `p` to the spine of each fillet of the instances
+    /// whose window holds `p` (each side's pieces taken together: the smallest over them).
+    /// The ball of radius `R` about any spine point is free of design material (it touches
+    /// hub and side and the fillet lies outside it), so a sphere about `p` of radius `ρ` with
+    /// `R − d ≥ ρ` for some visited `d` is clear of that fillet; a fillet not visited is
+    /// farther than [`Self::reach_mm`] from `p`. Cost: as [`Self::closest`].
+    pub fn spine_distances(&self, p: &Vector3<f64>, mut visit: impl FnMut(f64)) {
+        let phi = p.y.atan2(p.x);
+        for (row, rot) in &self.instances {
+            let (pair, (lo, hi)) = &self.rows[*row];
+            let a = phi - rot.scaled_axis().z;
+            let mid = 0.5 * (lo + hi);
+            let a = mid
+                + ((a - mid + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                    - std::f64::consts::PI);
+            if a < *lo || a > *hi {
+                continue;
+            }
+            let q = rot.inverse() * p;
+            for f in pair {
+                let d = f
+                    .pieces
+                    .iter()
+                    .map(|k| k.spine_distance(&q))
+                    .fold(f64::INFINITY, f64::min);
+                if d.is_finite() {
+                    visit(d);
+                }
+            }
+        }
     }
 
     /// The fillet distance of `p` and the fillet surface point deciding it (the smallest

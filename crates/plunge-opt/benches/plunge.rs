@@ -113,6 +113,7 @@ fn channel(c: &mut Criterion) {
         linker: &linker,
         links: &cam_plan::LinkStats::default(),
         reach: None,
+        remaining: None,
     };
     let mut g = c.benchmark_group("plan");
     g.sample_size(10);

@@ -166,6 +166,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             linker: &linker,
             links: &cam_plan::LinkStats::default(),
             reach: None,
+            remaining: None,
         };
         let t0 = std::time::Instant::now();
         let (planned, steps) = op.plan_with_steps(&ctx, &[&drill])?;

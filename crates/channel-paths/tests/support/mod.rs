@@ -129,6 +129,7 @@ macro_rules! plan_ctx {
             linker: &$c.linker,
             links: &cam_plan::LinkStats::default(),
             reach: None,
+            remaining: None,
         }
     };
 }

@@ -1,0 +1,919 @@
+//! Rest finishing (paper 003 §4, the "secondary cut" after verification): ball-end point
+//! milling of only the places where the job's earlier operations left material above the
+//! design, with a smaller tool.
+//!
+//! It lives beside hub and blade-root finishing because what it cuts is theirs: the corners
+//! where hub, blade sides and fillets meet, which a larger ball cannot enter. It reads the
+//! stock those operations leave ([`cam_plan::RemainingMaterial`]: the pipeline simulates their
+//! cuts on the blank and measures the residual at the verifier's design samples).
+//!
+//! # Regions
+//! On each surface's sample grid the samples whose residual exceeds `threshold_mm` are grouped
+//! into *regions*, the connected components of the grid (8-neighbourhood). A region's
+//! area is the sum of its samples' cells ([`cam_plan::RestGrid::cell_area_mm2`]).
+//!
+//! # Ball centres
+//! Let `D(p)` be the signed distance of `p` to the design material: hub body and every blade
+//! (exact NURBS, [`cam_plan::DesignClearance::design_signed_distance`]) and, inside their
+//! arcs' sectors, the blade-root fillets (the rolling-ball blend,
+//! [`impeller_model::fillet::ImpellerFillets`]), positive in the air. A region's cut is made of *passes* along the
+//! grid direction in which the region is longer, at most one step-over apart across it (the
+//! exact circle–circle step-over of a flat surface, [`cam_core::ball_step_over`], for
+//! `scallop_mm`), sampled at most `0.25·r` apart along. Each pass sample is a point `s` of the
+//! grid (bilinear between the samples); its ball centre is `s` moved onto the offset surface
+//! `D = r` by the fixed-point iteration `c ← c + (r − D(c))·∇D(c)` (central differences,
+//! `|r − D(c)| ≤ 1e-7` mm, at most 60 steps). On a face this is `s + r·n`; in a concave corner it
+//! converges to the ball that touches both walls nearest to `s` (in a corner of orthogonal
+//! walls in two steps, geometrically in sharper ones), so a corner the ball cannot enter is
+//! cut as deep as the ball reaches and no deeper. A sample whose iteration does not settle
+//! is left out (its pass is split there).
+//!
+//! # Clearance, fillets included
+//! `D` is exact for the sharp design, but the fillet's distance is defined only inside the
+//! arc's sector: a ball whose centre lies outside every sector (beyond a fillet's end, where
+//! the fillet stops at the hub's rim) can still reach into the fillet (a Ø1 ball beside the
+//! impeller-8+8 leading-edge roots cut 0.025–0.15 mm into the fillet's end). Clearance is
+//! therefore judged on a margin that bounds the true distance from below: a sphere of radius
+//! `ρ` about `p` is clear when `min(d_hub, d_blade) ≥ ρ` (sharp design) and, for the fillets,
+//! `max(d_hub, d_blade) ≥ reach + ρ` (the fillet material lies within
+//! [`ImpellerFillets::reach_mm`] of both walls) or, for every fillet `k` near `p`, `p` lies
+//! in one of its rolling balls (`R − d_k ≥ ρ`, `d_k` the distance to the spine: a rolling
+//! ball holds no material) or farther from its spine than its material spreads
+//! (`d_k ≥ (1 + CORNER_SLACK)·R/sin(β/2) + ρ`). The margin is 1-Lipschitz, so the motion
+//! certificates below hold for it. It is conservative: within about two fillet radii of a
+//! fillet's spine a ball is placed only inside the rolling balls, so near a fillet's end
+//! (where the rim corners keep material) locations are refused (`fillet_blocked_locations`).
+//!
+//! # Tool axis
+//! Every sample of the tool ([`cam_plan::DesignClearance::samples`]) above the ball centre
+//! keeps a margin `≥ −tol/2` on the fluted length; shank and holder keep the largest residual
+//! measured anywhere plus `tol` (they must not rub the stock that is still there). Axes are
+//! searched in rings of `step_deg` around the *preferred axis* (the sum of the unit normals of
+//! the walls within `r + tol` of the centre: the bisector of a corner) up to `max_tilt_deg`,
+//! tried in order of their angle to the previous station's axis (the same axis wherever it is
+//! clear, so the rotary axes move only where they must); the machine must reach the axis
+//! ([`cam_plan::PlanContext::reaches`]). A station with no clear axis is skipped.
+//!
+//! Every motion between consecutive stations is certified: for each tool sample (the ball
+//! included) the margin along the motion (centre linear, axis turned at constant rate) is a
+//! Lipschitz function with constant `|Δc| + |h − r|·Δθ`, bisected until each interval's lower
+//! bound `(f₀ + f₁)/2 − L·Δs/2` clears the floor (at most 2¹⁴ pieces). A motion that fails
+//! splits the pass; passes are joined at feed where that motion certifies, else linked over
+//! the safety surface ([`cam_plan::PlanContext::link`]).
+//!
+//! # Measured
+//! `residual_before_max_mm`, `target_area_mm2`: from the stock read. `residual_after_max_mm`:
+//! for every target sample, the distance above it of the nearest ball station `|p − c| − r`
+//! (an upper bound of what is left: the motions between stations cut more). Targets still
+//! above `threshold_mm` are *unreachable* with this tool (counted with their area): in a sharp
+//! concave corner of angle `β` a ball of radius `r` leaves `r(1/sin(β/2) − 1)` at the corner
+//! line whatever its path. `max_overcut_mm`: the largest negative margin of a station's ball (≤ tol/2 by construction).
+//!
+//! Cost: O(stations · iterations · design distance) for the centres, O(stations · axes tried
+//! · tool samples · design distance) for the postures, O(motions · samples · bisections) for
+//! the motions; regions run in parallel (rayon).
+
+use cam_core::{CutterLocation, Move, ToolPath};
+use cam_plan::{
+    ClearanceOptions, DesignClearance, Metrics, Operation, OperationSpec, PartSet, PlanContext,
+    PlanError, PlannedOperation, Plot, PlotKind, PlotSeries, Point3, RestGrid,
+};
+use impeller_model::fillet::{ImpellerFillets, CORNER_SLACK, DEFAULT_FILLET_TOL_MM};
+use nalgebra::{UnitQuaternion, Vector3};
+use rayon::prelude::*;
+use serde::Deserialize;
+
+use crate::accessibility::ball_radius;
+
+/// Kind key of rest finishing in job files.
+pub const REST_FINISHING: &str = "rest_finishing";
+
+/// Approach length above a path's first point (mm).
+const APPROACH_MM: f64 = 2.0;
+/// Fixed-point steps of a ball centre onto the offset surface.
+const SETTLE_STEPS: usize = 60;
+/// Accepted offset error of a settled centre (mm).
+const SETTLE_TOL_MM: f64 = 1e-7;
+/// Central-difference step of the distance gradient (mm).
+const GRAD_STEP_MM: f64 = 1e-5;
+/// Deepest bisection of a motion's certificate (2¹⁴ pieces).
+const MOTION_DEPTH: usize = 14;
+
+fn default_threshold() -> f64 {
+    0.1
+}
+fn default_scallop() -> f64 {
+    0.01
+}
+fn default_max_tilt() -> f64 {
+    75.0
+}
+fn default_step() -> f64 {
+    5.0
+}
+
+/// The kind's own job keys.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Params {
+    /// Residual above which a sample is rest material (mm).
+    #[serde(default = "default_threshold")]
+    threshold_mm: f64,
+    /// Scallop height between passes (mm).
+    #[serde(default = "default_scallop")]
+    scallop_mm: f64,
+    /// Largest angle of the axis from the preferred axis (degrees).
+    #[serde(default = "default_max_tilt")]
+    max_tilt_deg: f64,
+    /// Ring step of the axis search (degrees).
+    #[serde(default = "default_step")]
+    step_deg: f64,
+}
+
+/// Rest finishing, kind [`REST_FINISHING`].
+#[derive(Debug, Clone)]
+pub struct RestFinishing {
+    name: String,
+    tool: String,
+    params: Params,
+}
+
+/// Builds a [`RestFinishing`] from its job table. Keys: `threshold_mm` (> 0, default 0.1),
+/// `scallop_mm` (> 0, default 0.01), `max_tilt_deg` ([0, 89], default 75), `step_deg`
+/// ((0, 15], default 5).
+pub fn build_rest_finishing(spec: &OperationSpec) -> Result<Box<dyn Operation>, PlanError> {
+    let p: Params = cam_plan::params::parse(spec)?;
+    let bad = |key: &str, why: String| Err(PlanError::param(&spec.name, key, why));
+    if !(p.threshold_mm.is_finite() && p.threshold_mm > 0.0) {
+        return bad(
+            "threshold_mm",
+            format!("{} must be finite and > 0", p.threshold_mm),
+        );
+    }
+    if !(p.scallop_mm.is_finite() && p.scallop_mm > 0.0) {
+        return bad(
+            "scallop_mm",
+            format!("{} must be finite and > 0", p.scallop_mm),
+        );
+    }
+    if !(p.max_tilt_deg.is_finite() && (0.0..=89.0).contains(&p.max_tilt_deg)) {
+        return bad(
+            "max_tilt_deg",
+            format!("{} must be in [0, 89]", p.max_tilt_deg),
+        );
+    }
+    if !(p.step_deg.is_finite() && p.step_deg > 0.0 && p.step_deg <= 15.0) {
+        return bad("step_deg", format!("{} must be in (0, 15]", p.step_deg));
+    }
+    Ok(Box::new(RestFinishing {
+        name: spec.name.clone(),
+        tool: spec.tool.clone(),
+        params: p,
+    }))
+}
+
+/// A region: the grid it lies on and its samples `(i, j)`.
+#[derive(Debug, Clone)]
+struct Region {
+    grid: usize,
+    cells: Vec<(usize, usize)>,
+}
+
+/// The connected components (8-neighbourhood) of the samples of `g` above `threshold`.
+fn regions_of(g: &RestGrid, grid: usize, threshold: f64) -> Vec<Region> {
+    let above = |i: usize, j: usize| g.residual(i, j).is_some_and(|r| r > threshold);
+    let mut seen = vec![false; g.nu * g.nv];
+    let mut out = Vec::new();
+    for j0 in 0..g.nv {
+        for i0 in 0..g.nu {
+            if seen[j0 * g.nu + i0] || !above(i0, j0) {
+                continue;
+            }
+            seen[j0 * g.nu + i0] = true;
+            let mut stack = vec![(i0, j0)];
+            let mut cells = Vec::new();
+            while let Some((i, j)) = stack.pop() {
+                cells.push((i, j));
+                for dj in -1i64..=1 {
+                    for di in -1i64..=1 {
+                        let (ni, nj) = (i as i64 + di, j as i64 + dj);
+                        if ni < 0 || nj < 0 || ni >= g.nu as i64 || nj >= g.nv as i64 {
+                            continue;
+                        }
+                        let (ni, nj) = (ni as usize, nj as usize);
+                        if !seen[nj * g.nu + ni] && above(ni, nj) {
+                            seen[nj * g.nu + ni] = true;
+                            stack.push((ni, nj));
+                        }
+                    }
+                }
+            }
+            cells.sort_unstable_by_key(|&(i, j)| (j, i));
+            out.push(Region { grid, cells });
+        }
+    }
+    out
+}
+
+/// A ball station: centre, unit axis and the cutter location.
+#[derive(Debug, Clone, Copy)]
+struct Station {
+    centre: Vector3<f64>,
+    axis: Vector3<f64>,
+    cl: CutterLocation,
+}
+
+/// The planner of one operation: the design distance with fillets, the tool's samples and
+/// the floors.
+struct Planner<'a> {
+    ctx: &'a PlanContext<'a>,
+    material: DesignClearance<'a>,
+    fillets: Option<ImpellerFillets>,
+    r: f64,
+    tol: f64,
+    /// Tool samples above the ball centre: (height above the tip, radius, floor).
+    upper: Vec<(f64, f64, f64)>,
+    max_tilt: f64,
+    step: f64,
+}
+
+/// The signed distance of one wall (hub, blades, fillets) where it is defined.
+type WallDistance<'a> = dyn Fn(&Vector3<f64>) -> Option<f64> + 'a;
+
+/// Per-region outcome.
+#[derive(Debug, Default)]
+struct RegionResult {
+    runs: Vec<Vec<Station>>,
+    passes: usize,
+    skipped: usize,
+    unsettled: usize,
+    fillet_blocked: usize,
+    split: usize,
+    max_overcut: f64,
+}
+
+impl Planner<'_> {
+    /// `D(p)`: signed distance to hub, blades and fillets (module docs).
+    fn distance(&self, p: &Vector3<f64>) -> f64 {
+        let d = self.material.design_signed_distance(&Point3::from(*p)).0;
+        match self
+            .fillets
+            .as_ref()
+            .and_then(|f| f.closest(p).map(|(d, _)| d))
+        {
+            Some(f) => d.min(f),
+            None => d,
+        }
+    }
+
+    /// Clearance margin of the sphere of radius `rho` about `p` (≥ 0: clear of hub, blades
+    /// and fillets): the sharp design's `min(d_hub, d_blade) − ρ`, and for the fillets
+    /// `max(max(d_hub, d_blade) − reach − ρ, min_k(R − d_k − ρ))` with `d_k` the distance to
+    /// fillet `k`'s spine (module docs). 1-Lipschitz in `p`.
+    fn margin(&self, p: &Vector3<f64>, rho: f64) -> f64 {
+        let q = Point3::from(*p);
+        let hub = self.material.hub_signed_distance(&q);
+        let blade = self.material.blade_signed_distance(&q).0;
+        let sharp = hub.min(blade) - rho;
+        let Some(f) = &self.fillets else {
+            return sharp;
+        };
+        let far = hub.max(blade) - f.reach_mm() - rho;
+        if far >= sharp {
+            return sharp;
+        }
+        // Per fillet: inside one of its rolling balls, or farther from its spine than the
+        // fillet material reaches: the material lies in the spine's normal planes, in the
+        // sector between the contacts, on the air side of both walls' tangent planes moved
+        // in by CORNER_SLACK·R, so within (1 + CORNER_SLACK)·R/sin(β/2) of the spine.
+        let spread = (f.reach_mm() - f.radius()) * (1.0 + CORNER_SLACK);
+        let mut per_fillet = f64::INFINITY;
+        let mut visited = false;
+        f.spine_distances(p, |d| {
+            visited = true;
+            per_fillet = per_fillet.min((f.radius() - d - rho).max(d - spread - rho));
+        });
+        if !visited {
+            per_fillet = f64::NEG_INFINITY;
+        }
+        sharp.min(far.max(per_fillet))
+    }
+
+    fn gradient(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        let h = GRAD_STEP_MM;
+        let mut g = Vector3::zeros();
+        for k in 0..3 {
+            let mut e = Vector3::zeros();
+            e[k] = h;
+            g[k] = (self.distance(&(p + e)) - self.distance(&(p - e))) / (2.0 * h);
+        }
+        g
+    }
+
+    /// The ball centre of pass sample `s` on the offset surface `D = r` (module docs).
+    fn settle(&self, s: &Vector3<f64>) -> Option<Vector3<f64>> {
+        let mut c = *s;
+        for _ in 0..SETTLE_STEPS {
+            let e = self.r - self.distance(&c);
+            if e.abs() <= SETTLE_TOL_MM {
+                return Some(c);
+            }
+            let g = self.gradient(&c).try_normalize(1e-9)?;
+            c += g * e;
+        }
+        None
+    }
+
+    /// The preferred axis at centre `c`: the sum of the unit normals of the walls (hub,
+    /// blade, fillet) within `r + tol` of it.
+    fn preferred_axis(&self, c: &Vector3<f64>) -> Vector3<f64> {
+        let near = self.r + self.tol;
+        let h = GRAD_STEP_MM;
+        let parts: [&WallDistance<'_>; 3] = [
+            &|p| Some(self.material.hub_signed_distance(&Point3::from(*p))),
+            &|p| Some(self.material.blade_signed_distance(&Point3::from(*p)).0),
+            &|p| {
+                self.fillets
+                    .as_ref()
+                    .and_then(|f| f.closest(p).map(|(d, _)| d))
+            },
+        ];
+        let mut sum = Vector3::zeros();
+        for f in parts {
+            if !f(c).is_some_and(|d| d <= near) {
+                continue;
+            }
+            let mut g = Vector3::zeros();
+            for k in 0..3 {
+                let mut e = Vector3::zeros();
+                e[k] = h;
+                match (f(&(c + e)), f(&(c - e))) {
+                    (Some(a), Some(b)) => g[k] = (a - b) / (2.0 * h),
+                    _ => return self.gradient(c).try_normalize(1e-9).unwrap_or(Vector3::z()),
+                }
+            }
+            if let Some(u) = g.try_normalize(1e-9) {
+                sum += u;
+            }
+        }
+        sum.try_normalize(1e-9)
+            .unwrap_or_else(|| self.gradient(c).try_normalize(1e-9).unwrap_or(Vector3::z()))
+    }
+
+    /// Smallest margin of the tool above the ball over its floors at `(c, axis)` (negative:
+    /// not clear); stops below 0.
+    fn posture_margin(&self, c: &Vector3<f64>, axis: &Vector3<f64>) -> f64 {
+        let tip = c - axis * self.r;
+        let mut best = f64::INFINITY;
+        for &(h, rho, floor) in &self.upper {
+            let m = self.margin(&(tip + axis * h), rho) - floor;
+            best = best.min(m);
+            if best < 0.0 {
+                return best;
+            }
+        }
+        best
+    }
+
+    /// The axes tried at `c` (module docs), nearest to `prefer_near` first.
+    fn candidate_axes(
+        &self,
+        c: &Vector3<f64>,
+        prefer_near: Option<&Vector3<f64>>,
+    ) -> Vec<Vector3<f64>> {
+        let a0 = self.preferred_axis(c);
+        let u = a0
+            .cross(&Vector3::x())
+            .try_normalize(1e-6)
+            .unwrap_or_else(|| a0.cross(&Vector3::y()).normalize());
+        let v = a0.cross(&u);
+        let rings = (self.max_tilt / self.step).floor() as usize;
+        let mut out = vec![a0];
+        for k in 1..=rings {
+            let th = k as f64 * self.step;
+            let m = ((std::f64::consts::TAU * th.sin() / self.step).ceil() as usize).max(6);
+            for q in 0..m {
+                let ph = std::f64::consts::TAU * q as f64 / m as f64;
+                out.push((a0 * th.cos() + (u * ph.cos() + v * ph.sin()) * th.sin()).normalize());
+            }
+        }
+        let target = prefer_near.copied().unwrap_or(a0);
+        out.sort_by(|a, b| b.dot(&target).total_cmp(&a.dot(&target)));
+        if let Some(p) = prefer_near {
+            if p.dot(&a0) >= self.max_tilt.cos() {
+                out.insert(0, *p);
+            }
+        }
+        out
+    }
+
+    /// A clear posture with its ball centre at `c` (None: none within the search).
+    fn posture(&self, c: &Vector3<f64>, prev: Option<&Vector3<f64>>) -> Option<Station> {
+        self.candidate_axes(c, prev).into_iter().find_map(|a| {
+            if !self.ctx.reaches(&a) || self.posture_margin(c, &a) < 0.0 {
+                return None;
+            }
+            let cl = CutterLocation::new(Point3::from(c - a * self.r), a).ok()?;
+            Some(Station {
+                centre: *c,
+                axis: a,
+                cl,
+            })
+        })
+    }
+
+    /// Whether the motion from `a` to `b` is certified clear (module docs).
+    fn motion_clear(&self, a: &Station, b: &Station) -> bool {
+        let turn = UnitQuaternion::rotation_between(&a.axis, &b.axis)
+            .map(|q| q.scaled_axis())
+            .unwrap_or_else(Vector3::zeros);
+        let theta = turn.norm();
+        let dc = (b.centre - a.centre).norm();
+        let at = |s: f64, h: f64| -> Vector3<f64> {
+            let axis = UnitQuaternion::from_scaled_axis(turn * s) * a.axis;
+            let c = a.centre + (b.centre - a.centre) * s;
+            c + axis * (h - self.r)
+        };
+        let ball = (self.r, self.r, -0.5 * self.tol);
+        // Non-cutting parts keep their floor; the whole tool keeps `margin ≥ floor`.
+        std::iter::once(ball)
+            .chain(self.upper.iter().copied())
+            .all(|(h, rho, floor)| {
+                let f = |s: f64| self.margin(&at(s, h), rho);
+                let lip = dc + (h - self.r).abs() * theta;
+                certify(&f, lip, floor, (0.0, f(0.0)), (1.0, f(1.0)), 0)
+            })
+    }
+
+    /// Plans the passes of `region` on `g`.
+    fn plan_region(&self, g: &RestGrid, region: &Region, step: f64) -> RegionResult {
+        let mut res = RegionResult::default();
+        let (mut i0, mut i1, mut j0, mut j1) = (usize::MAX, 0, usize::MAX, 0);
+        for &(i, j) in &region.cells {
+            i0 = i0.min(i);
+            i1 = i1.max(i);
+            j0 = j0.min(j);
+            j1 = j1.max(j);
+        }
+        // One cell around the region, inside the grid.
+        let (i0, j0) = (i0.saturating_sub(1), j0.saturating_sub(1));
+        let (i1, j1) = ((i1 + 1).min(g.nu - 1), (j1 + 1).min(g.nv - 1));
+        let length = |along_i: bool, k: usize| -> f64 {
+            let (lo, hi) = if along_i { (i0, i1) } else { (j0, j1) };
+            (lo..hi)
+                .filter_map(|a| {
+                    let (p, q) = if along_i {
+                        (g.point(a, k), g.point(a + 1, k))
+                    } else {
+                        (g.point(k, a), g.point(k, a + 1))
+                    };
+                    Some((Vector3::from(p?) - Vector3::from(q?)).norm())
+                })
+                .sum()
+        };
+        let len_i = (j0..=j1).map(|j| length(true, j)).fold(0.0, f64::max);
+        let len_j = (i0..=i1).map(|i| length(false, i)).fold(0.0, f64::max);
+        let along_i = len_i >= len_j;
+        let (len_along, len_across) = if along_i {
+            (len_i, len_j)
+        } else {
+            (len_j, len_i)
+        };
+        let n_across = ((len_across / step).ceil() as usize + 1).max(1);
+        let n_along = ((len_along / (0.25 * self.r)).ceil() as usize + 1).max(2);
+        let in_region = |fi: f64, fj: f64| {
+            let (ci, cj) = (fi.round() as i64, fj.round() as i64);
+            region
+                .cells
+                .iter()
+                .any(|&(i, j)| (i as i64 - ci).abs() <= 1 && (j as i64 - cj).abs() <= 1)
+        };
+        let mut prev_axis: Option<Vector3<f64>> = None;
+        for k in 0..n_across {
+            let fk = if n_across == 1 {
+                0.5
+            } else {
+                k as f64 / (n_across - 1) as f64
+            };
+            let mut run: Vec<Station> = Vec::new();
+            let mut pass_runs = Vec::new();
+            let order: Vec<usize> = if k % 2 == 0 {
+                (0..n_along).collect()
+            } else {
+                (0..n_along).rev().collect()
+            };
+            for q in order {
+                let fq = q as f64 / (n_along - 1) as f64;
+                let (fi, fj) = if along_i {
+                    (
+                        i0 as f64 + fq * (i1 - i0) as f64,
+                        j0 as f64 + fk * (j1 - j0) as f64,
+                    )
+                } else {
+                    (
+                        i0 as f64 + fk * (i1 - i0) as f64,
+                        j0 as f64 + fq * (j1 - j0) as f64,
+                    )
+                };
+                let station = in_region(fi, fj)
+                    .then(|| bilinear(g, fi, fj))
+                    .flatten()
+                    .and_then(|s| {
+                        let c = self.settle(&s);
+                        if c.is_none() {
+                            res.unsettled += 1;
+                        }
+                        c
+                    })
+                    .filter(|c| {
+                        let clear = self.margin(c, self.r) >= -0.5 * self.tol;
+                        if !clear {
+                            res.fillet_blocked += 1;
+                        }
+                        clear
+                    })
+                    .and_then(|c| {
+                        let st = self.posture(&c, prev_axis.as_ref());
+                        if st.is_none() {
+                            res.skipped += 1;
+                        }
+                        st
+                    });
+                let Some(st) = station else {
+                    if !run.is_empty() {
+                        pass_runs.push(std::mem::take(&mut run));
+                    }
+                    continue;
+                };
+                prev_axis = Some(st.axis);
+                res.max_overcut = res.max_overcut.max(-self.margin(&st.centre, self.r));
+                if let Some(last) = run.last() {
+                    if (last.centre - st.centre).norm() < 1e-4 {
+                        continue;
+                    }
+                    if !self.motion_clear(last, &st) {
+                        res.split += 1;
+                        pass_runs.push(std::mem::take(&mut run));
+                    }
+                }
+                run.push(st);
+            }
+            if !run.is_empty() {
+                pass_runs.push(run);
+            }
+            if !pass_runs.is_empty() {
+                res.passes += 1;
+            }
+            res.runs.extend(pass_runs);
+        }
+        res.max_overcut = res.max_overcut.max(0.0);
+        res
+    }
+
+    /// The runs of one region as a closed path: consecutive runs joined at feed where the
+    /// motion certifies and is at most `near` long, else linked.
+    fn path(
+        &self,
+        name: String,
+        tool: &str,
+        runs: &[Vec<Station>],
+        near: f64,
+    ) -> Result<(ToolPath, usize), PlanError> {
+        let mut path = ToolPath::new(name, tool);
+        let mut joined = 0;
+        let mut last: Option<Station> = None;
+        for run in runs {
+            let Some(first) = run.first() else { continue };
+            match last {
+                None => path.moves.push(Move::feed(first.cl)),
+                Some(l) => {
+                    if (l.centre - first.centre).norm() <= near && self.motion_clear(&l, first) {
+                        path.moves.push(Move::feed(first.cl));
+                        joined += 1;
+                    } else {
+                        path.moves
+                            .extend(self.ctx.link(&l.cl, &first.cl, APPROACH_MM)?);
+                    }
+                }
+            }
+            path.moves
+                .extend(run.iter().skip(1).map(|s| Move::feed(s.cl)));
+            last = run.last().copied();
+        }
+        self.ctx.close(&mut path, APPROACH_MM)?;
+        Ok((path, joined))
+    }
+}
+
+/// Whether `f` (Lipschitz constant `lip` on `[a.0, b.0]`, values `a.1`, `b.1` at the ends)
+/// stays at or above `floor` on the interval: the lower bound `(f(a) + f(b))/2 − lip·(b − a)/2`
+/// of a Lipschitz function, bisected until it clears (at most [`MOTION_DEPTH`] levels).
+fn certify(
+    f: &dyn Fn(f64) -> f64,
+    lip: f64,
+    floor: f64,
+    a: (f64, f64),
+    b: (f64, f64),
+    depth: usize,
+) -> bool {
+    if a.1 < floor || b.1 < floor {
+        return false;
+    }
+    if 0.5 * (a.1 + b.1) - 0.5 * lip * (b.0 - a.0) >= floor {
+        return true;
+    }
+    if depth >= MOTION_DEPTH {
+        return false;
+    }
+    let m = 0.5 * (a.0 + b.0);
+    let fm = (m, f(m));
+    certify(f, lip, floor, a, fm, depth + 1) && certify(f, lip, floor, fm, b, depth + 1)
+}
+
+/// The grid point at fractional indices `(fi, fj)`, bilinear between its four samples
+/// (`None` where one is missing or outside the surface).
+fn bilinear(g: &RestGrid, fi: f64, fj: f64) -> Option<Vector3<f64>> {
+    let i = (fi.floor() as usize).min(g.nu.saturating_sub(2));
+    let j = (fj.floor() as usize).min(g.nv.saturating_sub(2));
+    let (a, b) = (
+        (fi - i as f64).clamp(0.0, 1.0),
+        (fj - j as f64).clamp(0.0, 1.0),
+    );
+    let p = |i: usize, j: usize| -> Option<Vector3<f64>> {
+        g.residual(i, j)?;
+        g.point(i, j).map(Vector3::from)
+    };
+    let (p00, p10) = (p(i, j)?, p(i + 1, j)?);
+    let (p01, p11) = (p(i, j + 1)?, p(i + 1, j + 1)?);
+    Some(
+        p00 * ((1.0 - a) * (1.0 - b))
+            + p10 * (a * (1.0 - b))
+            + p01 * ((1.0 - a) * b)
+            + p11 * (a * b),
+    )
+}
+
+impl Operation for RestFinishing {
+    fn kind(&self) -> &'static str {
+        REST_FINISHING
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn tool(&self) -> &str {
+        &self.tool
+    }
+    fn needs_remaining(&self) -> bool {
+        true
+    }
+    fn plan(&self, ctx: &PlanContext<'_>) -> Result<PlannedOperation, PlanError> {
+        let r = ball_radius(ctx, &self.name, "rest finishing")?;
+        let remaining = ctx.remaining.ok_or_else(|| {
+            PlanError::geometry(
+                &self.name,
+                "the stock",
+                "rest finishing plans from the stock the earlier operations leave, and none was given (it needs earlier operations in the job)",
+            )
+        })?;
+        let tol = ctx.tolerances.machining_tol;
+        let fillets = ImpellerFillets::new(ctx.impeller, DEFAULT_FILLET_TOL_MM)
+            .map_err(|e| PlanError::geometry(&self.name, "blade-root fillets", e.to_string()))?;
+        let stock_margin = remaining.max_residual_mm() + tol;
+        let flutes = ctx.tool.cutter.flute_length;
+        let upper = ctx
+            .clearance
+            .samples()
+            .filter(|&(h, _)| h > r + 1e-9)
+            .map(|(h, rho)| {
+                let floor = if h <= flutes {
+                    -0.5 * tol
+                } else {
+                    stock_margin
+                };
+                (h, rho, floor)
+            })
+            .collect();
+        let planner = Planner {
+            ctx,
+            material: ctx.clearance.with_options(ClearanceOptions {
+                parts: PartSet::MATERIAL,
+                ..ctx.clearance.options()
+            }),
+            fillets,
+            r,
+            tol,
+            upper,
+            max_tilt: self.params.max_tilt_deg.to_radians(),
+            step: self.params.step_deg.to_radians(),
+        };
+        let step = cam_core::ball_step_over(r, 0.0, self.params.scallop_mm)
+            .map_err(|e| PlanError::param(&self.name, "scallop_mm", e.to_string()))?;
+        let threshold = self.params.threshold_mm;
+        let regions: Vec<Region> = remaining
+            .grids
+            .iter()
+            .enumerate()
+            .flat_map(|(k, g)| regions_of(g, k, threshold))
+            .collect();
+        let results: Vec<RegionResult> = regions
+            .par_iter()
+            .map(|reg| planner.plan_region(&remaining.grids[reg.grid], reg, step))
+            .collect();
+
+        // What each target keeps: the nearest station's ball (an upper bound).
+        let centres: Vec<Vector3<f64>> = results
+            .iter()
+            .flat_map(|res| res.runs.iter().flatten().map(|s| s.centre))
+            .collect();
+        let mut target_points = 0usize;
+        let (mut area, mut unreachable_area, mut unreachable) = (0.0, 0.0, 0usize);
+        let (mut before_max, mut after_max): (f64, f64) = (0.0, 0.0);
+        let mut before_series = Vec::new();
+        let mut after_series = Vec::new();
+        for reg in &regions {
+            let g = &remaining.grids[reg.grid];
+            for &(i, j) in &reg.cells {
+                let (Some(p), Some(before)) = (g.point(i, j), g.residual(i, j)) else {
+                    continue;
+                };
+                let p = Vector3::from(p);
+                let cell = g.cell_area_mm2(i, j);
+                target_points += 1;
+                area += cell;
+                before_max = before_max.max(before);
+                let ball = centres
+                    .iter()
+                    .map(|c| (p - c).norm() - r)
+                    .fold(f64::INFINITY, f64::min)
+                    .max(0.0);
+                let after = before.min(ball);
+                after_max = after_max.max(after);
+                let rz = [p.x.hypot(p.y), p.z];
+                before_series.push(rz);
+                if after > threshold {
+                    unreachable += 1;
+                    unreachable_area += cell;
+                    after_series.push(rz);
+                }
+            }
+        }
+
+        let mut paths = Vec::new();
+        let mut joined = 0usize;
+        let mut sum = RegionResult::default();
+        let mut order: Vec<(f64, usize)> = results
+            .iter()
+            .enumerate()
+            .filter_map(|(k, res)| {
+                let c = res.runs.first()?.first()?.centre;
+                Some((c.y.atan2(c.x), k))
+            })
+            .collect();
+        order.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for &(_, k) in &order {
+            let res = &results[k];
+            let surface = &remaining.grids[regions[k].grid].surface;
+            let (path, j) = planner.path(
+                format!("{} {surface} region {k}", self.name),
+                &self.tool,
+                &res.runs,
+                2.0 * step + r,
+            )?;
+            joined += j;
+            paths.push(path);
+        }
+        for res in &results {
+            sum.passes += res.passes;
+            sum.skipped += res.skipped;
+            sum.unsettled += res.unsettled;
+            sum.fillet_blocked += res.fillet_blocked;
+            sum.split += res.split;
+            sum.max_overcut = sum.max_overcut.max(res.max_overcut);
+        }
+        let stations = centres.len();
+        let mut metrics = Metrics::new();
+        metrics
+            .count("regions", regions.len())
+            .count("target_points", target_points)
+            .number("target_area_mm2", area)
+            .number("threshold_mm", threshold)
+            .number("residual_before_max_mm", before_max)
+            .number("residual_after_max_mm", after_max)
+            .count("unreachable_points", unreachable)
+            .number("unreachable_area_mm2", unreachable_area)
+            .count("passes", sum.passes)
+            .count("stations", stations)
+            .count("skipped_locations", sum.skipped)
+            .count("unsettled_locations", sum.unsettled)
+            .count("fillet_blocked_locations", sum.fillet_blocked)
+            .count("split_motions", sum.split)
+            .number("step_over_mm", step)
+            .number("max_overcut_mm", sum.max_overcut);
+        let mut notes = vec![format!(
+            "{} regions above {threshold} mm after {} ({target_points} samples, {area:.2} mm²; largest residual {before_max:.3} mm): {} passes, {stations} ball stations, {joined} pass-to-pass steps at feed; largest residual left at the stations {after_max:.3} mm",
+            regions.len(),
+            remaining.after.join(", "),
+            sum.passes,
+        )];
+        if unreachable > 0 {
+            notes.push(format!(
+                "{unreachable} samples ({unreachable_area:.2} mm²) stay above {threshold} mm: no station of the ball of radius {r} mm cuts them below it (corners sharper than the ball, or locations left out: see below)"
+            ));
+        }
+        if sum.skipped > 0 || sum.unsettled > 0 || sum.split > 0 || sum.fillet_blocked > 0 {
+            notes.push(format!(
+                "{} locations without a clear axis within {}° of the preferred one, {} whose ball centre did not settle, {} whose ball cannot be certified clear of a fillet (near both walls and outside every rolling ball: at a fillet's end), {} motions not clear as a whole (split there)",
+                sum.skipped, self.params.max_tilt_deg, sum.unsettled, sum.fillet_blocked, sum.split
+            ));
+        }
+        if regions.is_empty() {
+            notes.push(format!(
+                "nothing above {threshold} mm is left: no rest to machine"
+            ));
+        }
+        let plots = vec![Plot {
+            title: "Rest material (meridional view): samples above the threshold before, and those the stations leave above it".into(),
+            kind: PlotKind::Lines {
+                x_label: "radius (mm)".into(),
+                y_label: "z (mm)".into(),
+                series: vec![
+                    PlotSeries {
+                        label: "before".into(),
+                        points: before_series,
+                    },
+                    PlotSeries {
+                        label: "left (unreachable)".into(),
+                        points: after_series,
+                    },
+                ],
+                equal_aspect: true,
+            },
+        }];
+        Ok(PlannedOperation {
+            paths,
+            metrics,
+            plots,
+            notes,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn regions_are_the_connected_components_above_the_threshold() {
+        let (nu, nv) = (6, 4);
+        let mut residual = vec![Some(0.0); nu * nv];
+        for (i, j) in [(0, 0), (1, 1), (4, 2), (5, 3), (5, 0)] {
+            residual[j * nu + i] = Some(0.2);
+        }
+        residual[3] = None;
+        let g = RestGrid {
+            surface: "hub".into(),
+            nu,
+            nv,
+            points: (0..nu * nv)
+                .map(|k| [(k % nu) as f64, (k / nu) as f64, 0.0])
+                .collect(),
+            residual_mm: residual,
+        };
+        let regs = regions_of(&g, 0, 0.1);
+        let mut sizes: Vec<usize> = regs.iter().map(|r| r.cells.len()).collect();
+        sizes.sort_unstable();
+        // (0,0)-(1,1) touch diagonally; (4,2)-(5,3) too; (5,0) stands alone.
+        assert_eq!(sizes, vec![1, 2, 2]);
+    }
+
+    #[test]
+    fn certify_finds_a_dip_between_clear_ends() {
+        // f(s) = |s − 0.5| − 0.01 dips below 0 at the middle; Lipschitz constant 1.
+        let f = |s: f64| (s - 0.5).abs() - 0.01;
+        assert!(!certify(&f, 1.0, 0.0, (0.0, f(0.0)), (1.0, f(1.0)), 0));
+        // Lifted by 0.02 it stays above 0 everywhere and is certified.
+        let g = |s: f64| (s - 0.5).abs() + 0.01;
+        assert!(certify(&g, 1.0, 0.0, (0.0, g(0.0)), (1.0, g(1.0)), 0));
+    }
+
+    #[test]
+    fn bilinear_interpolates_inside_and_refuses_missing_samples() {
+        let g = RestGrid {
+            surface: "s".into(),
+            nu: 2,
+            nv: 2,
+            points: vec![
+                [0.0, 0.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [0.0, 2.0, 0.0],
+                [2.0, 2.0, 4.0],
+            ],
+            residual_mm: vec![Some(0.0), Some(0.0), Some(0.0), Some(0.0)],
+        };
+        let p = bilinear(&g, 0.5, 0.5).unwrap();
+        assert!((p - Vector3::new(1.0, 1.0, 1.0)).norm() < 1e-12);
+        let mut h = g.clone();
+        h.residual_mm[3] = None;
+        assert!(bilinear(&h, 0.5, 0.5).is_none());
+    }
+}
