@@ -13,10 +13,9 @@
 //! area is the sum of its samples' cells ([`cam_plan::RestGrid::cell_area_mm2`]).
 //!
 //! # Ball centres
-//! Let `D(p)` be the signed distance of `p` to the design material: hub body and every blade
-//! (exact NURBS, [`cam_plan::DesignClearance::design_signed_distance`]) and, inside their
-//! arcs' sectors, the blade-root fillets (the rolling-ball blend,
-//! [`impeller_model::fillet::ImpellerFillets`]), positive in the air. A region's cut is made of *passes* along the
+//! Let `D(p)` be a lower bound of the distance of `p` to the design material, positive in the
+//! air, exact on hub and blades (NURBS, [`cam_plan::DesignClearance`]) and away from the
+//! blade-root fillets, conservative by the wedge bound near them (see below). A region's cut is made of *passes* along the
 //! grid direction in which the region is longer, at most one step-over apart across it (the
 //! exact circle–circle step-over of a flat surface, [`cam_core::ball_step_over`], for
 //! `scallop_mm`), sampled at most `0.25·r` apart along. Each pass sample is a point `s` of the
@@ -29,25 +28,26 @@
 //! is left out (its pass is split there).
 //!
 //! # Clearance, fillets included
-//! `D` is exact for the sharp design, but the fillet's distance is defined only inside the
-//! arc's sector: a ball whose centre lies outside every sector (beyond a fillet's end, where
-//! the fillet stops at the hub's rim) can still reach into the fillet (a Ø1 ball beside the
-//! impeller-8+8 leading-edge roots cut 0.025–0.15 mm into the fillet's end). Clearance is
-//! therefore judged on a margin that bounds the true distance from below: a sphere of radius
-//! `ρ` about `p` is clear when `min(d_hub, d_blade) ≥ ρ` (sharp design) and, for the fillets,
-//! `max(d_hub, d_blade) ≥ reach + ρ` (the fillet material lies within
-//! [`ImpellerFillets::reach_mm`] of both walls) or, for every fillet `k` near `p`, `p` lies
-//! in one of its rolling balls (`R − d_k ≥ ρ`, `d_k` the distance to the spine: a rolling
-//! ball holds no material) or farther from its spine than its material spreads
-//! (`d_k ≥ (1 + CORNER_SLACK)·R/sin(β/2) + ρ`). The margin is 1-Lipschitz, so the motion
-//! certificates below hold for it. It is conservative: within about two fillet radii of a
-//! fillet's spine a ball is placed only inside the rolling balls, so near a fillet's end
-//! (where the rim corners keep material) locations are refused (`fillet_blocked_locations`).
+//! The fillet's distance is defined only inside the arc's sector: a ball whose centre lies
+//! outside every sector (beyond a fillet's end, where the fillet stops at the hub's rim) can
+//! still reach into the fillet (a Ø1 ball beside the impeller-8+8 leading-edge roots cut
+//! 0.025–0.15 mm into the fillet's end when judged on it). Clearance and the centres are
+//! therefore judged on a margin that bounds the true distance from below everywhere: a
+//! sphere of radius `ρ` about `p` is clear when `min(d_hub, d_blade) ≥ ρ` (sharp design) and,
+//! for the fillets, `max(d_hub, d_blade) ≥ reach + ρ` (the fillet material lies within
+//! [`ImpellerFillets::reach_mm`] of both walls) or, for every fillet near `p`, `p` lies in one
+//! of its rolling balls (`R − d_spine ≥ ρ`: a rolling ball holds no material) or the lower
+//! bound of its distance to the fillet's material is `≥ ρ`
+//! ([`ImpellerFillets::material_bounds`]: the material lies section by section in the wedge
+//! of the contact directions, sampled every 0.01 mm of spine, each sample's exact distance
+//! less its neighbours' spread). The margin is 1-Lipschitz, so the motion certificates below
+//! hold for it; `D(p)` above is the margin of the point `p` (ρ = 0).
 //!
 //! # Tool axis
-//! Every sample of the tool ([`cam_plan::DesignClearance::samples`]) above the ball centre
-//! keeps a margin `≥ −tol/2` on the fluted length; shank and holder keep the largest residual
-//! measured anywhere plus `tol` (they must not rub the stock that is still there). Axes are
+//! Every cutter sample ([`cam_plan::DesignClearance::samples`]) above the ball centre keeps a
+//! margin `≥ −tol/2`; shank and holder (the query's frusta against the design mesh) keep the
+//! largest residual measured anywhere plus `tol` (they must not rub the stock that is still
+//! there), along motions too ([`cam_plan::DesignClearance::segment_clearance`]). Axes are
 //! searched in rings of `step_deg` around the *preferred axis* (the sum of the unit normals of
 //! the walls within `r + tol` of the centre: the bisector of a corner) up to `max_tilt_deg`,
 //! tried in order of their angle to the previous station's axis (the same axis wherever it is
@@ -63,8 +63,9 @@
 //!
 //! # Measured
 //! `residual_before_max_mm`, `target_area_mm2`: from the stock read. `residual_after_max_mm`:
-//! for every target sample, the distance above it of the nearest ball station `|p − c| − r`
-//! (an upper bound of what is left: the motions between stations cut more). Targets still
+//! for every target sample, the height along its normal to the first ball station the normal
+//! meets, as the verifier measures residual (an upper bound of what is left: the motions
+//! between stations cut more). Targets still
 //! above `threshold_mm` are *unreachable* with this tool (counted with their area): in a sharp
 //! concave corner of angle `β` a ball of radius `r` leaves `r(1/sin(β/2) − 1)` at the corner
 //! line whatever its path. `max_overcut_mm`: the largest negative margin of a station's ball (≤ tol/2 by construction).
@@ -78,7 +79,7 @@ use cam_plan::{
     ClearanceOptions, DesignClearance, Metrics, Operation, OperationSpec, PartSet, PlanContext,
     PlanError, PlannedOperation, Plot, PlotKind, PlotSeries, Point3, RestGrid,
 };
-use impeller_model::fillet::{ImpellerFillets, CORNER_SLACK, DEFAULT_FILLET_TOL_MM};
+use impeller_model::fillet::{ImpellerFillets, DEFAULT_FILLET_TOL_MM};
 use nalgebra::{UnitQuaternion, Vector3};
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -96,6 +97,8 @@ const SETTLE_STEPS: usize = 60;
 const SETTLE_TOL_MM: f64 = 1e-7;
 /// Central-difference step of the distance gradient (mm).
 const GRAD_STEP_MM: f64 = 1e-5;
+/// Queries allowed to certify the shank and holder along a motion.
+const SHANK_QUERIES: usize = 64;
 /// Deepest bisection of a motion's certificate (2¹⁴ pieces).
 const MOTION_DEPTH: usize = 14;
 
@@ -231,8 +234,12 @@ struct Planner<'a> {
     fillets: Option<ImpellerFillets>,
     r: f64,
     tol: f64,
-    /// Tool samples above the ball centre: (height above the tip, radius, floor).
+    /// Cutter samples above the ball centre: (height above the tip, radius, floor).
     upper: Vec<(f64, f64, f64)>,
+    /// Shank and holder against hub and blades (the cutter left out).
+    shank: DesignClearance<'a>,
+    /// What shank and holder keep from the design: the largest residual plus `tol`.
+    stock_margin: f64,
     max_tilt: f64,
     step: f64,
 }
@@ -253,17 +260,10 @@ struct RegionResult {
 }
 
 impl Planner<'_> {
-    /// `D(p)`: signed distance to hub, blades and fillets (module docs).
+    /// `D(p)`: the lower bound of the distance to hub, blades and fillets (module docs),
+    /// [`Self::margin`] of a point.
     fn distance(&self, p: &Vector3<f64>) -> f64 {
-        let d = self.material.design_signed_distance(&Point3::from(*p)).0;
-        match self
-            .fillets
-            .as_ref()
-            .and_then(|f| f.closest(p).map(|(d, _)| d))
-        {
-            Some(f) => d.min(f),
-            None => d,
-        }
+        self.margin(p, 0.0)
     }
 
     /// Clearance margin of the sphere of radius `rho` about `p` (≥ 0: clear of hub, blades
@@ -282,16 +282,14 @@ impl Planner<'_> {
         if far >= sharp {
             return sharp;
         }
-        // Per fillet: inside one of its rolling balls, or farther from its spine than the
-        // fillet material reaches: the material lies in the spine's normal planes, in the
-        // sector between the contacts, on the air side of both walls' tangent planes moved
-        // in by CORNER_SLACK·R, so within (1 + CORNER_SLACK)·R/sin(β/2) of the spine.
-        let spread = (f.reach_mm() - f.radius()) * (1.0 + CORNER_SLACK);
+        // Per fillet: inside one of its rolling balls, or clear of its material by the
+        // wedge bound (ImpellerFillets::material_bounds).
         let mut per_fillet = f64::INFINITY;
         let mut visited = false;
-        f.spine_distances(p, |d| {
+        // A material bound at or above the sharp distance changes nothing: capped there.
+        f.material_bounds(p, sharp + rho, |spine, material| {
             visited = true;
-            per_fillet = per_fillet.min((f.radius() - d - rho).max(d - spread - rho));
+            per_fillet = per_fillet.min((f.radius() - spine - rho).max(material - rho));
         });
         if !visited {
             per_fillet = f64::NEG_INFINITY;
@@ -322,6 +320,34 @@ impl Planner<'_> {
             c += g * e;
         }
         None
+    }
+
+    /// The outward unit normal at the design point `p` of the surface named `surface` (the
+    /// verifier's names: `hub`, `<blade>_fillet_<side>`, blade sides and tips): the
+    /// gradient of that part's distance (central differences).
+    fn surface_normal(&self, surface: &str, p: &Vector3<f64>) -> Vector3<f64> {
+        let part = |q: &Vector3<f64>| -> f64 {
+            let pt = Point3::from(*q);
+            if surface == "hub" {
+                self.material.hub_signed_distance(&pt)
+            } else if surface.contains("_fillet_") {
+                self.fillets
+                    .as_ref()
+                    .and_then(|f| f.closest(q))
+                    .map_or_else(|| self.distance(q), |(d, _)| d)
+            } else {
+                self.material.blade_signed_distance(&pt).0
+            }
+        };
+        let h = GRAD_STEP_MM;
+        let mut g = Vector3::zeros();
+        for k in 0..3 {
+            let mut e = Vector3::zeros();
+            e[k] = h;
+            g[k] = (part(&(p + e)) - part(&(p - e))) / (2.0 * h);
+        }
+        g.try_normalize(1e-9)
+            .unwrap_or_else(|| self.gradient(p).normalize())
     }
 
     /// The preferred axis at centre `c`: the sum of the unit normals of the walls (hub,
@@ -372,7 +398,10 @@ impl Planner<'_> {
                 return best;
             }
         }
-        best
+        match CutterLocation::new(Point3::from(tip), *axis) {
+            Ok(cl) if self.shank.is_clear(&cl, self.stock_margin) => best,
+            _ => -1.0,
+        }
     }
 
     /// The axes tried at `c` (module docs), nearest to `prefer_near` first.
@@ -443,6 +472,16 @@ impl Planner<'_> {
                 let lip = dc + (h - self.r).abs() * theta;
                 certify(&f, lip, floor, (0.0, f(0.0)), (1.0, f(1.0)), 0)
             })
+            && self
+                .shank
+                .segment_clearance(
+                    &a.cl,
+                    &b.cl,
+                    self.stock_margin,
+                    0.5 * self.tol,
+                    SHANK_QUERIES,
+                )
+                .is_ok()
     }
 
     /// Plans the passes of `region` on `g`.
@@ -605,6 +644,26 @@ impl Planner<'_> {
     }
 }
 
+/// The residual the balls of radius `r` about `centres` leave above the design point `p` along
+/// its normal `n`: the distance along the ray `p + t·n` (`t ≥ 0`) to the first ball it meets
+/// (0 when `p` lies in one; infinite when it meets none). The verifier measures the residual
+/// the same way, so this bounds what the stations leave from above (the motions between them
+/// cut more). O(centres).
+fn ray_entry(p: &Vector3<f64>, n: &Vector3<f64>, centres: &[Vector3<f64>], r: f64) -> f64 {
+    centres
+        .iter()
+        .filter_map(|c| {
+            let w = c - p;
+            let b = w.dot(n);
+            let disc = b * b - (w.norm_squared() - r * r);
+            (disc >= 0.0).then(|| {
+                let s = disc.sqrt();
+                (b + s >= 0.0).then_some((b - s).max(0.0))
+            })?
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Whether `f` (Lipschitz constant `lip` on `[a.0, b.0]`, values `a.1`, `b.1` at the ends)
 /// stays at or above `floor` on the interval: the lower bound `(f(a) + f(b))/2 − lip·(b − a)/2`
 /// of a Lipschitz function, bisected until it clears (at most [`MOTION_DEPTH`] levels).
@@ -630,11 +689,13 @@ fn certify(
     certify(f, lip, floor, a, fm, depth + 1) && certify(f, lip, floor, fm, b, depth + 1)
 }
 
-/// The grid point at fractional indices `(fi, fj)`, bilinear between its four samples
-/// (`None` where one is missing or outside the surface).
+/// The grid point at fractional indices `(fi, fj)`: bilinear between its cell's four
+/// samples, the weights of missing ones (under a fillet, inside a blade: the holes of a
+/// surface's grid) shared by the others; `None` where all four are missing. A start point
+/// only: the ball centre is settled on the design from it.
 fn bilinear(g: &RestGrid, fi: f64, fj: f64) -> Option<Vector3<f64>> {
-    let i = (fi.floor() as usize).min(g.nu.saturating_sub(2));
-    let j = (fj.floor() as usize).min(g.nv.saturating_sub(2));
+    let i = (fi.floor().max(0.0) as usize).min(g.nu.saturating_sub(2));
+    let j = (fj.floor().max(0.0) as usize).min(g.nv.saturating_sub(2));
     let (a, b) = (
         (fi - i as f64).clamp(0.0, 1.0),
         (fj - j as f64).clamp(0.0, 1.0),
@@ -643,14 +704,24 @@ fn bilinear(g: &RestGrid, fi: f64, fj: f64) -> Option<Vector3<f64>> {
         g.residual(i, j)?;
         g.point(i, j).map(Vector3::from)
     };
-    let (p00, p10) = (p(i, j)?, p(i + 1, j)?);
-    let (p01, p11) = (p(i, j + 1)?, p(i + 1, j + 1)?);
-    Some(
-        p00 * ((1.0 - a) * (1.0 - b))
-            + p10 * (a * (1.0 - b))
-            + p01 * ((1.0 - a) * b)
-            + p11 * (a * b),
-    )
+    let corners = [
+        (p(i, j), (1.0 - a) * (1.0 - b)),
+        (p(i + 1, j), a * (1.0 - b)),
+        (p(i, j + 1), (1.0 - a) * b),
+        (p(i + 1, j + 1), a * b),
+    ];
+    let (sum, weight) = corners
+        .iter()
+        .filter_map(|(q, w)| q.map(|q| (q * *w, *w)))
+        .fold((Vector3::zeros(), 0.0), |(s, t), (q, w)| (s + q, t + w));
+    if corners.iter().all(|(q, _)| q.is_none()) {
+        return None;
+    }
+    if weight > 1e-12 {
+        return Some(sum / weight);
+    }
+    // The present samples carry no weight here (a corner of the cell): the nearest of them.
+    corners.iter().filter_map(|(q, _)| *q).next()
 }
 
 impl Operation for RestFinishing {
@@ -675,6 +746,13 @@ impl Operation for RestFinishing {
                 "rest finishing plans from the stock the earlier operations leave, and none was given (it needs earlier operations in the job)",
             )
         })?;
+        if remaining.after.is_empty() {
+            return Err(PlanError::geometry(
+                &self.name,
+                "the stock",
+                "rest finishing machines what earlier operations leave, and none comes before it in the job",
+            ));
+        }
         let tol = ctx.tolerances.machining_tol;
         let fillets = ImpellerFillets::new(ctx.impeller, DEFAULT_FILLET_TOL_MM)
             .map_err(|e| PlanError::geometry(&self.name, "blade-root fillets", e.to_string()))?;
@@ -684,14 +762,7 @@ impl Operation for RestFinishing {
             .clearance
             .samples()
             .filter(|&(h, _)| h > r + 1e-9)
-            .map(|(h, rho)| {
-                let floor = if h <= flutes {
-                    -0.5 * tol
-                } else {
-                    stock_margin
-                };
-                (h, rho, floor)
-            })
+            .map(|(h, rho)| (h, rho, -0.5 * tol))
             .collect();
         let planner = Planner {
             ctx,
@@ -703,6 +774,12 @@ impl Operation for RestFinishing {
             r,
             tol,
             upper,
+            shank: ctx.clearance.with_options(ClearanceOptions {
+                parts: PartSet::MATERIAL,
+                above_mm: flutes,
+                ..ctx.clearance.options()
+            }),
+            stock_margin,
             max_tilt: self.params.max_tilt_deg.to_radians(),
             step: self.params.step_deg.to_radians(),
         };
@@ -741,12 +818,8 @@ impl Operation for RestFinishing {
                 target_points += 1;
                 area += cell;
                 before_max = before_max.max(before);
-                let ball = centres
-                    .iter()
-                    .map(|c| (p - c).norm() - r)
-                    .fold(f64::INFINITY, f64::min)
-                    .max(0.0);
-                let after = before.min(ball);
+                let n = planner.surface_normal(&g.surface, &p);
+                let after = before.min(ray_entry(&p, &n, &centres, r));
                 after_max = after_max.max(after);
                 let rz = [p.x.hypot(p.y), p.z];
                 before_series.push(rz);
@@ -887,6 +960,18 @@ mod tests {
     }
 
     #[test]
+    fn ray_entry_is_the_height_to_the_first_ball_along_the_normal() {
+        let p = Vector3::zeros();
+        let n = Vector3::z();
+        // A ball of radius 1 centred 3 above p: entered at height 2; one beside the ray: missed.
+        let cs = [Vector3::new(0.0, 0.0, 3.0), Vector3::new(5.0, 0.0, 1.0)];
+        assert!((ray_entry(&p, &n, &cs, 1.0) - 2.0).abs() < 1e-12);
+        // A ball holding p: nothing left; a ball below p only: none met.
+        assert_eq!(ray_entry(&p, &n, &[Vector3::new(0.0, 0.2, 0.1)], 1.0), 0.0);
+        assert!(ray_entry(&p, &n, &[Vector3::new(0.0, 0.0, -3.0)], 1.0).is_infinite());
+    }
+
+    #[test]
     fn certify_finds_a_dip_between_clear_ends() {
         // f(s) = |s − 0.5| − 0.01 dips below 0 at the middle; Lipschitz constant 1.
         let f = |s: f64| (s - 0.5).abs() - 0.01;
@@ -897,7 +982,7 @@ mod tests {
     }
 
     #[test]
-    fn bilinear_interpolates_inside_and_refuses_missing_samples() {
+    fn bilinear_interpolates_inside_and_shares_the_weight_of_missing_samples() {
         let g = RestGrid {
             surface: "s".into(),
             nu: 2,
@@ -912,8 +997,14 @@ mod tests {
         };
         let p = bilinear(&g, 0.5, 0.5).unwrap();
         assert!((p - Vector3::new(1.0, 1.0, 1.0)).norm() < 1e-12);
+        // Without (1, 1) the other three share its weight: their mean at the centre.
         let mut h = g.clone();
         h.residual_mm[3] = None;
+        let q = bilinear(&h, 0.5, 0.5).unwrap();
+        assert!((q - Vector3::new(2.0 / 3.0, 2.0 / 3.0, 0.0)).norm() < 1e-12);
+        // At the missing corner itself, the nearest present one.
+        assert!(bilinear(&h, 1.0, 1.0).is_some());
+        h.residual_mm = vec![None; 4];
         assert!(bilinear(&h, 0.5, 0.5).is_none());
     }
 }

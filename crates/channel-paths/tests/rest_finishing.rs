@@ -146,7 +146,7 @@ fn no_ball_enters_the_fillet_where_it_ends_at_the_inlet_rim() {
         }
     }
     let count = |k: &str| planned.metrics.get(k).and_then(|v| v.as_f64()).unwrap();
-    let refused = count("fillet_blocked_locations") + count("skipped_locations");
-    // The old planner placed balls here (and cut the fillet): the new one refuses them.
-    assert!(refused > 0.0, "{:?}", planned.metrics);
+    // Balls are placed (the check above is not vacuous): on the margin they settle clear of
+    // the fillet's end instead of in the sharp corner beyond it.
+    assert!(count("stations") > 0.0, "{:?}", planned.metrics);
 }

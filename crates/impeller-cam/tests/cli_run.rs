@@ -52,6 +52,7 @@ fn default_job_is_the_impeller_8_8_fixture_job() {
             ("blade-semi", "flank_semi_finishing"),
             ("blade-finish", "flank_finishing"),
             ("blade-root", "blade_root_finishing"),
+            ("rest", "rest_finishing"),
         ]
     );
     for o in ops {
@@ -121,7 +122,7 @@ fn default_job_is_the_impeller_8_8_fixture_job() {
     rs274_accepts(
         &out,
         &out.join("program.ngc"),
-        "T5 P5 Z115 D3 ;T5\nT6 P6 Z115 D2 ;T6\nT7 P7 Z110 D2 ;T7\n",
+        "T5 P5 Z115 D3 ;T5\nT6 P6 Z115 D2 ;T6\nT7 P7 Z110 D2 ;T7\nT9 P9 Z110 D1 ;T9\n",
         50_000,
     );
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();

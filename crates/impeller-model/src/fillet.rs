@@ -225,6 +225,69 @@ pub struct FilletPiece {
     normals: NurbsCurve<6>,
     projector: CurveProjector<3>,
     fit_error_mm: f64,
+    /// The material's bounding wedges along the spine, built on first use
+    /// ([`FilletPiece::material_distance_lower`]).
+    wedges: std::sync::OnceLock<Wedges>,
+}
+
+/// Spine spacing of the material wedges (mm).
+const WEDGE_SPACING_MM: f64 = 0.01;
+/// Wedges per culling block.
+const WEDGE_BLOCK: usize = 32;
+
+/// The region of one section's fillet material: in the plane of the contact directions `a`
+/// (to the hub contact) and `b` (to the blade contact) through the spine point `s`, the
+/// circular sector between `a` and `b` (angle `gamma`) from radius `R` to `r_out`, the
+/// farthest corner point `(1 + CORNER_SLACK)·R / cos(γ/2)` of the sector cut by both walls'
+/// tangent planes moved in by `CORNER_SLACK·R` (what [`FilletPiece::closest`] counts as
+/// material). `delta` bounds how far the wedge of any spine point up to the neighbouring
+/// samples lies from this one or that one.
+#[derive(Debug, Clone, Copy)]
+struct Wedge {
+    s: Vector3<f64>,
+    a: Vector3<f64>,
+    e: Vector3<f64>,
+    n: Vector3<f64>,
+    gamma: f64,
+    r_out: f64,
+    delta: f64,
+}
+
+/// A run of wedges with a bounding sphere of everything they hold (`delta` included).
+#[derive(Debug, Clone, Copy)]
+struct WedgeBlock {
+    centre: Vector3<f64>,
+    radius: f64,
+    range: (usize, usize),
+}
+
+#[derive(Debug, Clone, Default)]
+struct Wedges {
+    wedges: Vec<Wedge>,
+    blocks: Vec<WedgeBlock>,
+}
+
+impl Wedge {
+    /// Distance from `p` to the wedge (exact: the plane's normal offset and the 2-D distance to
+    /// the annular sector, whose angle is below π).
+    fn distance(&self, p: &Vector3<f64>, inner: f64) -> f64 {
+        let w = p - self.s;
+        let tau = w.dot(&self.n);
+        let (x, y) = (w.dot(&self.a), w.dot(&self.e));
+        let m = (x * x + y * y).sqrt();
+        let phi = y.atan2(x);
+        let d2 = if (0.0..=self.gamma).contains(&phi) {
+            (inner - m).max(m - self.r_out).max(0.0)
+        } else {
+            let seg = |dx: f64, dy: f64| {
+                let r = (x * dx + y * dy).clamp(inner, self.r_out);
+                let (u, v) = (x - r * dx, y - r * dy);
+                (u * u + v * v).sqrt()
+            };
+            seg(1.0, 0.0).min(seg(self.gamma.cos(), self.gamma.sin()))
+        };
+        (tau * tau + d2 * d2).sqrt()
+    }
 }
 
 impl FilletPiece {
@@ -270,6 +333,91 @@ impl FilletPiece {
             hub_normal: nh,
             radius: r,
         }
+    }
+
+    /// A lower bound of the distance from `p` to this piece's fillet material (≤ 0 inside it),
+    /// valid wherever `p` is: the material lies, section by section, in the wedge of the
+    /// contact directions between radius `R` and the corner ([`FilletPiece::closest`]: the
+    /// foot interior and perpendicular, the sector between the contacts, the slack-moved
+    /// tangent planes). The wedges are sampled every [`WEDGE_SPACING_MM`] of spine; a
+    /// sample's bound is its exact wedge distance less `delta`: the spine chord to the
+    /// neighbouring samples plus the corner radius times the contact directions' turn
+    /// (twice the half-interval bound, for the curvature between samples). 1-Lipschitz in `p`
+    /// (a minimum of distances less constants). Cost: O(blocks + wedges of the blocks near
+    /// `p`); the wedges are built on first use, O(spine length / spacing).
+    /// Values at or above `cap` are returned as some value `≥ cap` (the blocks that cannot go
+    /// below it are not evaluated).
+    pub fn material_distance_lower(&self, p: &Vector3<f64>, cap: f64) -> f64 {
+        let w = self.wedges.get_or_init(|| self.build_wedges());
+        let inner = self.sections[0].radius;
+        let mut best = cap;
+        for b in &w.blocks {
+            if (p - b.centre).norm() - b.radius >= best {
+                continue;
+            }
+            for k in &w.wedges[b.range.0..b.range.1] {
+                best = best.min(k.distance(p, inner) - k.delta);
+            }
+        }
+        best
+    }
+
+    fn build_wedges(&self) -> Wedges {
+        let r = self.sections[0].radius;
+        let length: f64 = self
+            .sections
+            .windows(2)
+            .map(|w| (w[1].centre - w[0].centre).norm())
+            .sum();
+        let n = ((length / WEDGE_SPACING_MM).ceil() as usize).max(2) + 1;
+        let mut wedges: Vec<Wedge> = (0..n)
+            .filter_map(|k| {
+                let t = k as f64 / (n - 1) as f64;
+                let nn = self.normals.point(t);
+                let a = -Vector3::new(nn[0], nn[1], nn[2]).try_normalize(1e-12)?;
+                let b = -Vector3::new(nn[3], nn[4], nn[5]).try_normalize(1e-12)?;
+                let e = (b - a * a.dot(&b)).try_normalize(1e-12)?;
+                let gamma = a.dot(&b).clamp(-1.0, 1.0).acos();
+                Some(Wedge {
+                    s: self.spine.point(t),
+                    a,
+                    e,
+                    n: a.cross(&e),
+                    gamma,
+                    r_out: (1.0 + CORNER_SLACK) * r / (0.5 * gamma).cos().max(1e-3),
+                    delta: 0.0,
+                })
+            })
+            .collect();
+        let gaps: Vec<f64> = wedges
+            .windows(2)
+            .map(|w| {
+                let turn = w[0].a.angle(&w[1].a).max(w[0].e.angle(&w[1].e));
+                (w[1].s - w[0].s).norm() + w[0].r_out.max(w[1].r_out) * turn
+            })
+            .collect();
+        for (k, wd) in wedges.iter_mut().enumerate() {
+            let before = if k > 0 { gaps[k - 1] } else { 0.0 };
+            wd.delta = before.max(gaps.get(k).copied().unwrap_or(0.0));
+        }
+        let blocks = (0..wedges.len())
+            .step_by(WEDGE_BLOCK)
+            .map(|lo| {
+                let hi = (lo + WEDGE_BLOCK).min(wedges.len());
+                let ws = &wedges[lo..hi];
+                let centre = ws.iter().map(|w| w.s).sum::<Vector3<f64>>() / ws.len() as f64;
+                let radius = ws
+                    .iter()
+                    .map(|w| (w.s - centre).norm() + w.r_out + w.delta)
+                    .fold(0.0, f64::max);
+                WedgeBlock {
+                    centre,
+                    radius,
+                    range: (lo, hi),
+                }
+            })
+            .collect();
+        Wedges { wedges, blocks }
     }
 
     /// Distance from `p` to the piece's spine (the curve of rolling-ball centres, its ends
@@ -579,13 +727,16 @@ impl ImpellerFillets {
         self.rows.get(row).map(|r| &r.0[k])
     }
 
-    /// Calls `visit` with the distance from `p` to the spine of each fillet of the instances
-    /// whose window holds `p` (each side's pieces taken together: the smallest over them).
-    /// The ball of radius `R` about any spine point is free of design material (it touches
-    /// hub and side and the fillet lies outside it), so a sphere about `p` of radius `ρ` with
-    /// `R − d ≥ ρ` for some visited `d` is clear of that fillet; a fillet not visited is
-    /// farther than [`Self::reach_mm`] from `p`. Cost: as [`Self::closest`].
-    pub fn spine_distances(&self, p: &Vector3<f64>, mut visit: impl FnMut(f64)) {
+    /// Calls `visit` with two bounds for each fillet of the instances whose window holds `p`
+    /// (each side's pieces taken together, the smallest over them): the distance from `p` to
+    /// the spine, and a lower bound of the distance from `p` to the fillet material
+    /// ([`FilletPiece::material_distance_lower`]). The ball of radius `R` about any spine
+    /// point is free of design material (it touches hub and side and the fillet lies outside
+    /// it), so a sphere about `p` of radius `ρ` is clear of that fillet when `R − d_spine ≥ ρ`
+    /// or when the material bound is `≥ ρ`; a fillet not visited is farther than
+    /// [`Self::reach_mm`] from `p`. Cost: as [`Self::closest`] plus the wedge bounds.
+    /// Material bounds at or above `cap` are passed as some value `≥ cap`.
+    pub fn material_bounds(&self, p: &Vector3<f64>, cap: f64, mut visit: impl FnMut(f64, f64)) {
         let phi = p.y.atan2(p.x);
         for (row, rot) in &self.instances {
             let (pair, (lo, hi)) = &self.rows[*row];
@@ -599,13 +750,13 @@ impl ImpellerFillets {
             }
             let q = rot.inverse() * p;
             for f in pair {
-                let d = f
-                    .pieces
-                    .iter()
-                    .map(|k| k.spine_distance(&q))
-                    .fold(f64::INFINITY, f64::min);
-                if d.is_finite() {
-                    visit(d);
+                let (mut spine, mut material) = (f64::INFINITY, f64::INFINITY);
+                for k in &f.pieces {
+                    spine = spine.min(k.spine_distance(&q));
+                    material = material.min(k.material_distance_lower(&q, cap));
+                }
+                if spine.is_finite() {
+                    visit(spine, material);
                 }
             }
         }
@@ -709,6 +860,7 @@ fn fit_piece(
         normals,
         projector,
         fit_error_mm,
+        wedges: std::sync::OnceLock::new(),
     })
 }
 

@@ -133,7 +133,8 @@ fn default_job_is_the_fixture_job_with_its_tools() {
     let machine = job.machine.clone().unwrap();
     assert!(job.is_embedded(&machine));
     assert!(job.read_text(&machine).unwrap().contains("xyzac-trt"));
-    // The process plan: five operations, their tools, from the turned blank; no CL files.
+    // The process plan: five operations and the rest finishing of what they leave, their
+    // tools, from the turned blank; no CL files.
     let ops: Vec<(&str, &str, &str)> = job
         .operations
         .iter()
@@ -147,6 +148,7 @@ fn default_job_is_the_fixture_job_with_its_tools() {
             ("blade-semi", "flank_semi_finishing", "T5-taper-ball-r1.5"),
             ("blade-finish", "flank_finishing", "T6-taper-ball-r1"),
             ("blade-root", "blade_root_finishing", "T7-ball-d2"),
+            ("rest", "rest_finishing", "T9-ball-d1"),
         ]
     );
     assert_eq!(job.stock.start, crate::job::StockStartKind::Turned);
