@@ -146,3 +146,66 @@ fn every_blade_instance_carries_its_rows_fillet() {
     let mid = imp.hub().point(0.5, 0.15) + imp.hub().normal(0.5, 0.15) * 0.4;
     assert!(all.closest(&mid).is_none());
 }
+
+/// `FilletPiece::material_distance_lower` never exceeds the distance to a point of fillet
+/// material: material points (those `BladeFillet::signed_distance` reads inside, sampled over
+/// the corner sectors of 400 fitted sections, the piece's ends included) against query points
+/// around the spine and beyond its ends, on the default impeller's main suction-side fillet.
+#[test]
+fn the_material_bound_is_below_the_distance_to_every_material_point() {
+    let imp = fixtures::default_impeller().unwrap();
+    let f = BladeFillet::build(
+        imp.hub(),
+        imp.main().blade(),
+        Side::Suction,
+        imp.fillet_radius_mm(),
+        DEFAULT_FILLET_TOL_MM,
+    )
+    .unwrap();
+    let piece = &f.pieces()[0];
+    let (u0, u1) = piece.u_range();
+    let r = f.radius();
+    let mut material = Vec::new();
+    for k in 0..400 {
+        let u = u0 + (u1 - u0) * k as f64 / 399.0;
+        let s = piece.section_at(u);
+        let (a, b) = (-s.hub_normal, -s.blade_normal);
+        for i in 0..12 {
+            for j in 0..6 {
+                let t = (i as f64 + 0.5) / 12.0;
+                let dir = (a * (1.0 - t) + b * t).normalize();
+                let rho = r * (1.0 + 0.5 * (j as f64 + 0.5) / 6.0);
+                let x = s.centre + dir * rho;
+                if f.signed_distance(&x).is_some_and(|d| d < 0.0) {
+                    material.push(x);
+                }
+            }
+        }
+    }
+    assert!(material.len() > 2000, "{} material points", material.len());
+    let (c0, c1) = (piece.section_at(u0).centre, piece.section_at(u1).centre);
+    let mut checked = 0;
+    for k in 0..300 {
+        // Around the spine (fractions beyond both ends too), offsets up to 2.5 mm.
+        let t = -0.05 + 1.1 * k as f64 / 299.0;
+        let u = (u0 + (u1 - u0) * t).clamp(u0, u1);
+        let base = piece.section_at(u).centre + (c1 - c0) * (t - t.clamp(0.0, 1.0));
+        let w = nalgebra::Vector3::new(
+            ((k * 37) % 100) as f64 / 20.0 - 2.5,
+            ((k * 61) % 100) as f64 / 20.0 - 2.5,
+            ((k * 13) % 100) as f64 / 20.0 - 2.5,
+        );
+        let p = base + w;
+        let bound = piece.material_distance_lower(&p, f64::INFINITY);
+        let exact = material
+            .iter()
+            .map(|x| (p - x).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(bound <= exact + 1e-9, "at {p:?}: bound {bound} > {exact}");
+        // Not vacuous: away from the material the bound is most of the distance.
+        if exact > 0.5 && bound > 0.5 * exact {
+            checked += 1;
+        }
+    }
+    assert!(checked > 100, "{checked} of 300 points bounded usefully");
+}
