@@ -298,14 +298,7 @@ impl Planner<'_> {
     }
 
     fn gradient(&self, p: &Vector3<f64>) -> Vector3<f64> {
-        let h = GRAD_STEP_MM;
-        let mut g = Vector3::zeros();
-        for k in 0..3 {
-            let mut e = Vector3::zeros();
-            e[k] = h;
-            g[k] = (self.distance(&(p + e)) - self.distance(&(p - e))) / (2.0 * h);
-        }
-        g
+        central_gradient(|q| self.distance(q), p)
     }
 
     /// The ball centre of pass sample `s` on the offset surface `D = r` (module docs).
@@ -339,14 +332,8 @@ impl Planner<'_> {
                 self.material.blade_signed_distance(&pt).0
             }
         };
-        let h = GRAD_STEP_MM;
-        let mut g = Vector3::zeros();
-        for k in 0..3 {
-            let mut e = Vector3::zeros();
-            e[k] = h;
-            g[k] = (part(&(p + e)) - part(&(p - e))) / (2.0 * h);
-        }
-        g.try_normalize(1e-9)
+        central_gradient(part, p)
+            .try_normalize(1e-9)
             .unwrap_or_else(|| self.gradient(p).normalize())
     }
 
@@ -354,7 +341,6 @@ impl Planner<'_> {
     /// blade, fillet) within `r + tol` of it.
     fn preferred_axis(&self, c: &Vector3<f64>) -> Vector3<f64> {
         let near = self.r + self.tol;
-        let h = GRAD_STEP_MM;
         let parts: [&WallDistance<'_>; 3] = [
             &|p| Some(self.material.hub_signed_distance(&Point3::from(*p))),
             &|p| Some(self.material.blade_signed_distance(&Point3::from(*p)).0),
@@ -369,14 +355,10 @@ impl Planner<'_> {
             if !f(c).is_some_and(|d| d <= near) {
                 continue;
             }
-            let mut g = Vector3::zeros();
-            for k in 0..3 {
-                let mut e = Vector3::zeros();
-                e[k] = h;
-                match (f(&(c + e)), f(&(c - e))) {
-                    (Some(a), Some(b)) => g[k] = (a - b) / (2.0 * h),
-                    _ => return self.gradient(c).try_normalize(1e-9).unwrap_or(Vector3::z()),
-                }
+            // A wall defined on one side of `c` only has no gradient here (NaN): the design's.
+            let g = central_gradient(|q| f(q).unwrap_or(f64::NAN), c);
+            if !g.iter().all(|x| x.is_finite()) {
+                return self.gradient(c).try_normalize(1e-9).unwrap_or(Vector3::z());
             }
             if let Some(u) = g.try_normalize(1e-9) {
                 sum += u;
@@ -642,6 +624,18 @@ impl Planner<'_> {
         self.ctx.close(&mut path, APPROACH_MM)?;
         Ok((path, joined))
     }
+}
+
+/// The gradient of `f` at `p` by central differences of [`GRAD_STEP_MM`].
+fn central_gradient(f: impl Fn(&Vector3<f64>) -> f64, p: &Vector3<f64>) -> Vector3<f64> {
+    let h = GRAD_STEP_MM;
+    let mut g = Vector3::zeros();
+    for k in 0..3 {
+        let mut e = Vector3::zeros();
+        e[k] = h;
+        g[k] = (f(&(p + e)) - f(&(p - e))) / (2.0 * h);
+    }
+    g
 }
 
 /// The residual the balls of radius `r` about `centres` leave above the design point `p` along

@@ -635,6 +635,22 @@ impl Shared<'_> {
     }
 }
 
+/// The verifier's design (blade projectors, side mesh) and the job's blank sampled at the
+/// verification resolution: independent, built side by side.
+fn design_and_blank(
+    job: &Job,
+    impeller: &Impeller,
+) -> Result<(ImpellerDesign, TriDexel), CliError> {
+    let (design, stock) = rayon::join(
+        || ImpellerDesign::new(impeller, ImpellerSampling::default()),
+        || {
+            machining_sim::blank_of(impeller)
+                .and_then(|b| TriDexel::from_shape(&b, job.verification.resolution_mm))
+        },
+    );
+    Ok((design.map_err(msg)?, stock.map_err(msg)?))
+}
+
 /// The stock the planned operations `earlier` leave on the job's blank, simulated at the
 /// job's verification resolution on their CL paths (machining-sim's tri-dexel stock) and
 /// measured above the design at the verifier's samples: what a rest operation plans from.
@@ -648,15 +664,7 @@ fn remaining_after(
         .iter()
         .filter_map(|op| op.cl.cutter.clone().map(|c| (c, op.cl.path.clone())))
         .collect();
-    let (design, stock) = rayon::join(
-        || ImpellerDesign::new(impeller, ImpellerSampling::default()),
-        || {
-            machining_sim::blank_of(impeller)
-                .and_then(|b| TriDexel::from_shape(&b, job.verification.resolution_mm))
-        },
-    );
-    let design = design.map_err(msg)?;
-    let mut stock = stock.map_err(msg)?;
+    let (design, mut stock) = design_and_blank(job, impeller)?;
     let rep = machining_sim::simulate(&mut stock, &design, &paths, &SimOptions::default())
         .map_err(msg)?;
     Ok(cam_plan::RemainingMaterial {
@@ -1163,17 +1171,7 @@ pub fn verify(
     if !job.verification.enabled || verifiable.is_empty() {
         return Ok(());
     }
-    // The design (blade projectors, side mesh) and the sampled blank are independent: built
-    // side by side.
-    let (design, stock) = rayon::join(
-        || ImpellerDesign::new(impeller, ImpellerSampling::default()),
-        || {
-            machining_sim::blank_of(impeller)
-                .and_then(|b| TriDexel::from_shape(&b, job.verification.resolution_mm))
-        },
-    );
-    let design = design.map_err(msg)?;
-    let mut stock = stock.map_err(msg)?;
+    let (design, mut stock) = design_and_blank(job, impeller)?;
     let progress = Progress::new(job.quiet);
     let total: usize = verifiable.iter().map(|(_, p)| p.moves.len()).sum();
     let bar = progress.bar(total as u64, "verifying");

@@ -737,18 +737,7 @@ impl ImpellerFillets {
     /// [`Self::reach_mm`] from `p`. Cost: as [`Self::closest`] plus the wedge bounds.
     /// Material bounds at or above `cap` are passed as some value `≥ cap`.
     pub fn material_bounds(&self, p: &Vector3<f64>, cap: f64, mut visit: impl FnMut(f64, f64)) {
-        let phi = p.y.atan2(p.x);
-        for (row, rot) in &self.instances {
-            let (pair, (lo, hi)) = &self.rows[*row];
-            let a = phi - rot.scaled_axis().z;
-            let mid = 0.5 * (lo + hi);
-            let a = mid
-                + ((a - mid + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-                    - std::f64::consts::PI);
-            if a < *lo || a > *hi {
-                continue;
-            }
-            let q = rot.inverse() * p;
+        self.near_instances(p, |pair, _, q| {
             for f in pair {
                 let (mut spine, mut material) = (f64::INFINITY, f64::INFINITY);
                 for k in &f.pieces {
@@ -759,18 +748,19 @@ impl ImpellerFillets {
                     visit(spine, material);
                 }
             }
-        }
+        });
     }
 
-    /// The fillet distance of `p` and the fillet surface point deciding it (the smallest
-    /// over the instances whose window holds `p`), `None` where no fillet decides
-    /// ([`BladeFillet::closest`]).
-    pub fn closest(&self, p: &Vector3<f64>) -> Option<(f64, Vector3<f64>)> {
+    /// Calls `visit` with the fillet pair, the rotation and `p` in the reference blade's frame
+    /// for every instance whose angular window holds `p`'s polar angle (unwrapped into it).
+    fn near_instances(
+        &self,
+        p: &Vector3<f64>,
+        mut visit: impl FnMut(&[BladeFillet; 2], &nalgebra::Rotation3<f64>, Vector3<f64>),
+    ) {
         let phi = p.y.atan2(p.x);
-        let mut best: Option<(f64, Vector3<f64>)> = None;
         for (row, rot) in &self.instances {
             let (pair, (lo, hi)) = &self.rows[*row];
-            // p's angle in the reference blade's frame, unwrapped into the window.
             let a = phi - rot.scaled_axis().z;
             let mid = 0.5 * (lo + hi);
             let a = mid
@@ -779,7 +769,16 @@ impl ImpellerFillets {
             if a < *lo || a > *hi {
                 continue;
             }
-            let q = rot.inverse() * p;
+            visit(pair, rot, rot.inverse() * p);
+        }
+    }
+
+    /// The fillet distance of `p` and the fillet surface point deciding it (the smallest
+    /// over the instances whose window holds `p`), `None` where no fillet decides
+    /// ([`BladeFillet::closest`]).
+    pub fn closest(&self, p: &Vector3<f64>) -> Option<(f64, Vector3<f64>)> {
+        let mut best: Option<(f64, Vector3<f64>)> = None;
+        self.near_instances(p, |pair, rot, q| {
             for f in pair {
                 if let Some((d, foot)) = f.closest(&q) {
                     if best.is_none_or(|b| d < b.0) {
@@ -787,7 +786,7 @@ impl ImpellerFillets {
                     }
                 }
             }
-        }
+        });
         best
     }
 }
