@@ -626,6 +626,16 @@ impl Planner<'_> {
     }
 }
 
+/// Each point of `points` as a cross of half-width `d` for a line chart (strokes separated by
+/// NaN, which lifts the pen): scattered samples drawn as markers, not joined.
+fn crosses(points: &[[f64; 2]], d: f64) -> Vec<[f64; 2]> {
+    let gap = [f64::NAN, f64::NAN];
+    points
+        .iter()
+        .flat_map(|&[x, y]| [[x - d, y], [x + d, y], gap, [x, y - d], [x, y + d], gap])
+        .collect()
+}
+
 /// The gradient of `f` at `p` by central differences of [`GRAD_STEP_MM`].
 fn central_gradient(f: impl Fn(&Vector3<f64>) -> f64, p: &Vector3<f64>) -> Vector3<f64> {
     let h = GRAD_STEP_MM;
@@ -899,18 +909,28 @@ impl Operation for RestFinishing {
             ));
         }
         let plots = vec![Plot {
-            title: "Rest material (meridional view): samples above the threshold before, and those the stations leave above it".into(),
+            title: "Rest finishing, meridional view: targets, what is left, ball centres".into(),
             kind: PlotKind::Lines {
                 x_label: "radius (mm)".into(),
                 y_label: "z (mm)".into(),
                 series: vec![
                     PlotSeries {
-                        label: "before".into(),
-                        points: before_series,
+                        label: "above the threshold before".into(),
+                        points: crosses(&before_series, 0.4),
                     },
                     PlotSeries {
-                        label: "left (unreachable)".into(),
-                        points: after_series,
+                        label: "left above it by the stations".into(),
+                        points: crosses(&after_series, 0.25),
+                    },
+                    PlotSeries {
+                        label: "ball centres".into(),
+                        points: crosses(
+                            &centres
+                                .iter()
+                                .map(|c| [c.x.hypot(c.y), c.z])
+                                .collect::<Vec<_>>(),
+                            0.1,
+                        ),
                     },
                 ],
                 equal_aspect: true,
