@@ -248,12 +248,15 @@ struct Wedge {
     a: Vector3<f64>,
     e: Vector3<f64>,
     n: Vector3<f64>,
-    gamma: f64,
+    /// `cos γ`, `sin γ` of the sector's angle `γ` (< π).
+    cos_g: f64,
+    sin_g: f64,
     r_out: f64,
     delta: f64,
 }
 
-/// A run of wedges with a bounding sphere of everything they hold (`delta` included).
+/// A run of wedges (or of blocks) with a bounding sphere of everything they hold (`delta`
+/// included).
 #[derive(Debug, Clone, Copy)]
 struct WedgeBlock {
     centre: Vector3<f64>,
@@ -261,10 +264,12 @@ struct WedgeBlock {
     range: (usize, usize),
 }
 
+/// The wedges, their blocks, and groups of [`WEDGE_BLOCK`] blocks (a two-level cull).
 #[derive(Debug, Clone, Default)]
 struct Wedges {
     wedges: Vec<Wedge>,
     blocks: Vec<WedgeBlock>,
+    groups: Vec<WedgeBlock>,
 }
 
 impl Wedge {
@@ -274,9 +279,9 @@ impl Wedge {
         let w = p - self.s;
         let tau = w.dot(&self.n);
         let (x, y) = (w.dot(&self.a), w.dot(&self.e));
-        let m = (x * x + y * y).sqrt();
-        let phi = y.atan2(x);
-        let d2 = if (0.0..=self.gamma).contains(&phi) {
+        // Inside the sector's angle (below π): on the left of `a` and on the right of `b`.
+        let d2 = if y >= 0.0 && x * self.sin_g - y * self.cos_g >= 0.0 {
+            let m = (x * x + y * y).sqrt();
             (inner - m).max(m - self.r_out).max(0.0)
         } else {
             let seg = |dx: f64, dy: f64| {
@@ -284,7 +289,7 @@ impl Wedge {
                 let (u, v) = (x - r * dx, y - r * dy);
                 (u * u + v * v).sqrt()
             };
-            seg(1.0, 0.0).min(seg(self.gamma.cos(), self.gamma.sin()))
+            seg(1.0, 0.0).min(seg(self.cos_g, self.sin_g))
         };
         (tau * tau + d2 * d2).sqrt()
     }
@@ -351,12 +356,17 @@ impl FilletPiece {
         let w = self.wedges.get_or_init(|| self.build_wedges());
         let inner = self.sections[0].radius;
         let mut best = cap;
-        for b in &w.blocks {
-            if (p - b.centre).norm() - b.radius >= best {
+        for g in &w.groups {
+            if (p - g.centre).norm() - g.radius >= best {
                 continue;
             }
-            for k in &w.wedges[b.range.0..b.range.1] {
-                best = best.min(k.distance(p, inner) - k.delta);
+            for b in &w.blocks[g.range.0..g.range.1] {
+                if (p - b.centre).norm() - b.radius >= best {
+                    continue;
+                }
+                for k in &w.wedges[b.range.0..b.range.1] {
+                    best = best.min(k.distance(p, inner) - k.delta);
+                }
             }
         }
         best
@@ -383,7 +393,8 @@ impl FilletPiece {
                     a,
                     e,
                     n: a.cross(&e),
-                    gamma,
+                    cos_g: gamma.cos(),
+                    sin_g: gamma.sin(),
                     r_out: (1.0 + CORNER_SLACK) * r / (0.5 * gamma).cos().max(1e-3),
                     delta: 0.0,
                 })
@@ -400,7 +411,7 @@ impl FilletPiece {
             let before = if k > 0 { gaps[k - 1] } else { 0.0 };
             wd.delta = before.max(gaps.get(k).copied().unwrap_or(0.0));
         }
-        let blocks = (0..wedges.len())
+        let blocks: Vec<WedgeBlock> = (0..wedges.len())
             .step_by(WEDGE_BLOCK)
             .map(|lo| {
                 let hi = (lo + WEDGE_BLOCK).min(wedges.len());
@@ -417,7 +428,29 @@ impl FilletPiece {
                 }
             })
             .collect();
-        Wedges { wedges, blocks }
+        // A group's sphere holds its blocks' spheres.
+        let groups = (0..blocks.len())
+            .step_by(WEDGE_BLOCK)
+            .map(|lo| {
+                let hi = (lo + WEDGE_BLOCK).min(blocks.len());
+                let bs = &blocks[lo..hi];
+                let centre = bs.iter().map(|b| b.centre).sum::<Vector3<f64>>() / bs.len() as f64;
+                let radius = bs
+                    .iter()
+                    .map(|b| (b.centre - centre).norm() + b.radius)
+                    .fold(0.0, f64::max);
+                WedgeBlock {
+                    centre,
+                    radius,
+                    range: (lo, hi),
+                }
+            })
+            .collect();
+        Wedges {
+            wedges,
+            blocks,
+            groups,
+        }
     }
 
     /// Distance from `p` to the piece's spine (the curve of rolling-ball centres, its ends
