@@ -264,6 +264,28 @@ struct WedgeBlock {
     range: (usize, usize),
 }
 
+/// Bounding spheres of runs of [`WEDGE_BLOCK`] items, each item a sphere `(centre, radius)`:
+/// the runs' mean centre and the largest reach of an item's sphere from it.
+fn cull_spheres<T>(items: &[T], sphere: impl Fn(&T) -> (Vector3<f64>, f64)) -> Vec<WedgeBlock> {
+    (0..items.len())
+        .step_by(WEDGE_BLOCK)
+        .map(|lo| {
+            let hi = (lo + WEDGE_BLOCK).min(items.len());
+            let run: Vec<(Vector3<f64>, f64)> = items[lo..hi].iter().map(&sphere).collect();
+            let centre = run.iter().map(|s| s.0).sum::<Vector3<f64>>() / run.len() as f64;
+            let radius = run
+                .iter()
+                .map(|s| (s.0 - centre).norm() + s.1)
+                .fold(0.0, f64::max);
+            WedgeBlock {
+                centre,
+                radius,
+                range: (lo, hi),
+            }
+        })
+        .collect()
+}
+
 /// The wedges, their blocks, and groups of [`WEDGE_BLOCK`] blocks (a two-level cull).
 #[derive(Debug, Clone, Default)]
 struct Wedges {
@@ -411,41 +433,9 @@ impl FilletPiece {
             let before = if k > 0 { gaps[k - 1] } else { 0.0 };
             wd.delta = before.max(gaps.get(k).copied().unwrap_or(0.0));
         }
-        let blocks: Vec<WedgeBlock> = (0..wedges.len())
-            .step_by(WEDGE_BLOCK)
-            .map(|lo| {
-                let hi = (lo + WEDGE_BLOCK).min(wedges.len());
-                let ws = &wedges[lo..hi];
-                let centre = ws.iter().map(|w| w.s).sum::<Vector3<f64>>() / ws.len() as f64;
-                let radius = ws
-                    .iter()
-                    .map(|w| (w.s - centre).norm() + w.r_out + w.delta)
-                    .fold(0.0, f64::max);
-                WedgeBlock {
-                    centre,
-                    radius,
-                    range: (lo, hi),
-                }
-            })
-            .collect();
+        let blocks = cull_spheres(&wedges, |w| (w.s, w.r_out + w.delta));
         // A group's sphere holds its blocks' spheres.
-        let groups = (0..blocks.len())
-            .step_by(WEDGE_BLOCK)
-            .map(|lo| {
-                let hi = (lo + WEDGE_BLOCK).min(blocks.len());
-                let bs = &blocks[lo..hi];
-                let centre = bs.iter().map(|b| b.centre).sum::<Vector3<f64>>() / bs.len() as f64;
-                let radius = bs
-                    .iter()
-                    .map(|b| (b.centre - centre).norm() + b.radius)
-                    .fold(0.0, f64::max);
-                WedgeBlock {
-                    centre,
-                    radius,
-                    range: (lo, hi),
-                }
-            })
-            .collect();
+        let groups = cull_spheres(&blocks, |b| (b.centre, b.radius));
         Wedges {
             wedges,
             blocks,
