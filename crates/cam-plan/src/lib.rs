@@ -54,7 +54,7 @@ pub use clearance::{
     Clearance, ClearanceOptions, DesignClearance, DesignMesh, DesignPart, PartSet, Row, ToolPart,
 };
 pub use error::PlanError;
-pub use linking::{LinkCheck, LinkStats, Linker, SafetySurface};
+pub use linking::{LinkCheck, LinkStats, Linker, SafetySurface, ToolEnvelope, RAPID_TRACE_STOP_MM};
 pub use metrics::{MetricValue, Metrics, Plot, PlotKind, PlotSeries};
 pub use operation::{
     AxisReach, Builder, Operation, OperationSpec, PlanContext, PlannedOperation, PlannedStep,

@@ -125,24 +125,29 @@ impl Linker {
     /// where the rapid part of an approach ends: `approach_mm` above `to`, or — with a blank
     /// — the highest point of the axis line from which the tip comes within `approach_mm` of
     /// the blank (probed every 0.25 mm, the tip and four lateral and one lower point at
-    /// `approach_mm`), whichever is higher. O(inside / 0.25) blank tests.
+    /// `approach_mm`), whichever is higher. O(inside / 0.25) blank tests. This looks at the
+    /// tip only; [`Linker::rapid_approach_end_enveloped`] keeps the whole tool away.
     pub fn rapid_approach_end(&self, to: &CutterLocation, inside: f64, approach_mm: f64) -> f64 {
-        self.rapid_approach_end_along(to, &to.axis.into_inner(), inside, approach_mm)
+        self.rapid_approach_end_along(to, &to.axis.into_inner(), inside, approach_mm, None)
     }
 
     /// [`Linker::rapid_approach_end`] for an approach along the unit direction `dir` (the
-    /// tool keeps `to`'s axis).
+    /// tool keeps `to`'s axis); with `envelope`, [`Linker::rapid_approach_end_enveloped`].
     pub fn rapid_approach_end_along(
         &self,
         to: &CutterLocation,
         dir: &Vector3,
         inside: f64,
         approach_mm: f64,
+        envelope: Option<&ToolEnvelope>,
     ) -> f64 {
         let a = approach_mm.clamp(0.0, inside);
         let Some(blank) = &self.blank else {
             return a;
         };
+        if let Some(env) = envelope {
+            return rapid_end_enveloped(blank, env, to, dir, inside, approach_mm);
+        }
         let axis = *dir;
         let m = approach_mm.max(0.0);
         let probes = [
@@ -168,6 +173,30 @@ impl Linker {
             }
         }
         a
+    }
+
+    /// Where the rapid part of an approach to `to` along the unit direction `dir` ends, for
+    /// the whole tool (flutes, shank, holder: `envelope`): the rapid runs from `inside`
+    /// (the safety surface) down the line as long as every ball of the envelope keeps
+    /// `approach_mm` from the blank, and never below `approach_mm` above `to`. Returns the
+    /// distance above `to` where it ends (`inside` when the tool is already that near the
+    /// blank on the safety surface: no rapid inside it).
+    ///
+    /// Sphere tracing on `g(t) = min_k (d_blank(c_k(t)) − ρ_k) − approach_mm`: `g` is
+    /// 1-Lipschitz in `t` (every ball centre moves at unit speed), so the tool moved by up to
+    /// `g(t)` keeps `approach_mm` from the blank; the rapid stops where `g` falls below
+    /// [`RAPID_TRACE_STOP_MM`]. So every posture of the rapid keeps at least `approach_mm`
+    /// from the blank, and so from the design inside it. Exact up to the envelope's cover
+    /// ([`ToolEnvelope`]); O(inside / 0.05) steps at most, each O(balls × profile points).
+    pub fn rapid_approach_end_enveloped(
+        &self,
+        to: &CutterLocation,
+        dir: &Vector3,
+        inside: f64,
+        approach_mm: f64,
+        envelope: &ToolEnvelope,
+    ) -> f64 {
+        self.rapid_approach_end_along(to, dir, inside, approach_mm, Some(envelope))
     }
 
     /// The point where a retract from `cl` along its axis reaches the safety surface, or an
@@ -285,7 +314,7 @@ impl Linker {
     /// a first cutting move) and appends the retract along the last move's axis, when `path`
     /// has moves and its ends lie inside the surface.
     pub fn close(&self, path: &mut ToolPath, approach_mm: f64) -> Result<(), PlanError> {
-        self.close_with(path, approach_mm, |cl| cl.axis.into_inner())
+        self.close_with(path, approach_mm, |cl| cl.axis.into_inner(), None)
     }
 
     /// The moves from `from` to the start `to` of the next path: retract along `from`'s axis
@@ -314,6 +343,19 @@ impl Linker {
         (to, in_dir): (&CutterLocation, &Vector3),
         approach_mm: f64,
     ) -> Result<Vec<Move>, PlanError> {
+        self.connect_enveloped((from, out_dir), (to, in_dir), approach_mm, None)
+    }
+
+    /// [`Linker::connect_along`] whose approach ends its rapid part where the whole tool
+    /// (`envelope`) comes within `approach_mm` of the blank
+    /// ([`Linker::rapid_approach_end_enveloped`]); the tip alone without an envelope.
+    pub fn connect_enveloped(
+        &self,
+        (from, out_dir): (&CutterLocation, &Vector3),
+        (to, in_dir): (&CutterLocation, &Vector3),
+        approach_mm: f64,
+        envelope: Option<&ToolEnvelope>,
+    ) -> Result<Vec<Move>, PlanError> {
         let out = self.leave(from, out_dir)?;
         let inn = self.leave(to, in_dir)?;
         let mut moves = Vec::new();
@@ -327,7 +369,7 @@ impl Linker {
         moves.extend(self.travel(&out, &inn));
         let inside = (inn.tip - to.tip).norm();
         if inside >= SAME_POSTURE_MM {
-            let a = self.rapid_approach_end_along(to, in_dir, inside, approach_mm);
+            let a = self.rapid_approach_end_along(to, in_dir, inside, approach_mm, envelope);
             if a < inside {
                 moves.push(Move::rapid(CutterLocation {
                     tip: to.tip + in_dir * a,
@@ -409,7 +451,13 @@ impl Linker {
     ) -> Result<Vec<Move>, PlanError> {
         let out_dir = self.checked_direction(from, check);
         let in_dir = self.checked_direction(to, check);
-        self.connect_along((from, &out_dir), (to, &in_dir), approach_mm)
+        let envelope = check.cutter.map(ToolEnvelope::of);
+        self.connect_enveloped(
+            (from, &out_dir),
+            (to, &in_dir),
+            approach_mm,
+            envelope.as_ref(),
+        )
     }
 
     /// [`Linker::close`] with the approach to the first move and the retract from the last
@@ -420,7 +468,13 @@ impl Linker {
         approach_mm: f64,
         check: &LinkCheck<'_>,
     ) -> Result<(), PlanError> {
-        self.close_with(path, approach_mm, |cl| self.checked_direction(cl, check))
+        let envelope = check.cutter.map(ToolEnvelope::of);
+        self.close_with(
+            path,
+            approach_mm,
+            |cl| self.checked_direction(cl, check),
+            envelope.as_ref(),
+        )
     }
 
     /// Appends the retract from the last move and prepends the approach to the first, each
@@ -430,6 +484,7 @@ impl Linker {
         path: &mut ToolPath,
         approach_mm: f64,
         dir: impl Fn(&CutterLocation) -> Vector3,
+        envelope: Option<&ToolEnvelope>,
     ) -> Result<(), PlanError> {
         let (Some(first), Some(last)) = (path.moves.first().copied(), path.moves.last().copied())
         else {
@@ -446,7 +501,7 @@ impl Linker {
             });
         }
         if self.surface.contains(&first.cl.tip) {
-            self.close_start_along(path, &dir(&first.cl), approach_mm)?;
+            self.close_start_along(path, &dir(&first.cl), approach_mm, envelope)?;
         }
         Ok(())
     }
@@ -547,7 +602,8 @@ impl Linker {
                 )
             })
             .collect();
-        self.join_with(name, tool, &paths, &ends, approach_mm)
+        let envelope = check.cutter.map(ToolEnvelope::of);
+        self.join_with(name, tool, &paths, &ends, approach_mm, envelope.as_ref())
     }
 
     /// `paths` (none empty) joined in order, the approach to each path's first move and the
@@ -559,21 +615,26 @@ impl Linker {
         paths: &[&ToolPath],
         ends: &[(Vector3, Vector3)],
         approach_mm: f64,
+        envelope: Option<&ToolEnvelope>,
     ) -> Result<ToolPath, PlanError> {
         let mut out = ToolPath::new(name, tool);
         let mut last_dir = Vector3::z();
         for (p, (in_dir, end_dir)) in paths.iter().zip(ends) {
             let first = p.moves[0];
             if let Some(last) = out.moves.last() {
-                let link =
-                    self.connect_along((&last.cl, &last_dir), (&first.cl, in_dir), approach_mm)?;
+                let link = self.connect_enveloped(
+                    (&last.cl, &last_dir),
+                    (&first.cl, in_dir),
+                    approach_mm,
+                    envelope,
+                )?;
                 out.moves.extend(link);
                 out.moves.extend_from_slice(&p.moves[1..]);
             } else {
                 let mut head = (*p).clone();
                 if self.surface.contains(&first.cl.tip) {
                     // Only the approach: the retract follows the last path.
-                    self.close_start_along(&mut head, in_dir, approach_mm)?;
+                    self.close_start_along(&mut head, in_dir, approach_mm, envelope)?;
                 }
                 out.moves = head.moves;
             }
@@ -600,6 +661,7 @@ impl Linker {
         path: &mut ToolPath,
         dir: &Vector3,
         approach_mm: f64,
+        envelope: Option<&ToolEnvelope>,
     ) -> Result<(), PlanError> {
         let Some(first) = path.moves.first().copied() else {
             return Ok(());
@@ -609,7 +671,7 @@ impl Linker {
             .ok_or_else(|| no_exit(&first.cl))?;
         let inside = (start.tip - first.cl.tip).norm();
         let mut head = vec![Move::rapid(start)];
-        let a = self.rapid_approach_end_along(&first.cl, dir, inside, approach_mm);
+        let a = self.rapid_approach_end_along(&first.cl, dir, inside, approach_mm, envelope);
         if a < inside {
             head.push(Move::rapid(CutterLocation {
                 tip: first.cl.tip + dir * a,
@@ -654,7 +716,7 @@ impl Linker {
                 )
             })
             .collect();
-        self.join_with(name, tool, &paths, &ends, approach_mm)
+        self.join_with(name, tool, &paths, &ends, approach_mm, None)
     }
 }
 
@@ -678,6 +740,10 @@ pub struct LinkCheck<'a> {
     pub tol_mm: f64,
     /// Clearance queries per direction tried.
     pub max_queries: usize,
+    /// The operation's tool: with it, the rapid part of every approach ends where the whole
+    /// tool comes within the approach distance of the blank
+    /// ([`Linker::rapid_approach_end_enveloped`]); without it, where the tip does.
+    pub cutter: Option<&'a cam_core::Cutter>,
 }
 
 /// Clearance queries per retract direction tried by default (a move leaving the design
@@ -764,4 +830,193 @@ pub fn widening_profile(cutter: &cam_core::Cutter) -> Option<(f64, f64)> {
         h += seg.length;
     }
     Some((h.max(l), prev))
+}
+
+/// Where a sphere-traced rapid approach stops (mm): the rapid ends once the tool's margin
+/// over the approach distance falls below this (it bounds the trace to `inside / 0.05`
+/// steps while a tool slides parallel to the blank).
+pub const RAPID_TRACE_STOP_MM: f64 = 0.05;
+
+/// Balls that cover a tool assembly (flutes, shank, holder) along its axis, for distance
+/// tests of a whole posture: ball `k` is centred `h_k` above the tip on the axis and has
+/// radius `ρ_k`.
+///
+/// A ball or tapered-ball end's ball is one of them, exactly (it holds the tool up to the
+/// ball's equator, or to the cone's tangency `R(1 − sin α)`). The rest of the assembly is
+/// cut into slabs at most [`ToolEnvelope::STEP_MM`] long; over a slab `[h₀, h₁]` the
+/// assembly lies in the cylinder of radius `r̄` = its largest radius there and half-height
+/// `(h₁ − h₀)/2`, which lies in the ball about the slab's middle of radius
+/// `√(r̄² + ((h₁ − h₀)/2)²)`. `r̄` is exact: every cutter shape's radius is non-decreasing
+/// from the tip up over the flutes (half angles ≥ 0), the shank is a cylinder and each holder
+/// segment a frustum, so a slab's largest radius is at one of its ends or at a part boundary
+/// inside it (read on both sides). So the balls cover the tool. They overreach it sideways
+/// by at most `√(r̄² + 0.25) − r̄ ≤ 0.5 mm`, and along the axis, at a flat face (a flat end's
+/// tip, the shoulder of shank or holder), by up to that face's radius. O(length / step)
+/// balls.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ToolEnvelope {
+    balls: Vec<(f64, f64)>,
+}
+
+impl ToolEnvelope {
+    /// Longest slab of the cover (mm).
+    pub const STEP_MM: f64 = 1.0;
+
+    /// The cover of `cutter`'s whole assembly.
+    pub fn of(cutter: &cam_core::Cutter) -> Self {
+        let mut bounds = vec![0.0, cutter.flute_length, cutter.overall_length];
+        let mut top = cutter.overall_length;
+        for seg in &cutter.holder {
+            top += seg.length;
+            bounds.push(top);
+        }
+        let mut balls = Vec::new();
+        // The end's own ball, and the height from which slabs cover the rest.
+        let start = match cutter.shape {
+            cam_core::CutterShape::BallEnd { radius } => {
+                balls.push((radius, radius));
+                radius
+            }
+            cam_core::CutterShape::TaperedBallEnd {
+                ball_radius,
+                half_angle,
+            } => {
+                balls.push((ball_radius, ball_radius));
+                ball_radius * (1.0 - half_angle.sin())
+            }
+            _ => 0.0,
+        }
+        .clamp(0.0, top);
+        let radius = |h: f64| cutter.assembly_radius_at(h.clamp(0.0, top)).unwrap_or(0.0);
+        let n = ((top - start) / Self::STEP_MM).ceil().max(1.0) as usize;
+        let slab = |k: usize| start + (top - start) * k as f64 / n as f64;
+        balls.extend((0..n).map(|k| {
+            let (h0, h1) = (slab(k), slab(k + 1));
+            let mut r = radius(h0).max(radius(h1));
+            for &b in &bounds {
+                if b >= h0 && b <= h1 {
+                    r = r.max(radius(b)).max(radius(b + 1e-9)).max(radius(b - 1e-9));
+                }
+            }
+            let half = 0.5 * (h1 - h0);
+            (0.5 * (h0 + h1), r.hypot(half))
+        }));
+        Self { balls }
+    }
+
+    /// The balls `(height of the centre above the tip, radius)`.
+    pub fn balls(&self) -> &[(f64, f64)] {
+        &self.balls
+    }
+
+    /// The smallest distance from the tool at tip `tip`, axis `axis` to the blank, less the
+    /// balls' radii: a lower bound of the true gap (≤ 0 when a ball reaches the blank).
+    pub fn blank_gap(&self, blank: &Stock, tip: &Point3, axis: &Vector3) -> f64 {
+        let (z_top, r_max) = (blank.z_range().1, blank.max_radius());
+        let mut gap = f64::INFINITY;
+        for &(h, rho) in &self.balls {
+            let c = tip + axis * h;
+            // The blank lies under its top and within its largest radius: a ball beyond
+            // those by more than the gap found cannot lower it.
+            let coarse = (c.z - z_top).max(c.x.hypot(c.y) - r_max) - rho;
+            if coarse >= gap {
+                continue;
+            }
+            gap = gap.min(blank.distance_to(&c.coords) - rho);
+        }
+        gap
+    }
+}
+
+/// [`Linker::rapid_approach_end_enveloped`]'s trace.
+fn rapid_end_enveloped(
+    blank: &Stock,
+    envelope: &ToolEnvelope,
+    to: &CutterLocation,
+    dir: &Vector3,
+    inside: f64,
+    approach_mm: f64,
+) -> f64 {
+    let floor = approach_mm.clamp(0.0, inside);
+    let axis = to.axis.into_inner();
+    let mut t = inside;
+    while t > floor {
+        let g = envelope.blank_gap(blank, &(to.tip + dir * t), &axis) - approach_mm.max(0.0);
+        if g < RAPID_TRACE_STOP_MM {
+            return t;
+        }
+        t -= g;
+    }
+    floor
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)] // test code
+    use super::*;
+    use cam_core::{Cutter, CutterShape, HolderSegment};
+
+    #[test]
+    fn the_envelope_covers_every_point_of_the_tool_and_hugs_a_ball_end() {
+        // Surface points every 0.01 mm of height (the axis frame is irrelevant: balls lie on
+        // the axis, so a point at height h and radius r is covered iff some ball has
+        // (h − h_k)² + r² ≤ ρ_k²), and the axis itself for the end faces.
+        let shapes = [
+            CutterShape::FlatEnd { radius: 3.0 },
+            CutterShape::BallEnd { radius: 2.0 },
+            CutterShape::BullNose {
+                radius: 4.0,
+                corner_radius: 1.0,
+            },
+            CutterShape::TaperedBallEnd {
+                ball_radius: 1.5,
+                half_angle: 3f64.to_radians(),
+            },
+            CutterShape::TaperedFlatEnd {
+                tip_radius: 1.0,
+                half_angle: 5f64.to_radians(),
+            },
+        ];
+        for shape in shapes {
+            let mut c = Cutter::new("t", shape, 12.3, 4.0, 40.7).unwrap();
+            c.holder = vec![
+                HolderSegment {
+                    bottom_radius: 10.5,
+                    top_radius: 13.5,
+                    length: 38.2,
+                },
+                HolderSegment {
+                    bottom_radius: 13.5,
+                    top_radius: 13.5,
+                    length: 41.9,
+                },
+            ];
+            let env = ToolEnvelope::of(&c);
+            let top = 40.7 + 38.2 + 41.9;
+            let n = (top / 0.01) as usize;
+            for i in 0..=n {
+                let h = top * i as f64 / n as f64;
+                let r = c.assembly_radius_at(h.min(top - 1e-9)).unwrap();
+                for rr in [0.0, r] {
+                    let inside = env
+                        .balls()
+                        .iter()
+                        .any(|&(hk, rho)| (h - hk).powi(2) + rr * rr <= rho * rho + 1e-12);
+                    assert!(inside, "{shape:?}: ({h}, {rr}) outside the envelope");
+                }
+            }
+            // A ball end's lowest point is the envelope's: no overreach below the tip.
+            if let CutterShape::BallEnd { .. } | CutterShape::TaperedBallEnd { .. } = shape {
+                let lowest = env
+                    .balls()
+                    .iter()
+                    .map(|&(hk, rho)| hk - rho)
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    lowest.abs() < 1e-12,
+                    "{shape:?}: reaches {lowest} below the tip"
+                );
+            }
+        }
+    }
 }

@@ -73,6 +73,7 @@ impl PlanContext<'_> {
                 .max(0.0),
             tol_mm: 0.5 * self.tolerances.machining_tol,
             max_queries: DEFAULT_LINK_QUERIES,
+            cutter: Some(&self.tool.cutter),
         }
     }
 
