@@ -451,6 +451,30 @@ impl TriDexel {
         g.ray(i, j).contains(p[d])
     }
 
+    /// The point of grid `d`'s ray nearest to `p` at `p`'s coordinate `d`: where
+    /// [`TriDexel::contains_via`] reads membership exactly. `None` where that reads outside
+    /// the grid.
+    #[inline]
+    pub fn nearest_ray_point(&self, d: usize, p: &[f64; 3]) -> Option<[f64; 3]> {
+        let g = &self.grids[d % 3];
+        let (ua, va) = ((d + 1) % 3, (d + 2) % 3);
+        let (u, v) = (p[ua], p[va]);
+        let h = self.cell;
+        if u < g.u0 - 0.5 * h
+            || v < g.v0 - 0.5 * h
+            || u > g.u0 + (g.nu as f64 + 0.5) * h
+            || v > g.v0 + (g.nv as f64 + 0.5) * h
+        {
+            return None;
+        }
+        let (i, j) = g.nearest(u, v);
+        let (ru, rv) = g.ray_uv(i, j);
+        let mut q = *p;
+        q[ua] = ru;
+        q[va] = rv;
+        Some(q)
+    }
+
     /// Membership by majority vote of the three grids' nearest rays.
     pub fn contains(&self, p: &[f64; 3]) -> bool {
         (0..3).filter(|&d| self.contains_via(d, p)).count() >= 2

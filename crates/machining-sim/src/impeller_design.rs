@@ -722,7 +722,18 @@ impl DesignModel for ImpellerDesign {
                 let below_tip = -at_p
                     .and_then(|v| v.shroud)
                     .unwrap_or_else(|| self.shroud_sd.signed_distance(p));
-                let side_depth = -wedge.unwrap_or(d1);
+                // A foot on the side's u-edge that no wedge decides (the other side ends
+                // elsewhere: a skewed blunt edge) says `p` lies beyond the side's end, so
+                // the side is no face above `p`; its distance is to the edge curve, not a
+                // depth. The blade's own signed distance gives the depth there (NASA Rotor
+                // 37's 0.44 mm trailing edges: an end point 0.007 mm inside the blade,
+                // entered through the suction side, read 0.043 mm "below" its edge curve;
+                // the exact swept envelopes give 0.0032 mm).
+                let side_depth = match wedge {
+                    Some(w) => -w,
+                    None if side_u_edge(blade, s, f1.u).is_some() => -self.blade_signed_distance(p),
+                    None => -d1,
+                };
                 if below_tip > 0.0 {
                     side_depth.min(below_tip)
                 } else {

@@ -18,7 +18,10 @@
 //! * probed overcut at P: if P is empty, the removed depth along `−n` is kept only when the
 //!   line crosses the design (or reaches the probe depth) without meeting material — the
 //!   through-cut case without end points; a line that meets material inside the design has an
-//!   end point there, which is exact and replaces the probe's cell-sized estimate;
+//!   end point there, which is exact and replaces the probe's cell-sized estimate. The depth
+//!   kept is that of the removed points on the rays read (`−sd` there), so a probe never
+//!   reads more than was cut: at an edge thinner than a cell the line's own depth would credit
+//!   a ray passing beside the edge;
 //! * residual at P: if P is in material, the distance along `+n` to the first empty point,
 //!   stopping when the line enters the design again or at the probe depth.
 //!
@@ -156,7 +159,7 @@ pub fn probe(
         }
     } else {
         // Overcut: march inward while removed; the value is the deepest removed point's
-        // distance inside the design, −sd (= t on a flat face).
+        // distance inside the design, −sd, read on the rays (see below).
         let mut t = 0.0;
         let mut best: f64 = 0.0;
         let mut steps = 0usize;
@@ -176,20 +179,27 @@ pub fn probe(
                     residual: 0.0,
                 };
             }
-            // The design is evaluated every other step (every cell): between evaluations the
-            // depth can exceed the sampled maximum by at most h/2 (1-Lipschitz), and the
-            // final transition point is always evaluated.
+            // The depth counted is that of the point on the nearest ray where the removal
+            // was read, `−sd(x′)`: that point is removed (exactly along its ray, and the
+            // simulated stock never removes more than the tool), so its depth is cut depth,
+            // never more. The probe line's own depth would credit the ray's lateral offset
+            // (up to h/√2): at a blade edge thinner than a cell the nearest ray passes beyond
+            // the edge through air, and the line read half the wall as overcut (NASA Rotor
+            // 37's 0.44 mm trailing edges at 0.5 mm: 0.172 mm where the exact swept
+            // envelopes give 0.0026 mm). A ray point outside the design counts nothing.
+            let x = p - n * next;
+            if let Some(q) = stock.nearest_ray_point(d, &[x.x, x.y, x.z]) {
+                best = best.max(-design.signed_distance(&Point3::new(q[0], q[1], q[2])));
+            }
+            // The line's design distance is evaluated every other step (every cell) to see
+            // whether it has left the design.
             steps += 1;
-            if steps % 2 == 1 {
-                let s = sd(-next);
-                if s > 0.0 {
-                    // Left the design (cut through a wall).
-                    return Probe {
-                        overcut: best,
-                        residual: 0.0,
-                    };
-                }
-                best = best.max(-s);
+            if steps % 2 == 1 && sd(-next) > 0.0 {
+                // Left the design (cut through a wall).
+                return Probe {
+                    overcut: best,
+                    residual: 0.0,
+                };
             }
             t = next;
         }
