@@ -437,6 +437,14 @@ impl TriDexel {
     /// (exact along `d`, lateral error up to half a cell diagonal).
     #[inline]
     pub fn contains_via(&self, d: usize, p: &[f64; 3]) -> bool {
+        self.nearest_ray(d, p)
+            .is_some_and(|(i, j)| self.grids[d % 3].ray(i, j).contains(p[d]))
+    }
+
+    /// The index of grid `d`'s ray nearest to `p`, `None` more than half a cell outside
+    /// the grid.
+    #[inline]
+    fn nearest_ray(&self, d: usize, p: &[f64; 3]) -> Option<(usize, usize)> {
         let g = &self.grids[d % 3];
         let (u, v) = (p[(d + 1) % 3], p[(d + 2) % 3]);
         let h = self.cell;
@@ -445,10 +453,9 @@ impl TriDexel {
             || u > g.u0 + (g.nu as f64 + 0.5) * h
             || v > g.v0 + (g.nv as f64 + 0.5) * h
         {
-            return false;
+            return None;
         }
-        let (i, j) = g.nearest(u, v);
-        g.ray(i, j).contains(p[d])
+        Some(g.nearest(u, v))
     }
 
     /// The point of grid `d`'s ray nearest to `p` at `p`'s coordinate `d`: where
@@ -456,22 +463,11 @@ impl TriDexel {
     /// the grid.
     #[inline]
     pub fn nearest_ray_point(&self, d: usize, p: &[f64; 3]) -> Option<[f64; 3]> {
-        let g = &self.grids[d % 3];
-        let (ua, va) = ((d + 1) % 3, (d + 2) % 3);
-        let (u, v) = (p[ua], p[va]);
-        let h = self.cell;
-        if u < g.u0 - 0.5 * h
-            || v < g.v0 - 0.5 * h
-            || u > g.u0 + (g.nu as f64 + 0.5) * h
-            || v > g.v0 + (g.nv as f64 + 0.5) * h
-        {
-            return None;
-        }
-        let (i, j) = g.nearest(u, v);
-        let (ru, rv) = g.ray_uv(i, j);
+        let (i, j) = self.nearest_ray(d, p)?;
+        let (ru, rv) = self.grids[d % 3].ray_uv(i, j);
         let mut q = *p;
-        q[ua] = ru;
-        q[va] = rv;
+        q[(d + 1) % 3] = ru;
+        q[(d + 2) % 3] = rv;
         Some(q)
     }
 
