@@ -369,22 +369,20 @@ impl Planner<'_> {
     }
 
     /// Smallest margin of the tool above the ball over its floors at `(c, axis)` (negative:
-    /// not clear; stops below 0) and, when a cutter sample is below its floor, that sample's
-    /// lever `|h − r|` (0 when the shank or holder failed): turned about the ball centre from
-    /// `axis` to `a`, the sample moves by `lever·|a − axis|`.
-    fn posture_check(&self, c: &Vector3<f64>, axis: &Vector3<f64>) -> (f64, f64) {
+    /// not clear); stops below 0.
+    fn posture_margin(&self, c: &Vector3<f64>, axis: &Vector3<f64>) -> f64 {
         let tip = c - axis * self.r;
         let mut best = f64::INFINITY;
         for &(h, rho, floor) in &self.upper {
             let m = self.margin(&(tip + axis * h), rho) - floor;
             best = best.min(m);
             if best < 0.0 {
-                return (best, (h - self.r).abs());
+                return best;
             }
         }
         match CutterLocation::new(Point3::from(tip), *axis) {
-            Ok(cl) if self.shank.is_clear(&cl, self.stock_margin) => (best, 0.0),
-            _ => (-1.0, 0.0),
+            Ok(cl) if self.shank.is_clear(&cl, self.stock_margin) => best,
+            _ => -1.0,
         }
     }
 
@@ -420,40 +418,19 @@ impl Planner<'_> {
         out
     }
 
-    /// A clear posture with its ball centre at `c` (None: none within the search): the first
-    /// candidate axis the machine reaches and [`Self::posture_check`] clears.
-    ///
-    /// A candidate is skipped, without evaluating it, when an axis already refused proves it
-    /// refused too: if a cutter sample with lever `ℓ` fell `m < 0` below its floor at axis
-    /// `f`, then at axis `a` that sample lies within `ℓ·|a − f|` of where it was, and the
-    /// margin is 1-Lipschitz, so it is still below its floor when `ℓ·|a − f| < −m`. The
-    /// skip is exact (the same posture is found); it spares the candidates around an axis
-    /// leaning into a wall. O(candidates × refusals) vector tests on top of the margins.
+    /// A clear posture with its ball centre at `c` (None: none within the search).
     fn posture(&self, c: &Vector3<f64>, prev: Option<&Vector3<f64>>) -> Option<Station> {
-        let mut refused: Vec<(Vector3<f64>, f64, f64)> = Vec::new();
-        for a in self.candidate_axes(c, prev) {
-            if !self.ctx.reaches(&a)
-                || refused
-                    .iter()
-                    .any(|(f, lever, m)| lever * (a - f).norm() < -m)
-            {
-                continue;
-            }
-            let (m, lever) = self.posture_check(c, &a);
-            if m < 0.0 {
-                if lever > 0.0 {
-                    refused.push((a, lever, m));
-                }
-                continue;
+        self.candidate_axes(c, prev).into_iter().find_map(|a| {
+            if !self.ctx.reaches(&a) || self.posture_margin(c, &a) < 0.0 {
+                return None;
             }
             let cl = CutterLocation::new(Point3::from(c - a * self.r), a).ok()?;
-            return Some(Station {
+            Some(Station {
                 centre: *c,
                 axis: a,
                 cl,
-            });
-        }
-        None
+            })
+        })
     }
 
     /// Whether the motion from `a` to `b` is certified clear (module docs).
