@@ -89,7 +89,10 @@ use serde::Deserialize;
 
 use crate::accessibility::ball_radius;
 use crate::ball_fit::{BladeBoundary, BoundaryPart};
-use crate::root_axis::{self, assembly_clearance, search_axis, shank_and_holder, Search, TurnAxis};
+use crate::root_axis::{
+    self, assembly_clearance, search_axis, shank_and_holder, shank_clear, shank_keep, Search,
+    TurnAxis,
+};
 
 /// Kind key of blade-root finishing in job files.
 pub const BLADE_ROOT_FINISHING: &str = "blade_root_finishing";
@@ -471,13 +474,14 @@ impl SidePlanner<'_, '_> {
                 self.r,
                 f64::NEG_INFINITY,
             );
-            (clearance >= -tol).then_some(Search::Found {
-                axis,
-                steps: 0,
-                rotation,
-                turn: TurnAxis::Interpolated,
-                clearance,
-            })
+            (clearance >= -tol && shank_clear(self.ctx, &self.upper, &centre, &axis, self.r))
+                .then_some(Search::Found {
+                    axis,
+                    steps: 0,
+                    rotation,
+                    turn: TurnAxis::Interpolated,
+                    clearance,
+                })
         });
         let found = match interpolated {
             Some(f) => f,
@@ -588,6 +592,18 @@ impl SidePlanner<'_, '_> {
         (cb, qb): (&CutterLocation, f64),
     ) -> bool {
         let min = -self.ctx.tolerances.machining_tol - MOTION_SAMPLE_TOL_MM;
+        // Shank and holder, which do not cut, keep half of `shank_keep` all along the motion
+        // (their postures keep all of it): the coarse bisection of the whole tool above
+        // admits `min − (MOTION_TOL_MM − MOTION_SAMPLE_TOL_MM)`, which lets a shank graze a
+        // blade (impeller-11+11-freeform: 0.022 mm into the design, found by the verifier).
+        let keep = shank_keep(self.ctx);
+        let upper_clear = || {
+            let ua = self.upper.clearance(ca).distance_mm;
+            let ub = self.upper.clearance(cb).distance_mm;
+            self.upper
+                .segment_clearance_between((ca, ua), (cb, ub), keep, 0.5 * keep, SEGMENT_QUERIES)
+                .is_ok()
+        };
         self.motion
             .segment_clearance_between(
                 (ca, qa),
@@ -597,6 +613,7 @@ impl SidePlanner<'_, '_> {
                 SEGMENT_QUERIES,
             )
             .is_ok()
+            && upper_clear()
     }
 
     /// The clearance of flutes, shank and holder of the posture with ball centre `centre` and
@@ -919,9 +936,10 @@ impl cam_plan::PostureCheck for SidePlanner<'_, '_> {
     type Clear = f64;
     fn posture_clear(&self, i: usize, cl: &CutterLocation) -> Option<f64> {
         let centre = cl.axis_point(self.r).coords;
-        let clear = self.ctx.reaches(&cl.axis.into_inner())
-            && self.posture_clearance(&centre, &cl.axis.into_inner())
-                >= -self.ctx.tolerances.machining_tol;
+        let axis = cl.axis.into_inner();
+        let clear = self.ctx.reaches(&axis)
+            && self.posture_clearance(&centre, &axis) >= -self.ctx.tolerances.machining_tol
+            && shank_clear(self.ctx, &self.upper, &centre, &axis, self.r);
         if !clear {
             return None;
         }

@@ -85,6 +85,35 @@ pub(crate) fn shank_and_holder<'a>(ctx: &PlanContext<'a>) -> DesignClearance<'a>
     })
 }
 
+/// What the shank and holder keep from the design (mm): they do not cut, and any contact of
+/// theirs with the design is a collision. The clearance query's mesh can read up to its chord
+/// above the truth at a convex edge, so they keep the larger of the chord and the machining
+/// tolerance (the cutter may touch within `−machining_tol`: it cuts there).
+pub(crate) fn shank_keep(ctx: &PlanContext<'_>) -> f64 {
+    ctx.tolerances
+        .machining_tol
+        .max(ctx.tolerances.chord_tol)
+        .max(0.0)
+}
+
+/// Whether the shank and holder (`upper`) of the posture with ball centre `centre`, unit
+/// `axis` and ball radius `r` keep [`shank_keep`] from the design.
+pub(crate) fn shank_clear(
+    ctx: &PlanContext<'_>,
+    upper: &DesignClearance<'_>,
+    centre: &Vector3<f64>,
+    axis: &Vector3<f64>,
+    r: f64,
+) -> bool {
+    Unit::try_new(*axis, 1e-12).is_some_and(|unit| {
+        let cl = CutterLocation {
+            tip: Point3::from(centre - axis * r),
+            axis: unit,
+        };
+        upper.clearance_if_clear(&cl, shank_keep(ctx)).is_some()
+    })
+}
+
 /// One blade-root station as the axis search sees it.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Station<'b> {
@@ -221,7 +250,8 @@ fn c_max(
 /// shank and holder frusta (`upper`, placed as on the job's tool: tip at `centre − r·axis`).
 /// With a finite `stop_below` it returns as soon as a part is found below it (the shank and
 /// holder are queried first, the cheaper query), with a value below `stop_below`: the flutes'
-/// sample there, or −∞ for the shank or holder; with `f64::NEG_INFINITY` the exact minimum.
+/// sample there, or −∞ for the shank or holder, which must also keep [`shank_keep`]; with
+/// `f64::NEG_INFINITY` the exact minimum.
 pub(crate) fn assembly_clearance(
     ctx: &PlanContext<'_>,
     upper: &DesignClearance<'_>,
@@ -237,7 +267,7 @@ pub(crate) fn assembly_clearance(
     });
     if stop_below.is_finite() {
         if let Some(cl) = &shank {
-            if let Some(c) = upper.clearance_if_clear(cl, stop_below) {
+            if let Some(c) = upper.clearance_if_clear(cl, stop_below.max(shank_keep(ctx))) {
                 return upper_clearance(ctx, centre, axis, r, ball, stop_below).min(c.distance_mm);
             }
             return f64::NEG_INFINITY;
