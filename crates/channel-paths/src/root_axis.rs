@@ -105,12 +105,16 @@ pub(crate) fn shank_clear(
     axis: &Vector3<f64>,
     r: f64,
 ) -> bool {
-    Unit::try_new(*axis, 1e-12).is_some_and(|unit| {
-        let cl = CutterLocation {
-            tip: Point3::from(centre - axis * r),
-            axis: unit,
-        };
-        upper.clearance_if_clear(&cl, shank_keep(ctx)).is_some()
+    posture_cl(centre, axis, r)
+        .is_some_and(|cl| upper.clearance_if_clear(&cl, shank_keep(ctx)).is_some())
+}
+
+/// The cutter location of the posture with ball centre `centre`, unit `axis` and ball radius
+/// `r` (tip at `centre − r·axis`); `None` for a zero axis.
+fn posture_cl(centre: &Vector3<f64>, axis: &Vector3<f64>, r: f64) -> Option<CutterLocation> {
+    Unit::try_new(*axis, 1e-12).map(|unit| CutterLocation {
+        tip: Point3::from(centre - axis * r),
+        axis: unit,
     })
 }
 
@@ -261,10 +265,7 @@ pub(crate) fn assembly_clearance(
     ball: f64,
     stop_below: f64,
 ) -> f64 {
-    let shank = Unit::try_new(*axis, 1e-12).map(|unit| CutterLocation {
-        tip: Point3::from(centre - axis * r),
-        axis: unit,
-    });
+    let shank = posture_cl(centre, axis, r);
     if stop_below.is_finite() {
         if let Some(cl) = &shank {
             if let Some(c) = upper.clearance_if_clear(cl, stop_below.max(shank_keep(ctx))) {
