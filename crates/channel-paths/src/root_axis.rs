@@ -110,12 +110,9 @@ pub(crate) fn shank_clear(
 }
 
 /// The cutter location of the posture with ball centre `centre`, unit `axis` and ball radius
-/// `r` (tip at `centre − r·axis`); `None` for a zero axis.
+/// `r` (tip at `centre − r·axis`); `None` for a zero or non-finite axis.
 fn posture_cl(centre: &Vector3<f64>, axis: &Vector3<f64>, r: f64) -> Option<CutterLocation> {
-    Unit::try_new(*axis, 1e-12).map(|unit| CutterLocation {
-        tip: Point3::from(centre - axis * r),
-        axis: unit,
-    })
+    CutterLocation::new(Point3::from(centre - axis * r), *axis).ok()
 }
 
 /// One blade-root station as the axis search sees it.

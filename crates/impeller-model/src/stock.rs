@@ -358,24 +358,16 @@ impl Stock {
         if self.contains(p) {
             return 0.0;
         }
-        let q = [p.x.hypot(p.y), p.z];
-        let seg = |a: [f64; 2], b: [f64; 2]| {
-            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-            let len2 = dx * dx + dy * dy;
-            let t = if len2 > 0.0 {
-                (((q[0] - a[0]) * dx + (q[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (q[0] - a[0] - t * dx).hypot(q[1] - a[1] - t * dy)
-        };
-        let rz = |p: &[f64; 2]| [p[1], p[0]];
+        use nalgebra::Vector2;
+        use nurbs::discretise::point_segment_distance;
+        let q = Vector2::new(p.x.hypot(p.y), p.z);
+        let rz = |p: &[f64; 2]| Vector2::new(p[1], p[0]);
         let pts = &self.profile_zr;
         let (first, last) = (rz(&pts[0]), rz(&pts[pts.len() - 1]));
-        let caps = seg([0.0, first[1]], first).min(seg([0.0, last[1]], last));
+        let cap = |e: &Vector2<f64>| point_segment_distance(&q, &Vector2::new(0.0, e.y), e);
         pts.windows(2)
-            .map(|w| seg(rz(&w[0]), rz(&w[1])))
-            .fold(caps, f64::min)
+            .map(|w| point_segment_distance(&q, &rz(&w[0]), &rz(&w[1])))
+            .fold(cap(&first).min(cap(&last)), f64::min)
     }
 
     /// Whether the point (x, y, z) lies in the blank.
