@@ -654,7 +654,9 @@ fn design_and_blank(
 /// The stock the planned operations `earlier` leave on the job's blank, simulated at the
 /// job's verification resolution on their CL paths (machining-sim's tri-dexel stock) and
 /// measured above the design at the verifier's samples: what a rest operation plans from.
-/// Cost: one stock simulation of `earlier` (as [`verify`]'s, without its progress bar).
+/// Cost: one stock simulation of `earlier` without the overcut reading and the collision
+/// checks ([`machining_sim::simulate_residual`]: the same stock and residual as
+/// [`verify`]'s simulation of the same paths, in about half its time).
 fn remaining_after(
     job: &Job,
     impeller: &Impeller,
@@ -665,13 +667,13 @@ fn remaining_after(
         .filter_map(|op| op.cl.cutter.clone().map(|c| (c, op.cl.path.clone())))
         .collect();
     let (design, mut stock) = design_and_blank(job, impeller)?;
-    let rep = machining_sim::simulate(&mut stock, &design, &paths, &SimOptions::default())
-        .map_err(msg)?;
+    let maps =
+        machining_sim::simulate_residual(&mut stock, &design, &paths, &SimOptions::default())
+            .map_err(msg)?;
     Ok(cam_plan::RemainingMaterial {
         after: earlier.iter().map(|op| op.cl.path.name.clone()).collect(),
         resolution_mm: job.verification.resolution_mm,
-        grids: rep
-            .maps
+        grids: maps
             .into_iter()
             .map(|m| cam_plan::RestGrid {
                 surface: m.name,

@@ -83,8 +83,8 @@ pub use measure::{Extremum, Measured, SurfaceMap};
 pub use motion::Interpolation;
 pub use removal::PartKind;
 pub use simulate::{
-    cut, simulate, Collision, CollisionTarget, CutOutcome, Metrics, ProgressSink, Report,
-    SimOptions, SimProgress, SimStats,
+    cut, simulate, simulate_residual, Collision, CollisionTarget, CutOutcome, Metrics,
+    ProgressSink, Report, SimOptions, SimProgress, SimStats,
 };
 pub use stock_shape::{BoxStock, RevolvedStock, StockShape};
 pub use surface_mesh::{extract_surface, write_stl, StockMesh};

@@ -104,18 +104,6 @@ pub fn probe(
     };
     let h = stock.cell();
     let step = 0.5 * h;
-    let refine = |mut a: f64, mut b: f64, occ_a: bool, f: &dyn Fn(f64) -> bool| {
-        // Transition of `f` lies between a (state occ_a) and b (the other state).
-        while (b - a).abs() > h / 64.0 {
-            let m = 0.5 * (a + b);
-            if f(m) == occ_a {
-                a = m;
-            } else {
-                b = m;
-            }
-        }
-        0.5 * (a + b)
-    };
     let sd = |t: f64| design.signed_distance(&(p + n * t));
     if kept(0.0) && !occ(0.0) {
         return Probe {
@@ -123,39 +111,10 @@ pub fn probe(
             residual: 0.0,
         };
     }
-    // A line point within `h` of another part of the design boundary is ambiguous (the
-    // nearest ray may lie on either side): the march stops once the design distance falls
-    // below min(t, h)/2 and reports the last unambiguous depth.
-    let margin = |t: f64| 0.5 * t.min(h);
     if occ(0.0) {
-        // Residual: march outward while in material, stop near/inside the design again.
-        let mut t = 0.0;
-        let mut safe = 0.0;
-        loop {
-            let next = t + step;
-            if next > max_depth {
-                return Probe {
-                    overcut: 0.0,
-                    residual: max_depth,
-                };
-            }
-            if next > safe {
-                let s = sd(next);
-                if s < margin(next) {
-                    return Probe {
-                        overcut: 0.0,
-                        residual: t,
-                    };
-                }
-                safe = next + (s - 0.5 * h).max(0.0);
-            }
-            if !occ(next) {
-                return Probe {
-                    overcut: 0.0,
-                    residual: refine(t, next, true, &occ),
-                };
-            }
-            t = next;
+        Probe {
+            overcut: 0.0,
+            residual: residual_along(stock, design, p, n, max_depth),
         }
     } else {
         // Overcut: march inward while removed; the value is the deepest removed point's
@@ -206,6 +165,71 @@ pub fn probe(
     }
 }
 
+/// The residual at `p` (outward unit normal `n`, up to `max_depth` mm): the distance along
+/// `+n` from `p` to the first empty point of `stock`, 0 when `p` itself is empty. The line is
+/// marched in steps of `h/2` and the transition refined by bisection to `h/64`; the march
+/// stops where the line comes within `min(t, h)/2` of the design again (another part of the
+/// design: the nearest ray may lie on either side) and reports the last unambiguous depth,
+/// or at `max_depth` (capped). This is [`probe`]'s residual, without its overcut reading,
+/// for callers that need the material left and not the cut depth (rest machining).
+/// Cost: O(residual / h) membership queries and at most as many design evaluations.
+pub fn residual_along(
+    stock: &TriDexel,
+    design: &dyn DesignModel,
+    p: &Point3,
+    n: &Vector3,
+    max_depth: f64,
+) -> f64 {
+    let d = (0..3)
+        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+        .unwrap_or(2);
+    let occ = |t: f64| {
+        let x = p + n * t;
+        stock.contains_via(d, &[x.x, x.y, x.z])
+    };
+    if !occ(0.0) {
+        return 0.0;
+    }
+    let h = stock.cell();
+    let step = 0.5 * h;
+    // A line point within `h` of another part of the design boundary is ambiguous (the
+    // nearest ray may lie on either side): the march stops once the design distance falls
+    // below min(t, h)/2 and reports the last unambiguous depth.
+    let margin = |t: f64| 0.5 * t.min(h);
+    let sd = |t: f64| design.signed_distance(&(p + n * t));
+    // Material at 0, none at `b`: bisect to h/64.
+    let refine = |mut a: f64, mut b: f64| {
+        while (b - a).abs() > h / 64.0 {
+            let m = 0.5 * (a + b);
+            if occ(m) {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        0.5 * (a + b)
+    };
+    let mut t = 0.0;
+    let mut safe = 0.0;
+    loop {
+        let next = t + step;
+        if next > max_depth {
+            return max_depth;
+        }
+        if next > safe {
+            let s = sd(next);
+            if s < margin(next) {
+                return t;
+            }
+            safe = next + (s - 0.5 * h).max(0.0);
+        }
+        if !occ(next) {
+            return refine(t, next);
+        }
+        t = next;
+    }
+}
+
 /// Measures every sample of every grid (parallel over samples); `initial` is the blank
 /// before machining (removed = material in `initial`, none in `stock`). See [`measure`].
 pub fn measure_maps(
@@ -216,6 +240,41 @@ pub fn measure_maps(
     max_depth: f64,
 ) -> Vec<SurfaceMap> {
     measure(stock, initial, design, grids, max_depth).maps
+}
+
+/// Residual maps only (every `overcut_mm` entry `None`): [`residual_along`] at every sample
+/// of every grid, parallel over samples. The residual values are bit for bit those of
+/// [`measure`] (the same march); no end point is read and no blank is needed, so this costs
+/// only the residual probes: O(residual / h) per sample.
+pub fn measure_residual(
+    stock: &TriDexel,
+    design: &dyn DesignModel,
+    grids: &[SurfaceGrid],
+    max_depth: f64,
+) -> Vec<SurfaceMap> {
+    grids
+        .iter()
+        .map(|g| {
+            let residual_mm: Vec<Option<f64>> = g
+                .points
+                .par_iter()
+                .zip(g.normals.par_iter())
+                .map(|(p, n)| {
+                    let len = n.norm();
+                    (len > 1e-12 && len.is_finite())
+                        .then(|| residual_along(stock, design, p, &(n / len), max_depth))
+                })
+                .collect();
+            SurfaceMap {
+                name: g.name.clone(),
+                nu: g.nu,
+                nv: g.nv,
+                points: g.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                overcut_mm: vec![None; residual_mm.len()],
+                residual_mm,
+            }
+        })
+        .collect()
 }
 
 /// Overcut/residual maps plus the deepest cut end point.

@@ -19,7 +19,7 @@ use crate::design::DesignModel;
 use crate::dexel::TriDexel;
 use crate::endpoints::overcut_error_bound;
 use crate::error::SimError;
-use crate::measure::{extremum, measure, Extremum, SurfaceMap};
+use crate::measure::{extremum, measure, measure_residual, Extremum, SurfaceMap};
 use crate::merge::{run_step, CuttingReach, Run};
 use crate::motion::{
     has_flat_face, positions_for_move, positions_for_samples, scallop_radius, sub_positions,
@@ -541,6 +541,44 @@ pub fn colliding_moves(collisions: &[Collision]) -> usize {
     keys.sort_unstable();
     keys.dedup();
     keys.len()
+}
+
+/// The material the tool paths leave: sweeps them through `stock` (modified in place to the
+/// final stock) and measures the residual over the design's surface samples
+/// ([`crate::measure::measure_residual`]); no overcut is read and no collision is reported
+/// (shank and holder are not checked against the design, the removal's checks of rapids
+/// against the stock are dropped: callers that need a verdict use [`simulate`]). The removal is [`simulate`]'s, so the final stock and the residual maps are
+/// bit for bit those of [`simulate`] with the same options; what it saves is the overcut
+/// reading (one design evaluation per cut dexel end point), the collision checks and the
+/// copy of the blank. What a rest operation plans from.
+pub fn simulate_residual(
+    stock: &mut TriDexel,
+    design: &dyn DesignModel,
+    ops: &[(Cutter, ToolPath)],
+    options: &SimOptions,
+) -> Result<Vec<SurfaceMap>, SimError> {
+    if !(options.probe_depth_mm.is_finite() && options.probe_depth_mm > 0.0) {
+        return Err(SimError::InvalidOption {
+            name: "probe_depth_mm",
+            value: options.probe_depth_mm,
+            reason: "must be finite and > 0",
+        });
+    }
+    let options = SimOptions {
+        check_collisions: false,
+        ..options.clone()
+    };
+    cut(stock, None, ops, &options)?;
+    if let Some(sink) = &options.on_progress {
+        (sink.0)(SimProgress::Measuring);
+    }
+    let grids = design.surface_grids();
+    Ok(measure_residual(
+        stock,
+        design,
+        &grids,
+        options.probe_depth_mm,
+    ))
 }
 
 /// Verifies tool paths against a design: sweeps them through `stock` (modified in place to
