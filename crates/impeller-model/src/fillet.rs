@@ -224,6 +224,9 @@ pub struct FilletPiece {
     /// Hub normal (0..3) and blade normal (3..6) along the spine's parameter.
     normals: NurbsCurve<6>,
     projector: CurveProjector<3>,
+    /// Farthest a point can lie from its nearest spine point where this piece decides the
+    /// distance ([`FilletPiece::closest`]'s sector), with a margin (see [`sector_reach`]).
+    sector_reach: f64,
     fit_error_mm: f64,
     /// The material's bounding wedges along the spine, built on first use
     /// ([`FilletPiece::material_distance_lower`]).
@@ -452,7 +455,9 @@ impl FilletPiece {
     /// Signed distance of `p` to the fillet material of this piece (module docs) and the
     /// nearest point of the fillet surface, `None` where the fillet does not decide it.
     fn closest(&self, p: &Vector3<f64>) -> Option<(f64, Vector3<f64>)> {
-        let q = self.projector.closest_point(p);
+        // Beyond the sector's reach from the whole spine nothing below can answer; the
+        // bounded search proves that from the spine's segment boxes without isolating roots.
+        let q = self.projector.closest_point_within(p, self.sector_reach)?;
         let d = p - q.point;
         let tangent = q.tangent.try_normalize(1e-12)?;
         if q.on_boundary || d.dot(&tangent).abs() > 1e-6 * (1.0 + d.norm()) {
@@ -751,25 +756,38 @@ impl ImpellerFillets {
     }
 
     /// Calls `visit` with two bounds for each fillet of the instances whose window holds `p`
-    /// (each side's pieces taken together, the smallest over them): the distance from `p` to
-    /// the spine, and a lower bound of the distance from `p` to the fillet material
-    /// ([`FilletPiece::material_distance_lower`]). The ball of radius `R` about any spine
-    /// point is free of design material (it touches hub and side and the fillet lies outside
-    /// it), so a sphere about `p` of radius `ρ` is clear of that fillet when `R − d_spine ≥ ρ`
-    /// or when the material bound is `≥ ρ`; a fillet not visited is farther than
-    /// [`Self::reach_mm`] from `p`. Cost: as [`Self::closest`] plus the wedge bounds.
+    /// (each side's pieces taken together, the smallest over them): the distance `d_spine`
+    /// from `p` to the spine, and a lower bound `m` of the distance from `p` to the fillet
+    /// material ([`FilletPiece::material_distance_lower`]). The ball of radius `R` about any
+    /// spine point is free of design material (it touches hub and side and the fillet lies
+    /// outside it), so a sphere about `p` of radius `ρ` is clear of that fillet when
+    /// `R − d_spine ≥ ρ` or when `m ≥ ρ`, i.e. when `max(R − d_spine, m) ≥ ρ`; a fillet not
+    /// visited is farther than [`Self::reach_mm`] from `p`. The spine distance is exact where
+    /// it is below `R − m`, the only place it can decide that maximum, and passed as `+∞`
+    /// elsewhere (the spine search is bounded there: most pieces are pruned by their boxes).
+    /// Cost: the wedge bounds plus a bounded certified projection per piece.
     /// Material bounds at or above `cap` are passed as some value `≥ cap`.
     pub fn material_bounds(&self, p: &Vector3<f64>, cap: f64, mut visit: impl FnMut(f64, f64)) {
         self.near_instances(p, |pair, _, q| {
             for f in pair {
-                let (mut spine, mut material) = (f64::INFINITY, f64::INFINITY);
-                for k in &f.pieces {
-                    spine = spine.min(k.spine_distance(&q));
-                    material = material.min(k.material_distance_lower(&q, cap));
+                if f.pieces.is_empty() {
+                    continue;
                 }
-                if spine.is_finite() {
-                    visit(spine, material);
-                }
+                let material = f
+                    .pieces
+                    .iter()
+                    .map(|k| k.material_distance_lower(&q, cap))
+                    .fold(f64::INFINITY, f64::min);
+                // Only a spine nearer than R − material can decide; the bounded search
+                // prunes the rest (10⁻⁹ mm above its certification tolerance).
+                let within = f.radius - material + 1e-9;
+                let spine = f
+                    .pieces
+                    .iter()
+                    .filter_map(|k| k.projector.closest_point_within(&q, within))
+                    .map(|c| c.distance)
+                    .fold(f64::INFINITY, f64::min);
+                visit(spine, material);
             }
         });
     }
@@ -876,14 +894,53 @@ fn fit_piece(
         })
         .reduce(|| 0.0, f64::max);
     let projector = CurveProjector::new(&spine);
+    let sector_reach = sector_reach(&normals, sections.len(), radius);
     Ok(FilletPiece {
         sections,
         spine,
         normals,
         projector,
+        sector_reach,
         fit_error_mm,
         wedges: std::sync::OnceLock::new(),
     })
+}
+
+/// Samples of the contact-normal curve per section interval in [`sector_reach`].
+const REACH_SAMPLES_PER_SECTION: usize = 16;
+
+/// Relative margin of [`sector_reach`] over its sampled value.
+const REACH_MARGIN: f64 = 0.1;
+
+/// How far from its spine point a point can lie where [`FilletPiece::closest`] answers.
+/// There `d = p − c(t) = λ·a + μ·b` (up to a tangent part below 10⁻⁶·|d|) with `λ, μ ≥ 0`, and
+/// `p` is on the air side of both walls' tangent planes moved in by `k·R` (`k` =
+/// [`CORNER_SLACK`]): `d·a ≤ (1 + k)·R` and `d·b ≤ (1 + k)·R`. On that quadrilateral of the
+/// `(a, b)` plane `|d|` is largest at the corner `d·a = d·b = (1 + k)·R`, where
+/// `|d| = (1 + k)·R / cos(γ/2)` (`γ` the angle between `a` and `b`). The largest `γ` of the
+/// contact-normal curve is taken over [`REACH_SAMPLES_PER_SECTION`] samples per section
+/// interval, and the bound widened by [`REACH_MARGIN`] for the curve between samples and the
+/// tangent part; a corner opening to within about 1° of flat (no bound worth the name) gives an
+/// infinite reach (the unbounded search). O(sections) evaluations.
+fn sector_reach(normals: &NurbsCurve<6>, sections: usize, radius: f64) -> f64 {
+    let n = (sections.max(2) - 1) * REACH_SAMPLES_PER_SECTION + 1;
+    let (t0, t1) = normals.domain();
+    let mut half_cos = f64::INFINITY;
+    for k in 0..n {
+        let t = t0 + (t1 - t0) * k as f64 / (n - 1) as f64;
+        let nn = normals.point(t);
+        let a = Vector3::new(nn[0], nn[1], nn[2]).try_normalize(1e-12);
+        let b = Vector3::new(nn[3], nn[4], nn[5]).try_normalize(1e-12);
+        let (Some(a), Some(b)) = (a, b) else {
+            return f64::INFINITY;
+        };
+        let gamma = a.dot(&b).clamp(-1.0, 1.0).acos();
+        half_cos = half_cos.min((0.5 * gamma).cos());
+    }
+    if half_cos.is_nan() || half_cos <= 0.01 {
+        return f64::INFINITY;
+    }
+    (1.0 + REACH_MARGIN) * (1.0 + CORNER_SLACK) * radius / half_cos
 }
 
 #[cfg(test)]
@@ -892,6 +949,140 @@ mod tests {
     use crate::blade::BladeKind;
     use crate::meridional::MeridionalCurve;
     use nurbs::NurbsSurface;
+
+    /// `material_bounds`' bounded spine distances decide the rolling-ball test exactly as the
+    /// exact spine distances: `max(R − d_spine, m)` is the same (to 1e-9 mm) at points
+    /// around every blade root of the default impeller (hub and side, near and beyond the
+    /// rolling balls); and the bound prunes (some spines passed as +∞).
+    #[test]
+    fn bounded_spines_decide_the_material_test_as_exact_ones() {
+        let imp = crate::fixtures::default_impeller().expect("fixture");
+        let f = ImpellerFillets::new(&imp, DEFAULT_FILLET_TOL_MM)
+            .expect("fillets")
+            .expect("a fillet radius");
+        let r = f.radius();
+        let (mut visits, mut infinite) = (0, 0);
+        for row in 0..2 {
+            for side in [Side::Pressure, Side::Suction] {
+                let bf = f.fillet(row, side).expect("row fillet");
+                for piece in bf.pieces() {
+                    let (u0, u1) = piece.u_range();
+                    for k in 0..300 {
+                        let s = piece.section_at(u0 + (u1 - u0) * k as f64 / 299.0);
+                        let w = Vector3::new(
+                            ((k * 37) % 101) as f64 / 25.0 - 2.0,
+                            ((k * 61) % 103) as f64 / 25.75 - 2.0,
+                            ((k * 13) % 107) as f64 / 26.75 - 2.0,
+                        );
+                        let p = s.centre + w;
+                        let mut got = Vec::new();
+                        f.material_bounds(&p, 10.0, |spine, m| got.push((spine, m)));
+                        let mut want = Vec::new();
+                        f.near_instances(&p, |pair, _, q| {
+                            for bf in pair {
+                                if bf.pieces.is_empty() {
+                                    continue;
+                                }
+                                let spine = bf
+                                    .pieces
+                                    .iter()
+                                    .map(|k| k.spine_distance(&q))
+                                    .fold(f64::INFINITY, f64::min);
+                                let m = bf
+                                    .pieces
+                                    .iter()
+                                    .map(|k| k.material_distance_lower(&q, 10.0))
+                                    .fold(f64::INFINITY, f64::min);
+                                want.push((spine, m));
+                            }
+                        });
+                        assert_eq!(got.len(), want.len(), "{p:?}");
+                        for (g, w) in got.iter().zip(&want) {
+                            visits += 1;
+                            infinite += usize::from(g.0.is_infinite());
+                            assert_eq!(g.1, w.1);
+                            let (a, b) = ((r - g.0).max(g.1), (r - w.0).max(w.1));
+                            assert!((a - b).abs() < 1e-9, "{p:?}: {g:?} vs {w:?}");
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            visits > 1000 && infinite > 100 && infinite < visits,
+            "{visits} visits, {infinite} pruned"
+        );
+    }
+
+    /// The bounded spine search answers exactly as the unbounded one: on the default
+    /// impeller's fillets (both sides of the main blade), points around the spines with
+    /// offsets up to 5 mm (inside and beyond the sector reach, the piece's ends included)
+    /// get the same answer, `None` included, to 1e-9 mm; and the reach is finite and
+    /// prunes (some points beyond it).
+    #[test]
+    fn the_sector_reach_changes_no_answer() {
+        let imp = crate::fixtures::default_impeller().expect("fixture");
+        let mut pruned = 0;
+        let mut answered = 0;
+        for side in [Side::Pressure, Side::Suction] {
+            let f = BladeFillet::build(
+                imp.hub(),
+                imp.main().blade(),
+                side,
+                imp.fillet_radius_mm(),
+                DEFAULT_FILLET_TOL_MM,
+            )
+            .expect("fillet");
+            for piece in f.pieces() {
+                assert!(
+                    piece.sector_reach.is_finite() && piece.sector_reach < 5.0,
+                    "{}",
+                    piece.sector_reach
+                );
+                let mut unbounded = piece.clone();
+                unbounded.sector_reach = f64::INFINITY;
+                let (u0, u1) = piece.u_range();
+                for k in 0..2000 {
+                    let t = -0.05 + 1.1 * k as f64 / 1999.0;
+                    let s = piece.section_at((u0 + (u1 - u0) * t).clamp(u0, u1));
+                    let w = Vector3::new(
+                        ((k * 37) % 101) as f64 / 10.0 - 5.0,
+                        ((k * 61) % 103) as f64 / 10.3 - 5.0,
+                        ((k * 13) % 107) as f64 / 10.7 - 5.0,
+                    );
+                    // Even k: in the corner's sector, from inside the ball to beyond the
+                    // corner; odd k: anywhere around.
+                    let p = if k % 2 == 0 {
+                        let (a, b) = (-s.hub_normal, -s.blade_normal);
+                        let f = ((k * 7) % 11) as f64 / 10.0;
+                        let rho = s.radius * (0.2 + 1.6 * ((k * 17) % 13) as f64 / 12.0);
+                        s.centre + (a * (1.0 - f) + b * f).normalize() * rho
+                    } else {
+                        s.centre + w
+                    };
+                    let a = piece.closest(&p);
+                    let b = unbounded.closest(&p);
+                    match (a, b) {
+                        (Some(a), Some(b)) => {
+                            answered += 1;
+                            assert!((a.0 - b.0).abs() < 1e-9, "{p:?}: {a:?} vs {b:?}");
+                            assert!((a.1 - b.1).norm() < 1e-9, "{p:?}: {a:?} vs {b:?}");
+                        }
+                        (None, None) => {
+                            if piece.projector.closest_point(&p).distance > piece.sector_reach {
+                                pruned += 1;
+                            }
+                        }
+                        _ => panic!("{p:?}: bounded {a:?}, unbounded {b:?}"),
+                    }
+                }
+            }
+        }
+        assert!(
+            answered > 500 && pruned > 500,
+            "{answered} answered, {pruned} pruned"
+        );
+    }
 
     /// A plane patch through `o` spanned by `eu` (u, 0..1) and `ev` (v, 0..1), bilinear.
     fn plane(o: Vector3<f64>, eu: Vector3<f64>, ev: Vector3<f64>) -> NurbsSurface {

@@ -144,3 +144,73 @@ fn centre_of_an_arc() {
     let r = CurveProjector::new(&c).closest_point(&Vector2::new(10.0, 10.0));
     assert!((r.distance - 10.0).abs() < 1e-9, "{}", r.distance);
 }
+
+/// `closest_point_within(q, ρ)` is the global closest point when it lies within `ρ` (the same
+/// distance as the unbounded search, to round-off) and `None` when it lies beyond `ρ`;
+/// bounds are drawn around the true distance, with a margin of 1e-6 mm either side of it
+/// (the search may drop a point within its 1e-10 mm certification tolerance of `ρ`).
+#[test]
+fn bounded_search_finds_exactly_what_lies_within_the_bound() {
+    case_floor::run(
+        file!(),
+        "bounded_search_finds_exactly_what_lies_within_the_bound",
+        (
+            0u64..1_000_000,
+            1usize..=4,
+            5usize..=9,
+            any::<bool>(),
+            -20.0f64..110.0,
+            -60.0f64..60.0,
+            0.0f64..2.0,
+        ),
+        |(seed, p, n, rational, x, y, f)| {
+            let c = random_curve(seed, p, n, rational);
+            let q = Vector2::new(x, y);
+            let pr = CurveProjector::new(&c);
+            let full = pr.closest_point(&q);
+            let rho = f * full.distance;
+            if (rho - full.distance).abs() < 1e-6 {
+                return Ok(());
+            }
+            match pr.closest_point_within(&q, rho) {
+                Some(w) => {
+                    prop_assert!(rho > full.distance, "found beyond the bound {rho}");
+                    prop_assert!(
+                        (w.distance - full.distance).abs() < 1e-9,
+                        "{} vs {}",
+                        w.distance,
+                        full.distance
+                    );
+                    prop_assert!(w.certified);
+                    prop_assert!(((c.point(w.u) - q).norm() - w.distance).abs() < 1e-9);
+                }
+                None => prop_assert!(
+                    rho < full.distance,
+                    "nothing found within {rho} though the curve comes to {}",
+                    full.distance
+                ),
+            }
+            Ok(())
+        },
+    );
+}
+
+#[test]
+fn bounded_search_refuses_non_finite_input() {
+    let pr = CurveProjector::new(&quarter(10.0, 5.0));
+    assert!(pr
+        .closest_point_within(&Vector2::new(f64::NAN, 0.0), 5.0)
+        .is_none());
+    assert!(pr
+        .closest_point_within(&Vector2::new(1.0, 1.0), f64::NAN)
+        .is_none());
+    assert!(pr
+        .closest_point_within(&Vector2::new(1.0, 1.0), -1.0)
+        .is_none());
+    let q = Vector2::new(1.0, 1.0);
+    let unbounded = pr.closest_point_within(&q, f64::INFINITY).unwrap();
+    assert_eq!(unbounded.distance, pr.closest_point(&q).distance);
+    assert!(pr
+        .closest_point_within(&Vector2::new(1.0, 1.0), 100.0)
+        .is_some());
+}

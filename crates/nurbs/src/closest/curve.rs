@@ -269,6 +269,37 @@ impl<const D: usize> CurveProjector<D> {
         self.closest_point_with_hint(q, None)
     }
 
+    /// The global closest point to `q` when it lies within `max_dist` of `q`, `None` when
+    /// every point of the curve is farther (a non-finite `q` or a NaN or negative `max_dist`
+    /// gives `None`; an infinite one is the unbounded search).
+    ///
+    /// For degree ≤ 7 the certified search starts with `max_dist²` as its upper bound, so
+    /// every Bézier segment whose control box lies farther is pruned before any root
+    /// isolation: a query far from the curve costs a few box distances of the segment tree's
+    /// top. The answer, when there is one, is the global closest point (as
+    /// [`Self::closest_point`]: the pruned segments are farther than it). A closest point
+    /// within the certification tolerance (10⁻¹⁰ mm) below `max_dist` may be reported as
+    /// `None`: callers give a bound with that much margin. Higher degrees run the full
+    /// search and compare.
+    pub fn closest_point_within(
+        &self,
+        q: &SVector<f64, D>,
+        max_dist: f64,
+    ) -> Option<CurvePoint<D>> {
+        if !(q.iter().all(|c| c.is_finite()) && max_dist >= 0.0) {
+            return None;
+        }
+        if max_dist == f64::INFINITY {
+            return Some(self.closest_point(q));
+        }
+        if self.tree.is_empty() {
+            return Some(self.closest_point(q)).filter(|c| c.distance <= max_dist);
+        }
+        // A hair above the bound so that a point at exactly `max_dist` is found.
+        let seed = max_dist * max_dist * (1.0 + 1e-12) + f64::MIN_POSITIVE;
+        self.tree_search_below(q, None, seed)
+    }
+
     /// The global closest point to `q`, starting Newton from parameter `hint` when given
     /// (the answer does not depend on it). A non-finite `q` gives a NaN distance.
     pub fn closest_point_with_hint(&self, q: &SVector<f64, D>, hint: Option<f64>) -> CurvePoint<D> {
@@ -367,12 +398,38 @@ impl<const D: usize> CurveProjector<D> {
     /// Certified search: best-first walk of the segment tree, each segment searched by
     /// Bernstein root isolation ([`super::curve_cert`]). The hint only seeds the upper bound.
     fn tree_search(&self, q: &SVector<f64, D>, hint: Option<f64>) -> CurvePoint<D> {
+        let found = self.tree_search_below(q, hint, f64::INFINITY);
+        // With no bound every search finds a point (a segment's end at worst); the fallback
+        // only keeps this total.
+        found.unwrap_or_else(|| {
+            let (a, _) = self.domain;
+            let e = self.derivs2(a);
+            CurvePoint {
+                u: a,
+                point: e[0],
+                tangent: e[1],
+                distance: (e[0] - q).norm(),
+                on_boundary: false,
+                certified: false,
+            }
+        })
+    }
+
+    /// The certified tree search for a point nearer than `sqrt(bound_d2)` (`None` when there
+    /// is none), Newton seeded at `hint`.
+    fn tree_search_below(
+        &self,
+        q: &SVector<f64, D>,
+        hint: Option<f64>,
+        bound_d2: f64,
+    ) -> Option<CurvePoint<D>> {
         use super::curve_cert::{box_d2, search_piece, Best};
         let (a, b) = self.domain;
+        // `piece` stays out of range until a segment search finds a point below the bound.
         let mut best = Best {
             t: 0.0,
-            piece: 0,
-            d2: f64::INFINITY,
+            piece: usize::MAX,
+            d2: bound_d2,
             certified: true,
         };
         if let Some(h) = hint.filter(|h| h.is_finite()) {
@@ -418,18 +475,18 @@ impl<const D: usize> CurveProjector<D> {
                 }
             }
         }
-        let sg = &self.segs[best.piece];
+        let sg = self.segs.get(best.piece)?;
         let u = (sg.u0 + best.t * (sg.u1 - sg.u0)).clamp(a, b);
         let e = sg.derivs2(u);
         let g = (e[0] - q).dot(&e[1]);
-        CurvePoint {
+        Some(CurvePoint {
             u,
             point: e[0],
             tangent: e[1],
             distance: (e[0] - q).norm(),
             on_boundary: (u <= a && g > 0.0) || (u >= b && g < 0.0),
             certified: best.certified && walked_all,
-        }
+        })
     }
 
     fn solve_piece(&self, i: usize, q: &SVector<f64, D>) -> Local1<D> {
