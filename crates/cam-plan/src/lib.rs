@@ -57,8 +57,8 @@ pub use error::PlanError;
 pub use linking::{LinkCheck, LinkStats, Linker, SafetySurface, ToolEnvelope, RAPID_TRACE_STOP_MM};
 pub use metrics::{MetricValue, Metrics, Plot, PlotKind, PlotSeries};
 pub use operation::{
-    AxisReach, Builder, Operation, OperationSpec, PlanContext, PlannedOperation, PlannedStep,
-    StepTool,
+    AxisReach, Builder, Operation, OperationSpec, PlanContext, PlanProgress, PlannedOperation,
+    PlannedStep, StepTool,
 };
 pub use pass_check::{PassCheck, PassFloors, PassViolation, PostureClearance};
 pub use process::Process;

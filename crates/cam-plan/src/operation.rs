@@ -35,6 +35,18 @@ pub struct PlanContext<'a> {
     /// The stock the job's earlier operations leave, measured above the design: given to
     /// the operations that ask for it ([`Operation::needs_remaining`]), `None` otherwise.
     pub remaining: Option<&'a RemainingMaterial>,
+    /// Where the caller wants to hear how far a long planning has come
+    /// ([`PlanContext::progress`]); `None`: nobody listens.
+    pub progress: Option<&'a dyn PlanProgress>,
+}
+
+/// A listener for how far an operation's planning has come: a person waits on it (a
+/// spinner's message, a line in a log). Operations whose planning can take long report units
+/// of their own work (`what`: "samples", "regions", …) through [`PlanContext::progress`], from
+/// any thread, as often as they like: the listener throttles what it shows.
+pub trait PlanProgress: Sync + std::fmt::Debug {
+    /// `done` of `total` units of `what` are planned.
+    fn report(&self, what: &str, done: usize, total: usize);
 }
 
 /// Which tool axes (unit vectors in the workpiece frame, from the tip toward the spindle) a
@@ -47,6 +59,14 @@ pub trait AxisReach: Sync + std::fmt::Debug {
 }
 
 impl PlanContext<'_> {
+    /// Tells the caller's listener ([`PlanContext::progress`]) that `done` of `total` units
+    /// of `what` are planned; nothing without one. O(1) plus the listener.
+    pub fn progress(&self, what: &str, done: usize, total: usize) {
+        if let Some(p) = self.progress {
+            p.report(what, done, total);
+        }
+    }
+
     /// Whether the job's machine can present the tool axis `axis` (unit, workpiece frame;
     /// `true` when no machine constrains the planning). O(1).
     pub fn reaches(&self, axis: &nalgebra::Vector3<f64>) -> bool {

@@ -67,6 +67,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         links: &cam_plan::LinkStats::default(),
         reach: None,
         remaining: None,
+        progress: None,
     };
     let op = channel_paths::build_blade_root_finishing(&OperationSpec {
         name: "root".into(),

@@ -796,9 +796,20 @@ impl Operation for RestFinishing {
             .enumerate()
             .flat_map(|(k, g)| regions_of(g, k, threshold))
             .collect();
+        // Progress in residual samples above the threshold, region by region.
+        let total_cells: usize = regions.iter().map(|r| r.cells.len()).sum();
+        let done_cells = std::sync::atomic::AtomicUsize::new(0);
+        ctx.progress("samples above the threshold", 0, total_cells);
         let results: Vec<RegionResult> = regions
             .par_iter()
-            .map(|reg| planner.plan_region(&remaining.grids[reg.grid], reg, step))
+            .map(|reg| {
+                let res = planner.plan_region(&remaining.grids[reg.grid], reg, step);
+                let done = done_cells
+                    .fetch_add(reg.cells.len(), std::sync::atomic::Ordering::Relaxed)
+                    + reg.cells.len();
+                ctx.progress("samples above the threshold", done, total_cells);
+                res
+            })
             .collect();
 
         // What each target keeps: the nearest station's ball (an upper bound).

@@ -117,6 +117,7 @@ fn hub_axes_stay_within_the_machines_reach() {
         links: &links,
         reach: Some(&cone),
         remaining: None,
+        progress: None,
     };
     let held = op.plan(&ctx).unwrap();
     let t = tilts(&held);

@@ -50,6 +50,16 @@ fn spec(params: &str) -> OperationSpec {
     }
 }
 
+/// Records what an operation reports while it plans.
+#[derive(Debug, Default)]
+struct Recorder(std::sync::Mutex<Vec<(String, usize, usize)>>);
+
+impl cam_plan::PlanProgress for Recorder {
+    fn report(&self, what: &str, done: usize, total: usize) {
+        self.0.lock().unwrap().push((what.to_string(), done, total));
+    }
+}
+
 /// Plans channel roughing with `params` in a context around the impeller's own stock (safety
 /// surface 10 mm over it).
 fn plan_rough(
@@ -59,6 +69,18 @@ fn plan_rough(
     process: &Process,
     clearance: &DesignClearance<'_>,
     params: &str,
+) -> cam_plan::PlannedOperation {
+    plan_rough_reporting(imp, tool, tol, process, clearance, params, None)
+}
+
+fn plan_rough_reporting(
+    imp: &impeller_model::Impeller,
+    tool: &Tool,
+    tol: &Tolerances,
+    process: &Process,
+    clearance: &DesignClearance<'_>,
+    params: &str,
+    progress: Option<&dyn cam_plan::PlanProgress>,
 ) -> cam_plan::PlannedOperation {
     let stock = imp.stock();
     let linker = Linker::new(SafetySurface::around_stock(stock, 10.0).unwrap());
@@ -73,6 +95,7 @@ fn plan_rough(
         links: &cam_plan::LinkStats::default(),
         reach: None,
         remaining: None,
+        progress,
     };
     build_channel_roughing(&spec(params))
         .unwrap()
@@ -97,12 +120,29 @@ fn rough_default_impeller_within_scallop_and_clear_of_blades() {
         },
     )
     .unwrap();
-    let plan = plan_rough(&imp, &tool, &tol, &proc_, &clearance, "scallop_mm = 0.3");
+    let recorder = Recorder::default();
+    let plan = plan_rough_reporting(
+        &imp,
+        &tool,
+        &tol,
+        &proc_,
+        &clearance,
+        "scallop_mm = 0.3",
+        Some(&recorder),
+    );
     let m = &plan.metrics;
     let get = |k: &str| m.get(k).and_then(|v| v.as_f64()).unwrap();
     eprintln!("{m:?}");
     assert_eq!(plan.paths.len(), 8);
     assert!(get("levels") >= 1.0);
+    // Progress: the start, then every level once, up to all of them.
+    let reports = recorder.0.into_inner().unwrap();
+    let n = get("levels") as usize;
+    assert_eq!(reports.len(), n + 1, "{reports:?}");
+    let mut done: Vec<usize> = reports.iter().map(|r| r.1).collect();
+    done.sort_unstable();
+    assert_eq!(done, (0..=n).collect::<Vec<_>>(), "{reports:?}");
+    assert!(reports.iter().all(|r| r.0 == "levels" && r.2 == n));
     // Measured scallop within the target (plus the sampling of discrete cutter positions).
     assert!(
         get("max_scallop_mm") <= 0.3 + 0.01,

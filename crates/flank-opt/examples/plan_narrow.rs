@@ -74,6 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         links: &cam_plan::LinkStats::default(),
         reach: None,
         remaining: None,
+        progress: None,
     };
     let spec = OperationSpec {
         name: "flank".into(),

@@ -96,6 +96,7 @@ fn with_ctx<T>(
         links: &links,
         reach: None,
         remaining: None,
+        progress: None,
     };
     f(&ctx)
 }

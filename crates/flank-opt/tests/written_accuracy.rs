@@ -85,6 +85,7 @@ fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
         links: &cam_plan::LinkStats::default(),
         reach: None,
         remaining: None,
+        progress: None,
     };
     let spec = OperationSpec {
         name: "blade-finish".into(),

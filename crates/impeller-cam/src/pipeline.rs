@@ -558,7 +558,9 @@ impl Shared<'_> {
             })
             .collect::<Result<_, _>>()?;
         let t = Instant::now();
-        let task = progress.task(format!("planning {} ({})", spec.name, spec.kind));
+        let label = format!("planning {} ({})", spec.name, spec.kind);
+        let task = progress.task(label.clone());
+        let listener = task.listener(label);
         let mesh = self
             .mesh
             .cloned()
@@ -578,6 +580,7 @@ impl Shared<'_> {
             links: &links,
             reach: Some(self.reach),
             remaining,
+            progress: Some(&listener),
         };
         let (planned, steps) = op.plan_with_steps(&ctx, &step_tools).map_err(fail)?;
         let mut main =

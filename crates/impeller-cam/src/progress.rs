@@ -4,7 +4,8 @@
 //! lines (`[impeller-cam] planning operations …`) are printed either way unless quiet.
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::time::Duration;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 /// The progress display of one run.
 #[derive(Debug, Clone)]
@@ -89,12 +90,62 @@ pub struct Task {
     lines: bool,
 }
 
+/// How often a task without a terminal prints how far its planning has come.
+const PROGRESS_LINE_EVERY: Duration = Duration::from_secs(10);
+
+/// What an operation reports while it plans ([`cam_plan::PlanProgress`]), shown on its
+/// task: on a terminal as the spinner's message (`planning rest (rest_finishing): 1 234 /
+/// 5 678 samples`), without one as a line at most every [`PROGRESS_LINE_EVERY`] (a long
+/// planning in a log still shows it moves), nothing when quiet.
+#[derive(Debug)]
+pub struct TaskProgress {
+    bar: ProgressBar,
+    what: String,
+    lines: bool,
+    last_line: Mutex<Instant>,
+}
+
 impl Task {
+    /// The listener an operation's planning reports to, labelled `what` (the task's own
+    /// message).
+    pub fn listener(&self, what: String) -> TaskProgress {
+        TaskProgress {
+            bar: self.bar.clone(),
+            what,
+            lines: self.lines,
+            last_line: Mutex::new(Instant::now()),
+        }
+    }
+
     /// Ends the spinner, leaving `summary` in its place (or prints it as a line).
     pub fn done(self, summary: String) {
         if self.lines {
             eprintln!("[impeller-cam] {summary}");
         }
         self.bar.finish_with_message(summary);
+    }
+}
+
+impl cam_plan::PlanProgress for TaskProgress {
+    fn report(&self, what: &str, done: usize, total: usize) {
+        let pct = if total > 0 {
+            100.0 * done as f64 / total as f64
+        } else {
+            100.0
+        };
+        let msg = format!("{}: {done}/{total} {what} ({pct:.0} %)", self.what);
+        if self.lines {
+            // A poisoned lock only means another report panicked: keep reporting.
+            let mut last = self
+                .last_line
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            if last.elapsed() >= PROGRESS_LINE_EVERY {
+                *last = Instant::now();
+                eprintln!("[impeller-cam] {msg}");
+            }
+        } else if !self.bar.is_hidden() {
+            self.bar.set_message(msg);
+        }
     }
 }

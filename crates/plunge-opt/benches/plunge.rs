@@ -114,6 +114,7 @@ fn channel(c: &mut Criterion) {
         links: &cam_plan::LinkStats::default(),
         reach: None,
         remaining: None,
+        progress: None,
     };
     let mut g = c.benchmark_group("plan");
     g.sample_size(10);

@@ -167,6 +167,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             links: &cam_plan::LinkStats::default(),
             reach: None,
             remaining: None,
+            progress: None,
         };
         let t0 = std::time::Instant::now();
         let (planned, steps) = op.plan_with_steps(&ctx, &[&drill])?;

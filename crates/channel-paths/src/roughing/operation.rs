@@ -353,6 +353,8 @@ impl ChannelRoughing {
         // Each level planned, located and measured; a level whose measured scallop exceeds
         // the target is planned again with its path interval narrowed (module docs, step 3).
         let target = self.params.scallop_mm;
+        let levels_done = std::sync::atomic::AtomicUsize::new(0);
+        ctx.progress("levels", 0, n_levels);
         let planned: Vec<Result<(LevelPlan, LevelCl, usize), PlanError>> = (1..=n_levels)
             .into_par_iter()
             .map(|j| {
@@ -379,6 +381,10 @@ impl ChannelRoughing {
                     level = lp.level;
                     bounds = lp.bounds;
                 }
+            })
+            .inspect(|_| {
+                let done = levels_done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                ctx.progress("levels", done, n_levels);
             })
             .collect();
         let mut levels: Vec<LevelPlan> = Vec::with_capacity(n_levels);

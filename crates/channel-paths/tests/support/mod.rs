@@ -130,6 +130,7 @@ macro_rules! plan_ctx {
             links: &cam_plan::LinkStats::default(),
             reach: None,
             remaining: None,
+            progress: None,
         }
     };
 }
