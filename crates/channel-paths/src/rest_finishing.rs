@@ -66,9 +66,14 @@
 //! for every target sample, the height along its normal to the first ball station the normal
 //! meets, as the verifier measures residual (an upper bound of what is left: the motions
 //! between stations cut more). Targets still
-//! above `threshold_mm` are *unreachable* with this tool (counted with their area): in a sharp
-//! concave corner of angle `β` a ball of radius `r` leaves `r(1/sin(β/2) − 1)` at the corner
-//! line whatever its path. `max_overcut_mm`: the largest negative margin of a station's ball (≤ tol/2 by construction).
+//! above `threshold_mm` are *unreachable* with this plan (`unreachable_points`, with their
+//! area): in a sharp concave corner of angle `β` a ball of radius `r` leaves
+//! `r(1/sin(β/2) − 1)` at the corner line whatever its path. Of those, `corner_points` (and
+//! `corner_area_mm2`) are proven out of reach of every ball of radius `r` or more: the ball
+//! tangent at the sample (centre on its normal) overlaps the design by at least
+//! `CORNER_OVERLAP_MM` (distances to points of the design's closed material: an upper bound
+//! of the centre's distance), and where the surface is smooth a ball can touch a point only
+//! from its normal; the rest could be touched by a ball and are left by this plan. `max_overcut_mm`: the largest negative margin of a station's ball (≤ tol/2 by construction).
 //!
 //! Cost: O(stations · iterations · design distance) for the centres, O(stations · axes tried
 //! · tool samples · design distance) for the postures, O(motions · samples · bisections) for
@@ -244,6 +249,12 @@ struct Planner<'a> {
     step: f64,
 }
 
+/// Overlap with the design (mm) of the ball tangent at a sample left above the threshold
+/// from which the sample counts as out of every ball's reach (`corner_points`): well above
+/// the design distances' accuracy and the normal's (central differences; an error `α` moves
+/// the tangent ball by `r·α²/2`).
+const CORNER_OVERLAP_MM: f64 = 0.005;
+
 /// The signed distance of one wall (hub, blades, fillets) where it is defined.
 type WallDistance<'a> = dyn Fn(&Vector3<f64>) -> Option<f64> + 'a;
 
@@ -335,6 +346,27 @@ impl Planner<'_> {
         central_gradient(part, p)
             .try_normalize(1e-9)
             .unwrap_or_else(|| self.gradient(p).normalize())
+    }
+
+    /// How deep the ball of radius `r` tangent to the design at `p` (outward unit normal `n`;
+    /// centre `p + r·n`) overlaps the design: `r` less an upper bound of the distance from the
+    /// centre to the design, each term the distance to a point of the design's closed
+    /// material (the exact hub and blade signed distances, the fillet's arc point where a
+    /// fillet decides). Positive: that ball gouges. Where the surface is smooth at `p`, every
+    /// ball whose sphere passes through `p` without entering the material has its centre on
+    /// the normal, and a ball of radius `R ≥ r` tangent there holds this one: no ball of
+    /// radius `r` or more reaches `p`. O(one design distance).
+    fn tangent_ball_overlap(&self, p: &Vector3<f64>, n: &Vector3<f64>) -> f64 {
+        let c = p + n * self.r;
+        let q = Point3::from(c);
+        let hub = self.material.hub_signed_distance(&q);
+        let blade = self.material.blade_signed_distance(&q).0;
+        let fillet = self
+            .fillets
+            .as_ref()
+            .and_then(|f| f.closest(&c))
+            .map_or(f64::INFINITY, |(d, _)| d);
+        self.r - hub.min(blade).min(fillet)
     }
 
     /// The preferred axis at centre `c`: the sum of the unit normals of the walls (hub,
@@ -467,7 +499,15 @@ impl Planner<'_> {
     }
 
     /// Plans the passes of `region` on `g`.
-    fn plan_region(&self, g: &RestGrid, region: &Region, step: f64) -> RegionResult {
+    /// Plans `region`'s passes; `pass_done(k, n)` is called after the `k`-th of its `n`
+    /// passes (progress).
+    fn plan_region(
+        &self,
+        g: &RestGrid,
+        region: &Region,
+        step: f64,
+        pass_done: &dyn Fn(usize, usize),
+    ) -> RegionResult {
         let mut res = RegionResult::default();
         let (mut i0, mut i1, mut j0, mut j1) = (usize::MAX, 0, usize::MAX, 0);
         for &(i, j) in &region.cells {
@@ -586,6 +626,7 @@ impl Planner<'_> {
                 res.passes += 1;
             }
             res.runs.extend(pass_runs);
+            pass_done(k + 1, n_across);
         }
         res.max_overcut = res.max_overcut.max(0.0);
         res
@@ -796,19 +837,24 @@ impl Operation for RestFinishing {
             .enumerate()
             .flat_map(|(k, g)| regions_of(g, k, threshold))
             .collect();
-        // Progress in residual samples above the threshold, region by region.
+        // Progress in residual samples above the threshold: a region's samples are credited
+        // pass by pass (after pass k of n, ⌊cells·k/n⌋ of them), so a large region shows it
+        // moves too.
         let total_cells: usize = regions.iter().map(|r| r.cells.len()).sum();
         let done_cells = std::sync::atomic::AtomicUsize::new(0);
         ctx.progress("samples above the threshold", 0, total_cells);
         let results: Vec<RegionResult> = regions
             .par_iter()
             .map(|reg| {
-                let res = planner.plan_region(&remaining.grids[reg.grid], reg, step);
-                let done = done_cells
-                    .fetch_add(reg.cells.len(), std::sync::atomic::Ordering::Relaxed)
-                    + reg.cells.len();
-                ctx.progress("samples above the threshold", done, total_cells);
-                res
+                let cells = reg.cells.len();
+                let pass_done = |k: usize, n: usize| {
+                    let share = |k: usize| cells * k / n.max(1);
+                    let credit = share(k) - share(k - 1);
+                    let done =
+                        done_cells.fetch_add(credit, std::sync::atomic::Ordering::Relaxed) + credit;
+                    ctx.progress("samples above the threshold", done, total_cells);
+                };
+                planner.plan_region(&remaining.grids[reg.grid], reg, step, &pass_done)
             })
             .collect();
 
@@ -819,6 +865,8 @@ impl Operation for RestFinishing {
             .collect();
         let mut target_points = 0usize;
         let (mut area, mut unreachable_area, mut unreachable) = (0.0, 0.0, 0usize);
+        // Of those left, the ones no ball of radius ≥ r reaches (CORNER_OVERLAP_MM).
+        let (mut corner_area, mut corner) = (0.0, 0usize);
         let (mut before_max, mut after_max): (f64, f64) = (0.0, 0.0);
         let mut before_series = Vec::new();
         let mut after_series = Vec::new();
@@ -842,6 +890,10 @@ impl Operation for RestFinishing {
                     unreachable += 1;
                     unreachable_area += cell;
                     after_series.push(rz);
+                    if planner.tangent_ball_overlap(&p, &n) >= CORNER_OVERLAP_MM {
+                        corner += 1;
+                        corner_area += cell;
+                    }
                 }
             }
         }
@@ -889,6 +941,8 @@ impl Operation for RestFinishing {
             .number("residual_after_max_mm", after_max)
             .count("unreachable_points", unreachable)
             .number("unreachable_area_mm2", unreachable_area)
+            .count("corner_points", corner)
+            .number("corner_area_mm2", corner_area)
             .count("passes", sum.passes)
             .count("stations", stations)
             .count("skipped_locations", sum.skipped)
@@ -904,8 +958,10 @@ impl Operation for RestFinishing {
             sum.passes,
         )];
         if unreachable > 0 {
+            let left = unreachable - corner;
+            let left_area = (unreachable_area - corner_area).max(0.0);
             notes.push(format!(
-                "{unreachable} samples ({unreachable_area:.2} mm²) stay above {threshold} mm: no station of the ball of radius {r} mm cuts them below it (corners sharper than the ball, or locations left out: see below)"
+                "{unreachable} samples ({unreachable_area:.2} mm²) stay above {threshold} mm: no station of the ball of radius {r} mm cuts them below it. {corner} of them ({corner_area:.2} mm²) no ball of radius {r} mm or more reaches: the ball tangent there overlaps the design by at least {CORNER_OVERLAP_MM} mm (corners sharper than the ball); {left} ({left_area:.2} mm²) a ball could touch but this plan leaves (locations left out: see below)"
             ));
         }
         if sum.skipped > 0 || sum.unsettled > 0 || sum.split > 0 || sum.fillet_blocked > 0 {
