@@ -870,6 +870,7 @@ impl Operation for RestFinishing {
         let (mut before_max, mut after_max): (f64, f64) = (0.0, 0.0);
         let mut before_series = Vec::new();
         let mut after_series = Vec::new();
+        let mut corner_series = Vec::new();
         for reg in &regions {
             let g = &remaining.grids[reg.grid];
             for &(i, j) in &reg.cells {
@@ -893,6 +894,7 @@ impl Operation for RestFinishing {
                     if planner.tangent_ball_overlap(&p, &n) >= CORNER_OVERLAP_MM {
                         corner += 1;
                         corner_area += cell;
+                        corner_series.push(rz);
                     }
                 }
             }
@@ -988,6 +990,10 @@ impl Operation for RestFinishing {
                     PlotSeries {
                         label: "left above it by the stations".into(),
                         points: crosses(&after_series, 0.25),
+                    },
+                    PlotSeries {
+                        label: "of those, out of every ball's reach".into(),
+                        points: crosses(&corner_series, 0.15),
                     },
                     PlotSeries {
                         label: "ball centres".into(),
