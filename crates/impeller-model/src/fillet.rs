@@ -1097,23 +1097,32 @@ mod tests {
     use crate::meridional::MeridionalCurve;
     use nurbs::NurbsSurface;
 
+    /// Both fillets of the default impeller's main blade.
+    fn default_main_fillets() -> Vec<BladeFillet> {
+        let imp = crate::fixtures::default_impeller().expect("fixture");
+        [Side::Pressure, Side::Suction]
+            .into_iter()
+            .map(|side| {
+                BladeFillet::build(
+                    imp.hub(),
+                    imp.main().blade(),
+                    side,
+                    imp.fillet_radius_mm(),
+                    DEFAULT_FILLET_TOL_MM,
+                )
+                .expect("fillet")
+            })
+            .collect()
+    }
+
     /// The culled wedge search (nearest first, spheres and plane bounds) returns what every
     /// wedge gives (to 1e-12 mm), with and without a cap, at points around the default
     /// impeller's fillets (near the material, inside the balls, beyond the piece's ends and
     /// far off); and the plane bounds cull (the point of them).
     #[test]
     fn culled_material_bound_is_the_bound_over_every_wedge() {
-        let imp = crate::fixtures::default_impeller().expect("fixture");
         let mut culled_blocks = 0usize;
-        for side in [Side::Pressure, Side::Suction] {
-            let f = BladeFillet::build(
-                imp.hub(),
-                imp.main().blade(),
-                side,
-                imp.fillet_radius_mm(),
-                DEFAULT_FILLET_TOL_MM,
-            )
-            .expect("fillet");
+        for f in default_main_fillets() {
             for piece in f.pieces() {
                 let (u0, u1) = piece.u_range();
                 for k in 0..600 {
@@ -1221,18 +1230,9 @@ mod tests {
     /// prunes (some points beyond it).
     #[test]
     fn the_sector_reach_changes_no_answer() {
-        let imp = crate::fixtures::default_impeller().expect("fixture");
         let mut pruned = 0;
         let mut answered = 0;
-        for side in [Side::Pressure, Side::Suction] {
-            let f = BladeFillet::build(
-                imp.hub(),
-                imp.main().blade(),
-                side,
-                imp.fillet_radius_mm(),
-                DEFAULT_FILLET_TOL_MM,
-            )
-            .expect("fillet");
+        for f in default_main_fillets() {
             for piece in f.pieces() {
                 assert!(
                     piece.sector_reach.is_finite() && piece.sector_reach < 5.0,

@@ -80,6 +80,14 @@ pub struct Probe {
     pub residual: f64,
 }
 
+/// The grid whose rays are most aligned with `n` (`|n_d| ≥ 1/√3`), whose membership the
+/// probes read along the normal line (module docs).
+fn aligned_grid(n: &Vector3) -> usize {
+    (0..3)
+        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+        .unwrap_or(2)
+}
+
 /// Measures overcut and residual at `p` with outward unit normal `n`, up to `max_depth` mm.
 pub fn probe(
     stock: &TriDexel,
@@ -89,9 +97,7 @@ pub fn probe(
     n: &Vector3,
     max_depth: f64,
 ) -> Probe {
-    let d = (0..3)
-        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
-        .unwrap_or(2);
+    let d = aligned_grid(n);
     let occ = |t: f64| {
         let x = p + n * t;
         stock.contains_via(d, &[x.x, x.y, x.z])
@@ -180,9 +186,7 @@ pub fn residual_along(
     n: &Vector3,
     max_depth: f64,
 ) -> f64 {
-    let d = (0..3)
-        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
-        .unwrap_or(2);
+    let d = aligned_grid(n);
     let occ = |t: f64| {
         let x = p + n * t;
         stock.contains_via(d, &[x.x, x.y, x.z])
