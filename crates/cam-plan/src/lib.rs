@@ -58,7 +58,7 @@ pub use linking::{LinkCheck, LinkStats, Linker, SafetySurface, ToolEnvelope, RAP
 pub use metrics::{MetricValue, Metrics, Plot, PlotKind, PlotSeries};
 pub use operation::{
     AxisReach, Builder, Operation, OperationSpec, PlanContext, PlanProgress, PlannedOperation,
-    PlannedStep, StepTool,
+    PlannedStep, ProgressLog, StepTool,
 };
 pub use pass_check::{PassCheck, PassFloors, PassViolation, PostureClearance};
 pub use process::Process;

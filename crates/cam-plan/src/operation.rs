@@ -58,6 +58,30 @@ pub trait AxisReach: Sync + std::fmt::Debug {
     fn reaches(&self, axis: &nalgebra::Vector3<f64>) -> bool;
 }
 
+/// A [`PlanProgress`] that keeps every report in order of arrival (for tests, and for callers
+/// that summarise a planning's progress afterwards).
+#[derive(Debug, Default)]
+pub struct ProgressLog(std::sync::Mutex<Vec<(String, usize, usize)>>);
+
+impl ProgressLog {
+    /// The reports so far: `(what, done, total)`.
+    pub fn reports(&self) -> Vec<(String, usize, usize)> {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .clone()
+    }
+}
+
+impl PlanProgress for ProgressLog {
+    fn report(&self, what: &str, done: usize, total: usize) {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .push((what.to_string(), done, total));
+    }
+}
+
 impl PlanContext<'_> {
     /// Tells the caller's listener ([`PlanContext::progress`]) that `done` of `total` units
     /// of `what` are planned; nothing without one. O(1) plus the listener.

@@ -12,16 +12,6 @@ use impeller_model::fillet::{ImpellerFillets, DEFAULT_FILLET_TOL_MM};
 use nalgebra::Vector3;
 use support::Ctx;
 
-/// Records what an operation reports while it plans.
-#[derive(Debug, Default)]
-struct Recorder(std::sync::Mutex<Vec<(String, usize, usize)>>);
-
-impl cam_plan::PlanProgress for Recorder {
-    fn report(&self, what: &str, done: usize, total: usize) {
-        self.0.lock().unwrap().push((what.to_string(), done, total));
-    }
-}
-
 fn op() -> Box<dyn Operation> {
     let spec = OperationSpec {
         name: "rest".into(),
@@ -85,11 +75,11 @@ fn a_hub_patch_in_mid_channel_is_cut_to_the_threshold_with_the_ball_on_the_hub()
     let rm = grid("hub", points, nu, nv);
     let mut ctx: PlanContext<'_> = plan_ctx!(c, cl);
     ctx.remaining = Some(&rm);
-    let recorder = Recorder::default();
+    let recorder = cam_plan::ProgressLog::default();
     ctx.progress = Some(&recorder);
     let planned = op().plan(&ctx).unwrap();
     // Progress in samples, pass by pass, up to all of them.
-    let reports = recorder.0.into_inner().unwrap();
+    let reports = recorder.reports();
     assert!(reports.len() > 2, "{reports:?}");
     assert!(reports.iter().all(|r| r.2 == nu * nv), "{reports:?}");
     assert!(reports.windows(2).all(|w| w[0].1 <= w[1].1), "{reports:?}");

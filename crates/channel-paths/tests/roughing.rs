@@ -50,16 +50,6 @@ fn spec(params: &str) -> OperationSpec {
     }
 }
 
-/// Records what an operation reports while it plans.
-#[derive(Debug, Default)]
-struct Recorder(std::sync::Mutex<Vec<(String, usize, usize)>>);
-
-impl cam_plan::PlanProgress for Recorder {
-    fn report(&self, what: &str, done: usize, total: usize) {
-        self.0.lock().unwrap().push((what.to_string(), done, total));
-    }
-}
-
 /// Plans channel roughing with `params` in a context around the impeller's own stock (safety
 /// surface 10 mm over it).
 fn plan_rough(
@@ -120,7 +110,7 @@ fn rough_default_impeller_within_scallop_and_clear_of_blades() {
         },
     )
     .unwrap();
-    let recorder = Recorder::default();
+    let recorder = cam_plan::ProgressLog::default();
     let plan = plan_rough_reporting(
         &imp,
         &tool,
@@ -136,7 +126,7 @@ fn rough_default_impeller_within_scallop_and_clear_of_blades() {
     assert_eq!(plan.paths.len(), 8);
     assert!(get("levels") >= 1.0);
     // Progress: the start, then every level once, up to all of them.
-    let reports = recorder.0.into_inner().unwrap();
+    let reports = recorder.reports();
     let n = get("levels") as usize;
     assert_eq!(reports.len(), n + 1, "{reports:?}");
     let mut done: Vec<usize> = reports.iter().map(|r| r.1).collect();

@@ -570,7 +570,8 @@ const DIRECT_STEP_SAMPLE_MM: f64 = 0.25;
 
 /// Plans both sides of every row in `rows` (in parallel), assembles each row's runs into
 /// one path (direct certified feed steps between runs where the whole tool keeps the floors,
-/// else links over the safety surface) and copies it to every blade of the row.
+/// else links over the safety surface) and copies it to every blade of the row. Reports the
+/// blade sides planned as progress ([`PlanContext::progress`]).
 pub fn plan_rows(
     ctx: &PlanContext<'_>,
     op_name: &str,
@@ -583,9 +584,15 @@ pub fn plan_rows(
         .iter()
         .flat_map(|&r| [Side::Pressure, Side::Suction].map(move |s| (r, s)))
         .collect();
+    let sides_done = std::sync::atomic::AtomicUsize::new(0);
+    ctx.progress("blade sides", 0, jobs.len());
     let planned: Vec<(Row, Side, SidePlan)> = jobs
         .par_iter()
         .map(|&(row, side)| plan_side(ctx, row, side, st).map(|p| (row, side, p)))
+        .inspect(|_| {
+            let done = sides_done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            ctx.progress("blade sides", done, jobs.len());
+        })
         .collect::<Result<_, _>>()?;
     let check = PassCheck::new(
         ctx.clearance,

@@ -154,8 +154,20 @@ fn splitter_rows_are_planned() {
             params: toml::Table::new(),
         };
         let op = flank_opt::build_flank_semi_finishing(&spec).unwrap();
-        op.plan(ctx).unwrap()
+        let recorder = cam_plan::ProgressLog::default();
+        let ctx = PlanContext {
+            progress: Some(&recorder),
+            ..*ctx
+        };
+        let planned = op.plan(&ctx).unwrap();
+        (planned, recorder.reports())
     });
+    let (planned, reports) = planned;
+    // Progress: the start, then each of the four blade sides (two rows) once.
+    let mut done: Vec<usize> = reports.iter().map(|r| r.1).collect();
+    done.sort_unstable();
+    assert_eq!(done, vec![0, 1, 2, 3, 4], "{reports:?}");
+    assert!(reports.iter().all(|r| r.0 == "blade sides" && r.2 == 4));
     assert_eq!(planned.paths.len(), 16, "8 main + 8 splitter blades");
     // Splitter blade 0's path: its balls touch the splitter's offset by the allowance.
     let sp = imp.splitter().unwrap().instance(0);
