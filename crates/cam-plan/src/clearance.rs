@@ -1106,7 +1106,7 @@ impl<'a> DesignClearance<'a> {
             let mesh = self.mesh.reference_sides.iter().find(|(r, _)| *r == row);
             if let Some((_, mesh)) = mesh.filter(|_| prune && cap.is_finite()) {
                 let q = PVec::new(local.x, local.y, local.z);
-                if mesh.nearest_within(q, cap).is_none() {
+                if !mesh.any_within(q, cap) {
                     skipped |= floor < best.0;
                     continue;
                 }

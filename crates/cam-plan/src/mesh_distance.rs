@@ -21,7 +21,7 @@
 //! the mesh, less when the bound prunes the root's children. No allocation.
 
 use parry3d_f64::math::Vector as PVec;
-use parry3d_f64::partitioning::Bvh;
+use parry3d_f64::partitioning::{Bvh, TraversalAction};
 
 /// A triangle mesh held for distance queries: its BVH and its triangles' corners by index.
 #[derive(Clone)]
@@ -68,6 +68,39 @@ impl MeshDistance {
             bvh: mesh.bvh().clone(),
             triangles,
         }
+    }
+
+    /// Whether some triangle lies nearer to `p` than `max_dist`: the same answer as
+    /// `nearest_within(p, max_dist).is_some()`, but the depth-first walk (nodes beyond
+    /// `max_dist` pruned) stops at the first triangle found, where the nearest-triangle search
+    /// goes on to the nearest. O(log T) down to the first hit; the same as the search when
+    /// there is none.
+    pub(crate) fn any_within(&self, p: PVec, max_dist: f64) -> bool {
+        let max2 = if max_dist.is_finite() {
+            max_dist * max_dist
+        } else {
+            f64::MAX
+        };
+        let mut found = false;
+        self.bvh.traverse(|node| {
+            let shift = (node.mins() - p).max(p - node.maxs()).max(PVec::ZERO);
+            if !(shift.length_squared() < max2) {
+                return TraversalAction::Prune;
+            }
+            if let Some(leaf) = node.leaf_data() {
+                if self
+                    .triangles
+                    .get(leaf as usize)
+                    .is_some_and(|t| t.distance_squared(p) < max2)
+                {
+                    found = true;
+                    return TraversalAction::EarlyExit;
+                }
+                return TraversalAction::Prune;
+            }
+            TraversalAction::Continue
+        });
+        found
     }
 
     /// The triangle nearest to `p` and its distance, when that distance is below `max_dist`
@@ -227,6 +260,8 @@ mod tests {
         // The bound is exclusive: nothing at or beyond it.
         assert!(md.nearest_within(PVec::new(1.0, 1.0, 2.5), 2.5).is_none());
         assert!(md.nearest_within(PVec::new(1.0, 1.0, 2.5), 2.6).is_some());
+        assert!(!md.any_within(PVec::new(1.0, 1.0, 2.5), 2.5));
+        assert!(md.any_within(PVec::new(1.0, 1.0, 2.5), 2.6));
     }
 
     proptest! {
@@ -259,6 +294,9 @@ mod tests {
             } else if reference > bound + 1e-9 {
                 prop_assert!(near.is_none());
             }
+            // The existence test answers exactly as the search.
+            prop_assert_eq!(md.any_within(p, bound), near.is_some());
+            prop_assert!(md.any_within(p, f64::INFINITY));
         }
     }
 }
