@@ -84,7 +84,9 @@ impl MeshDistance {
         let mut found = false;
         self.bvh.traverse(|node| {
             let shift = (node.mins() - p).max(p - node.maxs()).max(PVec::ZERO);
-            if !(shift.length_squared() < max2) {
+            let d2 = shift.length_squared();
+            // A non-finite point (NaN distance) meets nothing.
+            if d2.is_nan() || d2 >= max2 {
                 return TraversalAction::Prune;
             }
             if let Some(leaf) = node.leaf_data() {
