@@ -73,7 +73,9 @@
 //! tangent at the sample (centre on its normal) overlaps the design by at least
 //! `CORNER_OVERLAP_MM` (distances to points of the design's closed material: an upper bound
 //! of the centre's distance), and where the surface is smooth a ball can touch a point only
-//! from its normal; the rest could be touched by a ball and are left by this plan. `max_overcut_mm`: the largest negative margin of a station's ball (≤ tol/2 by construction).
+//! from its normal; the rest could be touched by a ball and are left by this plan.
+//! `max_overcut_mm`: the largest negative margin of a station's ball (≤ tol/2 by
+//! construction).
 //!
 //! Cost: O(stations · iterations · design distance) for the centres, O(stations · axes tried
 //! · tool samples · design distance) for the postures, O(motions · samples · bisections) for
@@ -498,9 +500,8 @@ impl Planner<'_> {
                 .is_ok()
     }
 
-    /// Plans the passes of `region` on `g`.
-    /// Plans `region`'s passes; `pass_done(k, n)` is called after the `k`-th of its `n`
-    /// passes (progress).
+    /// Plans the passes of `region` on `g`; `pass_done(k, n)` is called after the `k`-th of
+    /// its `n` passes (progress).
     fn plan_region(
         &self,
         g: &RestGrid,

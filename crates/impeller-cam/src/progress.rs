@@ -94,9 +94,10 @@ pub struct Task {
 const PROGRESS_LINE_EVERY: Duration = Duration::from_secs(10);
 
 /// What an operation reports while it plans ([`cam_plan::PlanProgress`]), shown on its
-/// task: on a terminal as the spinner's message (`planning rest (rest_finishing): 1 234 /
-/// 5 678 samples`), without one as a line at most every [`PROGRESS_LINE_EVERY`] (a long
-/// planning in a log still shows it moves), nothing when quiet.
+/// task: on a terminal as the spinner's message (`planning rest (rest_finishing): 78/359
+/// samples above the threshold (22 %)`), without one as a line at most every
+/// [`PROGRESS_LINE_EVERY`] (a long planning in a log still shows it moves), nothing when
+/// quiet; the message is formatted only when it is shown.
 #[derive(Debug)]
 pub struct TaskProgress {
     bar: ProgressBar,
@@ -126,14 +127,20 @@ impl Task {
     }
 }
 
-impl cam_plan::PlanProgress for TaskProgress {
-    fn report(&self, what: &str, done: usize, total: usize) {
+impl TaskProgress {
+    /// The message of a report: `{task}: {done}/{total} {what} ({percent} %)`.
+    fn message(&self, what: &str, done: usize, total: usize) -> String {
         let pct = if total > 0 {
             100.0 * done as f64 / total as f64
         } else {
             100.0
         };
-        let msg = format!("{}: {done}/{total} {what} ({pct:.0} %)", self.what);
+        format!("{}: {done}/{total} {what} ({pct:.0} %)", self.what)
+    }
+}
+
+impl cam_plan::PlanProgress for TaskProgress {
+    fn report(&self, what: &str, done: usize, total: usize) {
         if self.lines {
             // A poisoned lock only means another report panicked: keep reporting.
             let mut last = self
@@ -142,10 +149,10 @@ impl cam_plan::PlanProgress for TaskProgress {
                 .unwrap_or_else(std::sync::PoisonError::into_inner);
             if last.elapsed() >= PROGRESS_LINE_EVERY {
                 *last = Instant::now();
-                eprintln!("[impeller-cam] {msg}");
+                eprintln!("[impeller-cam] {}", self.message(what, done, total));
             }
         } else if !self.bar.is_hidden() {
-            self.bar.set_message(msg);
+            self.bar.set_message(self.message(what, done, total));
         }
     }
 }

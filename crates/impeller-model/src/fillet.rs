@@ -556,9 +556,8 @@ impl FilletPiece {
         let mut wedges: Vec<Wedge> = (0..n)
             .filter_map(|k| {
                 let t = k as f64 / (n - 1) as f64;
-                let nn = self.normals.point(t);
-                let a = -Vector3::new(nn[0], nn[1], nn[2]).try_normalize(1e-12)?;
-                let b = -Vector3::new(nn[3], nn[4], nn[5]).try_normalize(1e-12)?;
+                let (nh, nb) = contact_normals(&self.normals, t)?;
+                let (a, b) = (-nh, -nb);
                 let e = (b - a * a.dot(&b)).try_normalize(1e-12)?;
                 let gamma = a.dot(&b).clamp(-1.0, 1.0).acos();
                 Some(Wedge {
@@ -610,9 +609,8 @@ impl FilletPiece {
         if q.on_boundary || d.dot(&tangent).abs() > 1e-6 * (1.0 + d.norm()) {
             return None;
         }
-        let n = self.normals.point(q.u);
-        let a = -Vector3::new(n[0], n[1], n[2]).normalize();
-        let b = -Vector3::new(n[3], n[4], n[5]).normalize();
+        let (nh, nb) = contact_normals(&self.normals, q.u)?;
+        let (a, b) = (-nh, -nb);
         // d = λ a + μ b (+ a tangent part): the arc's sector when λ, μ ≥ 0.
         let ab = a.dot(&b);
         let det = 1.0 - ab * ab;
@@ -1053,6 +1051,16 @@ fn fit_piece(
     })
 }
 
+/// The unit hub and blade normals (out of the material, toward the ball) of the
+/// contact-normal curve at `t`, `None` where either vanishes.
+fn contact_normals(normals: &NurbsCurve<6>, t: f64) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    let n = normals.point(t);
+    Some((
+        Vector3::new(n[0], n[1], n[2]).try_normalize(1e-12)?,
+        Vector3::new(n[3], n[4], n[5]).try_normalize(1e-12)?,
+    ))
+}
+
 /// Samples of the contact-normal curve per section interval in [`sector_reach`].
 const REACH_SAMPLES_PER_SECTION: usize = 16;
 
@@ -1075,10 +1083,7 @@ fn sector_reach(normals: &NurbsCurve<6>, sections: usize, radius: f64) -> f64 {
     let mut half_cos = f64::INFINITY;
     for k in 0..n {
         let t = t0 + (t1 - t0) * k as f64 / (n - 1) as f64;
-        let nn = normals.point(t);
-        let a = Vector3::new(nn[0], nn[1], nn[2]).try_normalize(1e-12);
-        let b = Vector3::new(nn[3], nn[4], nn[5]).try_normalize(1e-12);
-        let (Some(a), Some(b)) = (a, b) else {
+        let Some((a, b)) = contact_normals(normals, t) else {
             return f64::INFINITY;
         };
         let gamma = a.dot(&b).clamp(-1.0, 1.0).acos();

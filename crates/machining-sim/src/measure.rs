@@ -259,16 +259,7 @@ pub fn measure_residual(
     grids
         .iter()
         .map(|g| {
-            let residual_mm: Vec<Option<f64>> = g
-                .points
-                .par_iter()
-                .zip(g.normals.par_iter())
-                .map(|(p, n)| {
-                    let len = n.norm();
-                    (len > 1e-12 && len.is_finite())
-                        .then(|| residual_along(stock, design, p, &(n / len), max_depth))
-                })
-                .collect();
+            let residual_mm = at_samples(g, |p, n| residual_along(stock, design, p, n, max_depth));
             SurfaceMap {
                 name: g.name.clone(),
                 nu: g.nu,
@@ -277,6 +268,22 @@ pub fn measure_residual(
                 overcut_mm: vec![None; residual_mm.len()],
                 residual_mm,
             }
+        })
+        .collect()
+}
+
+/// `f(point, unit normal)` at every sample of `g` (parallel over samples), `None` where the
+/// normal is zero or not finite (a skipped sample).
+fn at_samples<T: Send>(
+    g: &SurfaceGrid,
+    f: impl Fn(&Point3, &Vector3) -> T + Sync,
+) -> Vec<Option<T>> {
+    g.points
+        .par_iter()
+        .zip(g.normals.par_iter())
+        .map(|(p, n)| {
+            let len = n.norm();
+            (len > 1e-12 && len.is_finite()).then(|| f(p, &(n / len)))
         })
         .collect()
 }
@@ -315,19 +322,7 @@ pub fn measure(
     let mut maps: Vec<SurfaceMap> = grids
         .iter()
         .map(|g| {
-            let probes: Vec<Option<Probe>> = g
-                .points
-                .par_iter()
-                .zip(g.normals.par_iter())
-                .map(|(p, n)| {
-                    let len = n.norm();
-                    if len > 1e-12 && len.is_finite() {
-                        Some(probe(stock, initial, design, p, &(n / len), max_depth))
-                    } else {
-                        None
-                    }
-                })
-                .collect();
+            let probes = at_samples(g, |p, n| probe(stock, initial, design, p, n, max_depth));
             SurfaceMap {
                 name: g.name.clone(),
                 nu: g.nu,

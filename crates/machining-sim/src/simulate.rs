@@ -543,27 +543,34 @@ pub fn colliding_moves(collisions: &[Collision]) -> usize {
     keys.len()
 }
 
+/// Refuses a probe depth that is not finite and positive.
+fn check_probe_depth(options: &SimOptions) -> Result<(), SimError> {
+    if options.probe_depth_mm.is_finite() && options.probe_depth_mm > 0.0 {
+        return Ok(());
+    }
+    Err(SimError::InvalidOption {
+        name: "probe_depth_mm",
+        value: options.probe_depth_mm,
+        reason: "must be finite and > 0",
+    })
+}
+
 /// The material the tool paths leave: sweeps them through `stock` (modified in place to the
 /// final stock) and measures the residual over the design's surface samples
 /// ([`crate::measure::measure_residual`]); no overcut is read and no collision is reported
 /// (shank and holder are not checked against the design, the removal's checks of rapids
-/// against the stock are dropped: callers that need a verdict use [`simulate`]). The removal is [`simulate`]'s, so the final stock and the residual maps are
-/// bit for bit those of [`simulate`] with the same options; what it saves is the overcut
-/// reading (one design evaluation per cut dexel end point), the collision checks and the
-/// copy of the blank. What a rest operation plans from.
+/// against the stock are dropped: callers that need a verdict use [`simulate`]). The
+/// removal is [`simulate`]'s, so the final stock and the residual maps are bit for bit
+/// those of [`simulate`] with the same options; what it saves is the overcut reading (one
+/// design evaluation per cut dexel end point), the collision checks and the copy of the
+/// blank. What a rest operation plans from.
 pub fn simulate_residual(
     stock: &mut TriDexel,
     design: &dyn DesignModel,
     ops: &[(Cutter, ToolPath)],
     options: &SimOptions,
 ) -> Result<Vec<SurfaceMap>, SimError> {
-    if !(options.probe_depth_mm.is_finite() && options.probe_depth_mm > 0.0) {
-        return Err(SimError::InvalidOption {
-            name: "probe_depth_mm",
-            value: options.probe_depth_mm,
-            reason: "must be finite and > 0",
-        });
-    }
+    check_probe_depth(options)?;
     let options = SimOptions {
         check_collisions: false,
         ..options.clone()
@@ -591,13 +598,7 @@ pub fn simulate(
     ops: &[(Cutter, ToolPath)],
     options: &SimOptions,
 ) -> Result<Report, SimError> {
-    if !(options.probe_depth_mm.is_finite() && options.probe_depth_mm > 0.0) {
-        return Err(SimError::InvalidOption {
-            name: "probe_depth_mm",
-            value: options.probe_depth_mm,
-            reason: "must be finite and > 0",
-        });
-    }
+    check_probe_depth(options)?;
     let initial = stock.clone();
     let outcome = cut(stock, Some(design), ops, options)?;
     let t = Instant::now();
