@@ -51,19 +51,8 @@ fn spec(params: &str) -> OperationSpec {
 }
 
 /// Plans channel roughing with `params` in a context around the impeller's own stock (safety
-/// surface 10 mm over it).
+/// surface 10 mm over it), reporting progress to `progress`.
 fn plan_rough(
-    imp: &impeller_model::Impeller,
-    tool: &Tool,
-    tol: &Tolerances,
-    process: &Process,
-    clearance: &DesignClearance<'_>,
-    params: &str,
-) -> cam_plan::PlannedOperation {
-    plan_rough_reporting(imp, tool, tol, process, clearance, params, None)
-}
-
-fn plan_rough_reporting(
     imp: &impeller_model::Impeller,
     tool: &Tool,
     tol: &Tolerances,
@@ -111,7 +100,7 @@ fn rough_default_impeller_within_scallop_and_clear_of_blades() {
     )
     .unwrap();
     let recorder = cam_plan::ProgressLog::default();
-    let plan = plan_rough_reporting(
+    let plan = plan_rough(
         &imp,
         &tool,
         &tol,
@@ -194,7 +183,15 @@ fn rough_tapered_ball_trimmed_to_where_the_cutter_fits() {
         },
     )
     .unwrap();
-    let plan = plan_rough(&imp, &tool, &tol, &proc_, &clearance, "scallop_mm = 0.5");
+    let plan = plan_rough(
+        &imp,
+        &tool,
+        &tol,
+        &proc_,
+        &clearance,
+        "scallop_mm = 0.5",
+        None,
+    );
     let m = &plan.metrics;
     let get = |k: &str| m.get(k).and_then(|v| v.as_f64()).unwrap();
     eprintln!("{m:?}");
