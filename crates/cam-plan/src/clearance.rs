@@ -150,6 +150,9 @@ pub enum DesignPart {
     Hub,
     /// The shroud contour (not material: a boundary the paths of some operations respect).
     Shroud,
+    /// The blade-root fillets (material in the corner between hub and blades, measured by
+    /// [`crate::FilletMargin`] where an operation asks for it).
+    Fillet,
     /// Blade `index` of the main or splitter row.
     Blade {
         /// Main or splitter row.

@@ -14,6 +14,8 @@
 //!   the surface for the cutter, shank and holder frusta as convex shapes against the mesh;
 //! - [`pass_check`]: the whole tool (cutter, shank, holder) of a cutting pass, every posture
 //!   and every motion between two, against the whole design with a floor per part;
+//! - [`fillet_margin`]: the blade-root fillets in the clearance of a ball near the corner
+//!   between hub and blade (a lower bound, motions certified);
 //! - [`axis_smoothing`]: the tool axes of a ball-end cutting run made monotone and smooth
 //!   about the ball centres, re-checked with the whole-tool query, kept reversals reported
 //!   with their reasons;
@@ -37,6 +39,7 @@
 pub mod axis_smoothing;
 pub mod clearance;
 pub mod error;
+pub mod fillet_margin;
 pub mod linking;
 mod mesh_distance;
 pub mod metrics;
@@ -54,6 +57,7 @@ pub use clearance::{
     Clearance, ClearanceOptions, DesignClearance, DesignMesh, DesignPart, PartSet, Row, ToolPart,
 };
 pub use error::PlanError;
+pub use fillet_margin::FilletMargin;
 pub use linking::{LinkCheck, LinkStats, Linker, SafetySurface, ToolEnvelope, RAPID_TRACE_STOP_MM};
 pub use metrics::{MetricValue, Metrics, Plot, PlotKind, PlotSeries};
 pub use operation::{

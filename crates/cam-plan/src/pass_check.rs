@@ -38,6 +38,7 @@
 //! (rayon).
 
 use crate::clearance::{ClearanceOptions, DesignClearance, DesignPart, PartSet, ToolPart};
+use crate::FilletMargin;
 use cam_core::CutterLocation;
 use rayon::prelude::*;
 
@@ -96,6 +97,7 @@ impl PassViolation {
         let part = match self.design_part {
             DesignPart::Hub => "the hub".to_string(),
             DesignPart::Shroud => "the shroud contour".to_string(),
+            DesignPart::Fillet => "a blade-root fillet".to_string(),
             DesignPart::Blade { row, index } => format!(
                 "{} blade {index}",
                 match row {
@@ -156,6 +158,12 @@ pub struct PassCheck<'a> {
     upper_hub: DesignClearance<'a>,
     floors: PassFloors,
     split_mm: f64,
+    /// The blade-root fillets when asked for ([`PassCheck::with_fillets`]), with the ball
+    /// they are checked against: (fillets, height of the ball centre above the tip, radius).
+    fillets: Option<(&'a FilletMargin, f64, f64)>,
+    /// Whether the posture queries hold the ball ([`PassCheck::with_postures_above`] may
+    /// leave it to the planner).
+    postures_hold_ball: bool,
 }
 
 impl<'a> PassCheck<'a> {
@@ -202,7 +210,69 @@ impl<'a> PassCheck<'a> {
             upper_hub: with(hub, split_mm),
             floors,
             split_mm,
+            fillets: None,
+            postures_hold_ball: true,
         }
+    }
+
+    /// The same check with the ball of a ball or tapered ball end also kept clear of the
+    /// blade-root fillets ([`FilletMargin`]; floor: the smaller of the blade and hub
+    /// floors): at every posture whose query holds the ball, and along every motion
+    /// (certified, [`FilletMargin::certify_motion`]). The sharp design queries read a
+    /// fillet's material as air; only the ball is checked against it, since the parts above
+    /// it stay farther from the corner than the ball wherever the axis leans away from hub
+    /// and side. A tool without a ball end is returned unchanged.
+    pub fn with_fillets(mut self, fillets: Option<&'a FilletMargin>) -> Self {
+        let Some(f) = fillets else {
+            return self;
+        };
+        let Some(h) = self.motion_hub.ball_centre_mm() else {
+            return self;
+        };
+        let rho = self
+            .motion_hub
+            .samples()
+            .find(|&(hs, _)| (hs - h).abs() <= 1e-9)
+            .map(|(_, rho)| rho);
+        if let Some(rho) = rho {
+            self.fillets = Some((f, h, rho));
+        }
+        self
+    }
+
+    /// Whether the ball about `centre` keeps `floor` from the fillets (true when the check
+    /// holds no fillets): for a planner that places the ball itself
+    /// ([`PassCheck::with_postures_above`]).
+    pub fn ball_keeps_fillets(&self, centre: &crate::Vector3, floor: f64) -> bool {
+        self.fillets
+            .is_none_or(|(f, _, rho)| f.clearance(&self.motion_hub, centre, rho, floor) >= floor)
+    }
+
+    /// The floor of the fillets: the smaller of the blade and hub floors.
+    fn fillet_floor(&self) -> f64 {
+        self.floors.blades_mm.min(self.floors.hub_mm)
+    }
+
+    /// The fillet clearance of the posture's ball when it comes below the fillet floor
+    /// (checked only when the fillets were asked for and the posture queries hold the ball).
+    fn fillet_violation(&self, index: usize, cl: &CutterLocation) -> Option<PassViolation> {
+        let (f, h, rho) = self.fillets?;
+        if !self.postures_hold_ball {
+            return None;
+        }
+        let floor = self.fillet_floor();
+        let c = cl.axis_point(h).coords;
+        let value = f.clearance(&self.motion_hub, &c, rho, floor);
+        (value < floor).then_some(PassViolation {
+            index,
+            s: 0.0,
+            clearance_mm: value,
+            floor_mm: floor,
+            design_part: DesignPart::Fillet,
+            tool_part: ToolPart::Cutter,
+            height_mm: h,
+            at: *cl,
+        })
     }
 
     /// The same check with the tool samples up to `above_mm` above the tip left out of the
@@ -220,6 +290,10 @@ impl<'a> PassCheck<'a> {
         };
         self.blades = set(&self.blades);
         self.hub = set(&self.hub);
+        self.postures_hold_ball = self
+            .motion_hub
+            .ball_centre_mm()
+            .is_some_and(|h| above_mm < h - 1e-9);
         self
     }
 
@@ -231,7 +305,9 @@ impl<'a> PassCheck<'a> {
     /// Whether the posture keeps both floors (stops at the first part below its floor:
     /// cheaper than [`PassCheck::posture`]).
     pub fn is_clear(&self, cl: &CutterLocation) -> bool {
-        self.blades.is_clear(cl, self.floors.blades_mm) && self.hub.is_clear(cl, self.floors.hub_mm)
+        self.blades.is_clear(cl, self.floors.blades_mm)
+            && self.hub.is_clear(cl, self.floors.hub_mm)
+            && self.fillet_violation(0, cl).is_none()
     }
 
     /// The violation of one posture, if any (blades first, then hub).
@@ -295,7 +371,8 @@ impl<'a> PassCheck<'a> {
                 tool_part: c.tool_part,
                 height_mm: c.height_mm,
                 at: *cl,
-            });
+            })
+            .or_else(|| self.fillet_violation(index, cl));
         ((b.distance_mm, h.distance_mm), v)
     }
 
@@ -386,6 +463,26 @@ impl<'a> PassCheck<'a> {
             }
             if !self.motion_hub.is_clear(&cl, self.floors.hub_mm) {
                 return Some(violation(&self.motion_hub, s, self.floors.hub_mm));
+            }
+        }
+        // The ball against the fillets, certified.
+        if let Some((f, h, rho)) = self.fillets {
+            let floor = self.fillet_floor();
+            if let Err(s) =
+                f.certify_motion(&self.motion_hub, a, b, h, rho, floor, tol, MOTION_QUERIES)
+            {
+                let cl = at(s);
+                let c = cl.axis_point(h).coords;
+                return Some(PassViolation {
+                    index,
+                    s,
+                    clearance_mm: f.clearance(&self.motion_hub, &c, rho, floor),
+                    floor_mm: floor,
+                    design_part: DesignPart::Fillet,
+                    tool_part: ToolPart::Cutter,
+                    height_mm: h,
+                    at: cl,
+                });
             }
         }
         // The upper part, certified.

@@ -83,10 +83,9 @@
 
 use cam_core::{CutterLocation, Move, ToolPath};
 use cam_plan::{
-    ClearanceOptions, DesignClearance, Metrics, Operation, OperationSpec, PartSet, PlanContext,
-    PlanError, PlannedOperation, Plot, PlotKind, PlotSeries, Point3, RestGrid,
+    ClearanceOptions, DesignClearance, FilletMargin, Metrics, Operation, OperationSpec, PartSet,
+    PlanContext, PlanError, PlannedOperation, Plot, PlotKind, PlotSeries, Point3, RestGrid,
 };
-use impeller_model::fillet::{ImpellerFillets, DEFAULT_FILLET_TOL_MM};
 use nalgebra::{UnitQuaternion, Vector3};
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -238,7 +237,7 @@ struct Station {
 struct Planner<'a> {
     ctx: &'a PlanContext<'a>,
     material: DesignClearance<'a>,
-    fillets: Option<ImpellerFillets>,
+    fillets: Option<FilletMargin>,
     r: f64,
     tol: f64,
     /// Cutter samples above the ball centre: (height above the tip, radius, floor).
@@ -287,27 +286,10 @@ impl Planner<'_> {
         let q = Point3::from(*p);
         let hub = self.material.hub_signed_distance(&q);
         let blade = self.material.blade_signed_distance(&q).0;
-        let sharp = hub.min(blade) - rho;
-        let Some(f) = &self.fillets else {
-            return sharp;
-        };
-        let far = hub.max(blade) - f.reach_mm() - rho;
-        if far >= sharp {
-            return sharp;
+        match &self.fillets {
+            Some(f) => f.margin(p, rho, hub, blade),
+            None => hub.min(blade) - rho,
         }
-        // Per fillet: inside one of its rolling balls, or clear of its material by the
-        // wedge bound (ImpellerFillets::material_bounds).
-        let mut per_fillet = f64::INFINITY;
-        let mut visited = false;
-        // A material bound at or above the sharp distance changes nothing: capped there.
-        f.material_bounds(p, sharp + rho, |spine, material| {
-            visited = true;
-            per_fillet = per_fillet.min((f.radius() - spine - rho).max(material - rho));
-        });
-        if !visited {
-            per_fillet = f64::NEG_INFINITY;
-        }
-        sharp.min(far.max(per_fillet))
     }
 
     fn gradient(&self, p: &Vector3<f64>) -> Vector3<f64> {
@@ -339,7 +321,7 @@ impl Planner<'_> {
             } else if surface.contains("_fillet_") {
                 self.fillets
                     .as_ref()
-                    .and_then(|f| f.closest(q))
+                    .and_then(|f| f.fillets().closest(q))
                     .map_or_else(|| self.distance(q), |(d, _)| d)
             } else {
                 self.material.blade_signed_distance(&pt).0
@@ -366,7 +348,7 @@ impl Planner<'_> {
         let fillet = self
             .fillets
             .as_ref()
-            .and_then(|f| f.closest(&c))
+            .and_then(|f| f.fillets().closest(&c))
             .map_or(f64::INFINITY, |(d, _)| d);
         self.r - hub.min(blade).min(fillet)
     }
@@ -381,7 +363,7 @@ impl Planner<'_> {
             &|p| {
                 self.fillets
                     .as_ref()
-                    .and_then(|f| f.closest(p).map(|(d, _)| d))
+                    .and_then(|f| f.fillets().closest(p).map(|(d, _)| d))
             },
         ];
         let mut sum = Vector3::zeros();
@@ -800,7 +782,7 @@ impl Operation for RestFinishing {
             ));
         }
         let tol = ctx.tolerances.machining_tol;
-        let fillets = ImpellerFillets::new(ctx.impeller, DEFAULT_FILLET_TOL_MM)
+        let fillets = FilletMargin::new(ctx.impeller)
             .map_err(|e| PlanError::geometry(&self.name, "blade-root fillets", e.to_string()))?;
         let stock_margin = remaining.max_residual_mm() + tol;
         let flutes = ctx.tool.cutter.flute_length;

@@ -6,7 +6,8 @@
 //! is clear of the design (one pass for a ruled side: paper 002's situation; several on a
 //! free-form side: paper 001 §4), and point-mills the rest ([`crate::point`]: passes along
 //! the flow from tip to root, scallop-controlled, tool axis tilted within the accessible
-//! cone, every posture and motion certified for the whole tool). The report says which
+//! cone, every posture and motion certified for the whole tool, the ball also against the
+//! blade-root fillets, [`cam_plan::PassCheck::with_fillets`]). The report says which
 //! method each region got and why (`regions`), and what it measured: `max_scallop_mm`
 //! (between point-milling passes), `max_overcut_mm` and `max_undercut_mm` (over every
 //! region, on the surface the operation leaves), `min_clearance_mm` (smallest clearance of

@@ -30,7 +30,7 @@ use crate::semi::strip_pass;
 use crate::FlankError;
 use cam_core::{CutterLocation, Point3};
 use cam_plan::axis_smoothing::RunSmoothing;
-use cam_plan::{PassCheck, PassFloors, PlanContext, Row};
+use cam_plan::{FilletMargin, PassCheck, PassFloors, PlanContext, Row};
 use impeller_model::{Blade, Side};
 use serde::Deserialize;
 
@@ -182,6 +182,7 @@ pub fn plan_side(
     row: Row,
     side: Side,
     st: &SideSettings,
+    fillets: Option<&FilletMargin>,
 ) -> Result<SidePlan, FlankError> {
     let blade = rows::blade_set(ctx.impeller, row)?.blade().clone();
     let v_range = side_v_range(ctx, &blade, side)?;
@@ -193,13 +194,15 @@ pub fn plan_side(
         ctx.clearance,
         floors(a, a_h, tol + chord, chord),
         ctx.tool.cutter.flute_length,
-    );
+    )
+    .with_fillets(fillets);
     let point_check = PassCheck::new(
         ctx.clearance,
         floors(a, a_h, st.point.tol_mm, chord),
         point_split_mm(ctx, &st.point),
     )
-    .with_postures_above(st.point.ball_radius);
+    .with_postures_above(st.point.ball_radius)
+    .with_fillets(fillets);
     let label = rows::label(row);
     let strips = if st.choice == MethodChoice::Point {
         Vec::new()
@@ -585,10 +588,12 @@ pub fn plan_rows(
         .flat_map(|&r| [Side::Pressure, Side::Suction].map(move |s| (r, s)))
         .collect();
     let sides_done = std::sync::atomic::AtomicUsize::new(0);
+    let fillets = FilletMargin::new(ctx.impeller)
+        .map_err(|e| FlankError::Geometry(format!("blade-root fillets: {e}")))?;
     ctx.progress("blade sides", 0, jobs.len());
     let planned: Vec<(Row, Side, SidePlan)> = jobs
         .par_iter()
-        .map(|&(row, side)| plan_side(ctx, row, side, st).map(|p| (row, side, p)))
+        .map(|&(row, side)| plan_side(ctx, row, side, st, fillets.as_ref()).map(|p| (row, side, p)))
         .inspect(|_| {
             let done = sides_done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             ctx.progress("blade sides", done, jobs.len());
@@ -604,7 +609,8 @@ pub fn plan_rows(
         ),
         point_split_mm(ctx, &st.point),
     )
-    .with_postures_above(st.point.ball_radius);
+    .with_postures_above(st.point.ball_radius)
+    .with_fillets(fillets.as_ref());
     let mut paths = Vec::new();
     let (mut direct, mut linked) = (0, 0);
     let mut reference_cut = 0.0;

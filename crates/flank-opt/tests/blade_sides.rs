@@ -242,7 +242,7 @@ fn flutes_reaching_the_upper_blade_are_point_milled() {
             .expect("a strip whose flank pass runs its flutes into the blade");
         assert!(worst > 0.05, "the flutes reach {worst} mm below the floor");
         // The rule point-mills it, and what it emits is clear.
-        let plan = regions::plan_side(ctx, Row::Main, Side::Suction, &st).unwrap();
+        let plan = regions::plan_side(ctx, Row::Main, Side::Suction, &st, None).unwrap();
         let point = plan
             .regions
             .iter()
@@ -339,7 +339,7 @@ fn free_form_side_is_finished() {
             ruled.max_deviation_mm
         );
         let st = side_settings(MethodChoice::Auto, tol, scallop, &p, &t);
-        let plan = regions::plan_side(ctx, Row::Main, Side::Suction, &st).unwrap();
+        let plan = regions::plan_side(ctx, Row::Main, Side::Suction, &st, None).unwrap();
         assert!(plan.regions.iter().any(|g| g.method == Method::Point));
         for g in &plan.regions {
             assert!(
@@ -407,8 +407,8 @@ fn point_milling_axes_are_smoothed_about_the_ball_centres() {
         let st = side_settings(MethodChoice::Point, 0.01, 0.05, &p, &t);
         let mut raw_st = st;
         raw_st.point.smooth_axes = false;
-        let smooth = regions::plan_side(ctx, Row::Main, Side::Suction, &st).unwrap();
-        let raw = regions::plan_side(ctx, Row::Main, Side::Suction, &raw_st).unwrap();
+        let smooth = regions::plan_side(ctx, Row::Main, Side::Suction, &st, None).unwrap();
+        let raw = regions::plan_side(ctx, Row::Main, Side::Suction, &raw_st, None).unwrap();
         let reversals = |runs: &[Vec<CutterLocation>]| -> usize {
             runs.iter()
                 .map(|r| {
@@ -464,7 +464,7 @@ fn flank_strips_that_leave_more_than_the_tolerance_are_point_milled() {
         strict.flank_residual_mm = Some(tol);
         let mut seen_loose = false;
         for side in [Side::Pressure, Side::Suction] {
-            let plan = regions::plan_side(ctx, Row::Main, side, &loose).unwrap();
+            let plan = regions::plan_side(ctx, Row::Main, side, &loose, None).unwrap();
             let worst = plan
                 .regions
                 .iter()
@@ -475,7 +475,7 @@ fn flank_strips_that_leave_more_than_the_tolerance_are_point_milled() {
                 continue;
             }
             seen_loose = true;
-            let plan = regions::plan_side(ctx, Row::Main, side, &strict).unwrap();
+            let plan = regions::plan_side(ctx, Row::Main, side, &strict, None).unwrap();
             for g in plan.regions.iter().filter(|g| flank(g)) {
                 assert!(
                     g.max_residual_mm <= tol + 1e-9,
@@ -586,8 +586,8 @@ fn semi_flank_passes_are_smoothed_within_the_strip_tolerance() {
         let (mut before, mut after, mut smoothed) = (0, 0, 0);
         for row in [Row::Main, Row::Splitter] {
             for side in [Side::Pressure, Side::Suction] {
-                let a = regions::plan_side(ctx, row, side, &plain).unwrap();
-                let b = regions::plan_side(ctx, row, side, &smooth).unwrap();
+                let a = regions::plan_side(ctx, row, side, &plain, None).unwrap();
+                let b = regions::plan_side(ctx, row, side, &smooth, None).unwrap();
                 for (ga, gb) in a.regions.iter().zip(&b.regions) {
                     assert_eq!(ga.method, gb.method);
                     if ga.method == Method::Point {

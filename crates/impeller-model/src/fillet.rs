@@ -239,12 +239,14 @@ const WEDGE_SPACING_MM: f64 = 0.01;
 const WEDGE_BLOCK: usize = 32;
 
 /// The region of one section's fillet material: in the plane of the contact directions `a`
-/// (to the hub contact) and `b` (to the blade contact) through the spine point `s`, the
-/// circular sector between `a` and `b` (angle `gamma`) from radius `R` to `r_out`, the
-/// farthest corner point `(1 + CORNER_SLACK)·R / cos(γ/2)` of the sector cut by both walls'
-/// tangent planes moved in by `CORNER_SLACK·R` (what [`FilletPiece::closest`] counts as
-/// material). `delta` bounds how far the wedge of any spine point up to the neighbouring
-/// samples lies from this one or that one.
+/// (to the hub contact) and `b` (to the blade contact) through the spine point `s`, the part
+/// of the angle between `a` and `b` (angle `gamma`) outside the disc of radius `R` and on the
+/// air side of both walls' tangent planes moved in by `CORNER_SLACK·R` (`w·a ≤ c`,
+/// `w·b ≤ c`, `c = (1 + CORNER_SLACK)·R`): what [`FilletPiece::closest`] counts as material.
+/// It lies in the annular sector from `R` to `r_out = c / cos(γ/2)` (the corner) and in the
+/// quadrilateral of the spine point, the two moved contacts `c·a`, `c·b` and the corner.
+/// `delta` bounds how far the wedge of any spine point up to the neighbouring samples lies
+/// from this one or that one.
 #[derive(Debug, Clone, Copy)]
 struct Wedge {
     s: Vector3<f64>,
@@ -255,6 +257,8 @@ struct Wedge {
     cos_g: f64,
     sin_g: f64,
     r_out: f64,
+    /// `c = (1 + CORNER_SLACK)·R`: the moved tangent planes' distance from the spine point.
+    c: f64,
     delta: f64,
 }
 
@@ -423,15 +427,61 @@ struct Wedges {
     groups: Vec<WedgeBlock>,
 }
 
+/// 2-D distance from `(x, y)` to the segment from `(x0, y0)` to `(x1, y1)`.
+#[inline]
+fn segment_distance_2d(x: f64, y: f64, (x0, y0): (f64, f64), (x1, y1): (f64, f64)) -> f64 {
+    let (dx, dy) = (x1 - x0, y1 - y0);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        (((x - x0) * dx + (y - y0) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (u, v) = (x - x0 - t * dx, y - y0 - t * dy);
+    (u * u + v * v).sqrt()
+}
+
 impl Wedge {
-    /// Distance from `p` to the wedge (exact: the plane's normal offset and the 2-D distance to
-    /// the annular sector, whose angle is below π).
+    /// Distance from `p` to the wedge's region (type docs): the plane's normal offset and a
+    /// lower bound of the 2-D distance to the region, the larger of the exact 2-D distances
+    /// to the annular sector (angle below π) and to the quadrilateral, each of which holds
+    /// it. The quadrilateral keeps the bound tight beside a wall above the fillet (a ball
+    /// riding a blade side well above the hub), where the sector, as wide as the corner is
+    /// far, reaches into the wall up to `r_out` from the spine.
     fn distance(&self, p: &Vector3<f64>, inner: f64) -> f64 {
         let w = p - self.s;
         let tau = w.dot(&self.n);
         let (x, y) = (w.dot(&self.a), w.dot(&self.e));
+        let d2 = self
+            .sector_distance_2d(x, y, inner)
+            .max(self.kite_distance_2d(x, y));
+        (tau * tau + d2 * d2).sqrt()
+    }
+
+    /// 2-D distance from `(x, y)` (along `a`, `e`) to the quadrilateral of the spine point,
+    /// `c·a`, the corner and `c·b` (convex: its angles at the contacts are right angles).
+    #[inline]
+    fn kite_distance_2d(&self, x: f64, y: f64) -> f64 {
+        let c = self.c;
+        let bx = (x * self.cos_g + y * self.sin_g) - c;
+        if y >= 0.0 && x * self.sin_g - y * self.cos_g >= 0.0 && x <= c && bx <= 0.0 {
+            return 0.0;
+        }
+        // The corner: on both moved tangent lines, `x = c` and `x cos γ + y sin γ = c`.
+        let corner = (c, c * (1.0 - self.cos_g) / self.sin_g.max(1e-12));
+        let (o, pa, pb) = ((0.0, 0.0), (c, 0.0), (c * self.cos_g, c * self.sin_g));
+        segment_distance_2d(x, y, o, pa)
+            .min(segment_distance_2d(x, y, pa, corner))
+            .min(segment_distance_2d(x, y, corner, pb))
+            .min(segment_distance_2d(x, y, pb, o))
+    }
+
+    /// 2-D distance from `(x, y)` to the annular sector between `a` and `b` from `inner` to
+    /// `r_out` (exact; the angle is below π).
+    #[inline]
+    fn sector_distance_2d(&self, x: f64, y: f64, inner: f64) -> f64 {
         // Inside the sector's angle (below π): on the left of `a` and on the right of `b`.
-        let d2 = if y >= 0.0 && x * self.sin_g - y * self.cos_g >= 0.0 {
+        if y >= 0.0 && x * self.sin_g - y * self.cos_g >= 0.0 {
             let m = (x * x + y * y).sqrt();
             (inner - m).max(m - self.r_out).max(0.0)
         } else {
@@ -441,8 +491,7 @@ impl Wedge {
                 (u * u + v * v).sqrt()
             };
             seg(1.0, 0.0).min(seg(self.cos_g, self.sin_g))
-        };
-        (tau * tau + d2 * d2).sqrt()
+        }
     }
 }
 
@@ -568,6 +617,7 @@ impl FilletPiece {
                     cos_g: gamma.cos(),
                     sin_g: gamma.sin(),
                     r_out: (1.0 + CORNER_SLACK) * r / (0.5 * gamma).cos().max(1e-3),
+                    c: (1.0 + CORNER_SLACK) * r,
                     delta: 0.0,
                 })
             })

@@ -16,7 +16,10 @@
 //! (`a_h` the hub allowance: near the root), the contact rides up the side to where it
 //! keeps exactly that (bisection in `v`): the ball then touches hub and side, the corner
 //! below is left to blade-root finishing. A station whose ball would still come nearer than
-//! the floor to any part of the design (a concave corner sharper than the ball) is skipped.
+//! the floor to any part of the design (a concave corner sharper than the ball), the
+//! blade-root fillets included ([`cam_plan::FilletMargin`]: beyond a fillet's end, past the
+//! hub's rim or an edge, a ball reads clear of hub and side and still reaches into the
+//! fillet), is skipped; every motion keeps the ball off the fillets too (certified).
 //! Stations are spaced along `u` (bisection) so that the chord between two ball centres
 //! strays from the offset curve halfway by at most `chord_mm` where it runs toward the side
 //! (where the straight move would cut into it) and by at most the scallop height where it
@@ -338,14 +341,22 @@ pub fn plan_band(
 }
 
 /// Whether the ball at `c` keeps the floor from the whole design (a concave corner sharper
-/// than the ball, a neighbouring blade): it may reach at most `tol` below the smaller
-/// allowance. One exact design distance.
-pub fn ball_fits(ctx: &PlanContext<'_>, c: &Contact, st: &PointSettings) -> bool {
+/// than the ball, a neighbouring blade) and from the blade-root fillets when `check` holds
+/// them ([`PassCheck::ball_keeps_fillets`]: a ball hanging over a fillet's end, beyond the
+/// hub's rim, reaches into it where hub and side read it clear): it may reach at most `tol`
+/// below the smaller allowance. One exact design distance, and the fillet bound near the
+/// corner.
+pub fn ball_fits(
+    ctx: &PlanContext<'_>,
+    c: &Contact,
+    st: &PointSettings,
+    check: &PassCheck<'_>,
+) -> bool {
     let floor = st.allowance_mm.min(st.hub_allowance_mm) - st.tol_mm;
     let (d, _) = ctx
         .clearance
         .design_signed_distance(&Point3::from(c.centre));
-    d - st.ball_radius >= floor
+    d - st.ball_radius >= floor && check.ball_keeps_fillets(&c.centre, floor)
 }
 
 /// The contact and ball centre at `(u, v)`, riding up toward `v_top` where the ball would
@@ -453,7 +464,7 @@ fn plan_pass(
     let mut stations: Vec<Option<Station>> = Vec::with_capacity(contacts.len());
     for c in &contacts {
         let c = match c {
-            Ok(c) if !ball_fits(ctx, c, st) => Err((c.u, "the ball would cut the design")),
+            Ok(c) if !ball_fits(ctx, c, st, check) => Err((c.u, "the ball would cut the design")),
             other => *other,
         };
         match &c {
@@ -618,7 +629,7 @@ fn connect(
     let Ok(c) = contact_at(ctx, blade, side, (um, line.v_at(um)), v_top, st) else {
         return false;
     };
-    if !ball_fits(ctx, &c, st) {
+    if !ball_fits(ctx, &c, st, check) {
         return false;
     }
     let prev = (
