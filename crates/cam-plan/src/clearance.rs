@@ -809,6 +809,9 @@ pub struct DesignClearance<'a> {
     /// of half angle θ is `ρ·cos θ` from the axis point where the cross-section's radius is
     /// `ρ`, so the sphere pokes out by `ρ(1 − cos θ)`.
     sphere_poke_mm: f64,
+    /// How much nearer than measured the shank and holder read against the material
+    /// ([`DesignClearance::with_non_cutting_margin`]; 0 by default).
+    non_cutting_margin_mm: f64,
 }
 
 impl std::fmt::Debug for DesignClearance<'_> {
@@ -981,6 +984,7 @@ impl<'a> DesignClearance<'a> {
                 _ => None,
             }
             .filter(|h| *h <= c.flute_length),
+            non_cutting_margin_mm: 0.0,
         })
     }
 
@@ -989,6 +993,20 @@ impl<'a> DesignClearance<'a> {
     pub fn with_options(&self, options: ClearanceOptions) -> Self {
         Self {
             options,
+            ..self.clone()
+        }
+    }
+
+    /// The same query with the shank and holder read `margin_mm` nearer to the hub and
+    /// blades than they are (as if that much wider): a check against a floor `f` then keeps
+    /// the cutting part `f` and the parts that do not cut `f + margin_mm` from the material.
+    /// A finishing floor lets the flutes reach the tolerance into the surface they finish;
+    /// shank and holder must not touch the finished part at all. The value stays a lower
+    /// bound of the (shifted) clearance and 1-Lipschitz in every tool point's displacement,
+    /// so the motion certificates hold unchanged. Negative margins are taken as 0.
+    pub fn with_non_cutting_margin(&self, margin_mm: f64) -> Self {
+        Self {
+            non_cutting_margin_mm: margin_mm.max(0.0),
             ..self.clone()
         }
     }
@@ -1773,6 +1791,7 @@ impl<'a> DesignClearance<'a> {
         let a = PVec::new(axis.x, axis.y, axis.z);
         let pose = Pose::from_parts(pv(&cl.tip), Rotation::from_rotation_arc(PVec::Z, a));
         let c = self.mesh.chord_mm;
+        let lift = self.non_cutting_margin_mm;
         let meshes = [
             (self.options.parts.hub, &self.mesh.hub, false),
             (self.options.parts.blades, &self.mesh.blades, true),
@@ -1785,13 +1804,13 @@ impl<'a> DesignClearance<'a> {
                 }
                 // Only contacts that could lower the answer (or fail the check) matter.
                 let reach = want.need(best);
-                let prediction = (reach + c).max(0.0);
+                let prediction = (reach + c + lift).max(0.0);
                 let Some((dist, point)) = frustum_mesh_contact(&pose, &f.shape, mesh, prediction)
                 else {
                     continue;
                 };
                 crossed |= dist <= 0.0;
-                let d = dist - c;
+                let d = dist - c - lift;
                 if d < best.distance_mm {
                     let at = Point3::new(point.x, point.y, point.z);
                     *best = Clearance {
@@ -1814,9 +1833,9 @@ impl<'a> DesignClearance<'a> {
             if !crossed && self.may_be_inside(&(cl.tip + axis * f.h_mid)) {
                 let mid = cl.tip + axis * f.h_mid;
                 let (d, dp) = self.design_signed_distance(&mid);
-                if d < 0.0 && d - f.r_mid < best.distance_mm {
+                if d < 0.0 && d - f.r_mid - lift < best.distance_mm {
                     *best = Clearance {
-                        distance_mm: d - f.r_mid,
+                        distance_mm: d - f.r_mid - lift,
                         design_part: dp,
                         tool_part: f.part,
                         height_mm: f.h_mid,

@@ -29,6 +29,10 @@
 //!   flank pass's two-point tangency solution and the point-milling ball centre within the
 //!   chord tolerance of their curves).
 //!
+//! Shank and holder keep at least [`NON_CUTTING_CLEARANCE_MM`] from the design whatever the
+//! floors ([`DesignClearance::with_non_cutting_margin`]): a finishing floor lets the flutes
+//! reach the tolerance into the surface they finish, never the parts that do not cut.
+//!
 //! The answers are conservative like the query itself (a lower bound of the true clearance
 //! within the query's sampling tolerance).
 //!
@@ -51,6 +55,13 @@ pub const UPPER_CAP_MM: f64 = 4.0;
 /// Largest displacement (mm) of the lower part's highest point between two sampled postures
 /// of a motion.
 pub const MOTION_STEP_MM: f64 = 1.0;
+
+/// Least clearance (mm) of the shank and holder from the design in every pass check, below
+/// whatever floor the cutting part keeps: they do not cut, and a finishing floor (the
+/// machining tolerance into the finished surface) would let them rub the finished part.
+/// Twice the default mesh chord, so that a check of the finished part on its own
+/// tessellation does not read the clearance as contact.
+pub const NON_CUTTING_CLEARANCE_MM: f64 = 0.02;
 
 /// How near each design part a pass may bring the tool (mm; negative = into the design).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -201,13 +212,19 @@ impl<'a> PassCheck<'a> {
             hub_mm: floors.hub_mm - err,
             ..floors
         };
+        // Shank and holder keep NON_CUTTING_CLEARANCE_MM from the finished part whatever
+        // the floor lets the flutes do (module docs).
+        let lifted = |q: DesignClearance<'a>, floor: f64| {
+            q.with_non_cutting_margin(NON_CUTTING_CLEARANCE_MM - floor)
+        };
+        let (fb, fh) = (floors.blades_mm, floors.hub_mm);
         Self {
-            blades: with(PartSet::BLADES, lowest),
-            hub: with(hub, lowest),
-            motion_blades: with(PartSet::BLADES, lowest),
-            motion_hub: with(hub, lowest),
-            upper_blades: with(PartSet::BLADES, split_mm),
-            upper_hub: with(hub, split_mm),
+            blades: lifted(with(PartSet::BLADES, lowest), fb),
+            hub: lifted(with(hub, lowest), fh),
+            motion_blades: lifted(with(PartSet::BLADES, lowest), fb),
+            motion_hub: lifted(with(hub, lowest), fh),
+            upper_blades: lifted(with(PartSet::BLADES, split_mm), fb),
+            upper_hub: lifted(with(hub, split_mm), fh),
             floors,
             split_mm,
             fillets: None,

@@ -117,6 +117,34 @@ fn shank_lying_over_the_inlet_disc_is_clear_by_its_gap() {
 }
 
 #[test]
+fn a_non_cutting_margin_lowers_the_shank_and_not_the_flutes() {
+    // The shank over the inlet disc at gap 0.3 (as above): with a 0.25 mm margin it reads
+    // 0.05 (and a check at 0.1 fails), the flutes' own reading is untouched.
+    let t = tool(CutterShape::BallEnd { radius: 0.5 }, 2.0, 2.0, 14.0, &[]);
+    let q = query(&t);
+    let lifted = q.with_non_cutting_margin(0.25);
+    let cl = CutterLocation::new(Point3::new(-7.0, 0.0, top() + 0.3 + 2.0), Vector3::x()).unwrap();
+    let (a, b) = (q.clearance(&cl), lifted.clearance(&cl));
+    assert_eq!(b.tool_part, ToolPart::Shank, "{b:?}");
+    assert!(
+        (a.distance_mm - 0.25 - b.distance_mm).abs() < 1e-9,
+        "{a:?} {b:?}"
+    );
+    assert!(q.is_clear(&cl, 0.1) && !lifted.is_clear(&cl, 0.1));
+    // A vertical ball 0.2 mm over the disc: the flutes are nearest, the margin changes
+    // nothing (the shank is 2 mm higher, farther than the margin makes it read).
+    let down = CutterLocation::vertical(Point3::new(0.0, 0.0, top() + 0.2));
+    let (a, b) = (q.clearance(&down), lifted.clearance(&down));
+    assert_eq!(a.tool_part, ToolPart::Cutter, "{a:?}");
+    assert_eq!(a, b);
+    // A negative margin is none.
+    assert_eq!(
+        q.with_non_cutting_margin(-1.0).clearance(&cl),
+        q.clearance(&cl)
+    );
+}
+
+#[test]
 fn holder_lying_over_the_inlet_disc_is_clear_by_its_gap() {
     // Horizontal: a Ø7 holder over the inlet disc (x from −7 to 6, r < 7.8 mm) at gap g; the
     // Ø2 shank and the flutes are 2.5 mm higher, out beyond the blades' tips.
