@@ -1070,6 +1070,7 @@ pub fn post(
         post.reverse_motions_after += m.reverse_motions_after;
         post.reverse_motions_cutting_before += m.reverse_motions_cutting_before;
         post.reverse_motions_cutting_after += m.reverse_motions_cutting_after;
+        post.reverse_motions_cutting_near_pole += m.reversals.rotate.cutting_near_pole;
         post.reverse_motions_links_before += m.reverse_motions_links_before;
         post.reverse_motions_links_after += m.reverse_motions_links_after;
         post.max_linearisation_error_mm = post

@@ -58,6 +58,10 @@ pub struct PostReport {
     pub reverse_motions_cutting_before: usize,
     /// Of `reverse_motions_after`, the reversals inside a cut.
     pub reverse_motions_cutting_after: usize,
+    /// Of `reverse_motions_cutting_after`, the reversals of C within 1° of the pole, where the
+    /// tool axis no longer determines C ([`postproc_kinematics::rotary_motion`]).
+    #[serde(default)]
+    pub reverse_motions_cutting_near_pole: usize,
     /// Of `reverse_motions_before`, the reversals at path ends and links (harmless).
     pub reverse_motions_links_before: usize,
     /// Of `reverse_motions_after`, the reversals at path ends and links.
@@ -140,6 +144,9 @@ pub struct PostOperationReport {
     pub reverse_motions_cutting_tilt: usize,
     /// The same of C.
     pub reverse_motions_cutting_rotate: usize,
+    /// Of `reverse_motions_cutting_rotate`, those within 1° of the pole.
+    #[serde(default)]
+    pub reverse_motions_cutting_near_pole: usize,
     /// Smallest reversing step of the reversals inside cuts (deg; 0 without one).
     pub reversal_step_min_deg: f64,
     /// Largest reversing step of the reversals inside cuts (deg).
@@ -180,6 +187,7 @@ impl PostOperationReport {
             reverse_motions_links_after: m.reverse_motions_links_after,
             reverse_motions_cutting_tilt: m.reversals.tilt.cutting,
             reverse_motions_cutting_rotate: m.reversals.rotate.cutting,
+            reverse_motions_cutting_near_pole: m.reversals.rotate.cutting_near_pole,
             reversal_step_min_deg: m.reversals.cutting_steps().0.to_degrees(),
             reversal_step_max_deg: m.reversals.cutting_steps().1.to_degrees(),
             max_rotary_step_deg: m.rotary.max_step.to_degrees(),

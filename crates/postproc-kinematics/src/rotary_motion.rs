@@ -13,7 +13,12 @@
 //! (longer than [`TIP_STILL_MM`]) of those moves turn by more than [`PATH_CORNER_RAD`]. Otherwise it
 //! lies *at a path end or link*: a rapid, plunge or retract takes part, or the tip path turns
 //! a corner (the end of a zig-zag line and the feed step to the next line). The *step* of a
-//! reversal is `|Δ|` of its reversing step `k`.
+//! reversal is `|Δ|` of its reversing step `k`. A reversal of the rotate axis inside a cut
+//! lies *near the pole* when the tilt comes within [`POLE_TILT_RAD`] of 0 over the blocks
+//! `p..=k`: there the rotate axis is all but undetermined by the tool axis (a change `δ` of
+//! the axis turns it by up to `δ / sin(tilt)`, so a wiggle of the planned axis within its
+//! accuracy turns it by degrees), and where the path crosses the pole the rotate axis must
+//! swing whatever the plan.
 //!
 //! **Steps and accelerations.** Over consecutive non-rapid blocks `i − 1 → i` the time of a
 //! block is `Δtᵢ = 1 / F⁻¹ᵢ` with `F⁻¹ᵢ` its inverse-time feed (1/min), which is the tip path
@@ -42,6 +47,9 @@ pub const PATH_CORNER_RAD: f64 = std::f64::consts::FRAC_PI_4;
 /// Tip displacements shorter than this (mm) carry no direction of travel.
 pub const TIP_STILL_MM: f64 = 1e-6;
 
+/// Tilt (rad) within which a reversal of the rotate axis counts as near the pole: 1°.
+pub const POLE_TILT_RAD: f64 = 0.017_453_292_519_943_295;
+
 /// Shortest block time (s) used for the acceleration estimate: shorter blocks are merged
 /// with the next.
 pub const MIN_BLOCK_S: f64 = 1e-4;
@@ -57,6 +65,9 @@ pub struct AxisReversals {
     pub cutting_step_min: f64,
     /// Largest reversing step of the reversals inside a cut (rad).
     pub cutting_step_max: f64,
+    /// Of the reversals inside a cut, those of the rotate axis near the pole (module docs).
+    #[serde(default)]
+    pub cutting_near_pole: usize,
 }
 
 /// Reversals of both rotary axes.
@@ -138,6 +149,13 @@ pub fn axis_reversals(blocks: &[PostedBlock], axis: AxisId) -> AxisReversals {
                 let all_feed = blocks[p..=k].iter().all(|b| b.kind == MoveKind::Feed);
                 if all_feed && tip_keeps_direction(blocks, p, k) {
                     out.cutting += 1;
+                    if axis == AxisId::Rotate
+                        && blocks[p..=k]
+                            .iter()
+                            .any(|b| b.joints.tilt.abs() <= POLE_TILT_RAD)
+                    {
+                        out.cutting_near_pole += 1;
+                    }
                     out.cutting_step_min = out.cutting_step_min.min(d.abs());
                     out.cutting_step_max = out.cutting_step_max.max(d.abs());
                 } else {
@@ -283,6 +301,29 @@ mod tests {
             split.cutting() + split.links(),
             crate::reverse_motion::count_path_reverse_motions(&b)
         );
+    }
+
+    /// The same chatter with the tilt passing within 1° of the pole counts as near the pole;
+    /// 2° away it does not.
+    #[test]
+    fn chatter_at_the_pole_is_near_the_pole() {
+        let line = |tilt_mid: f64| {
+            let cs = [0.0, 0.02, 0.04, 0.03, 0.05, 0.07];
+            let tilts = [0.3, 0.2, tilt_mid, tilt_mid, 0.2, 0.3];
+            let mut b: Vec<PostedBlock> = cs
+                .iter()
+                .enumerate()
+                .map(|(i, c)| block(i as f64, 0.0, *c, MoveKind::Feed))
+                .collect();
+            for (blk, t) in b.iter_mut().zip(tilts) {
+                blk.joints.tilt = t;
+            }
+            axis_reversals(&b, AxisId::Rotate)
+        };
+        let near = line(0.5f64.to_radians());
+        assert_eq!((near.cutting, near.cutting_near_pole), (2, 2), "{near:?}");
+        let away = line(2f64.to_radians());
+        assert_eq!((away.cutting, away.cutting_near_pole), (2, 0), "{away:?}");
     }
 
     /// A retract between two cuts makes the reversal a link.
