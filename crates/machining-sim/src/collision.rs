@@ -341,6 +341,18 @@ mod tests {
     use crate::design::BoxDesign;
     use crate::synthetic::workload_cutter;
 
+    /// A 20 × 20 × 20 mm block design (x, y in ±10, z in 0..20), its collider and the
+    /// synthetic workload tool (Ø40 holder from 50 mm above the tip).
+    fn block_case() -> (BoxDesign, DesignCollider, ToolBody) {
+        let design = BoxDesign {
+            min: [-10.0, -10.0, 0.0],
+            max: [10.0, 10.0, 20.0],
+            sample_spacing: 2.0,
+        };
+        let collider = DesignCollider::new(&design.triangle_mesh()).unwrap();
+        (design, collider, ToolBody::new(&workload_cutter()))
+    }
+
     /// The polygons stand at most `RING_EXCESS_MM` outside their circles, from a needle to
     /// a Ø80 holder.
     #[test]
@@ -364,13 +376,7 @@ mod tests {
     /// polygon's corner stood 0.17 mm proud and read the clear one as a collision.
     #[test]
     fn a_holder_just_clear_of_a_wall_is_clear() {
-        let design = BoxDesign {
-            min: [-10.0, -10.0, 0.0],
-            max: [10.0, 10.0, 20.0],
-            sample_spacing: 2.0,
-        };
-        let collider = DesignCollider::new(&design.triangle_mesh()).unwrap();
-        let body = ToolBody::new(&workload_cutter());
+        let (design, collider, body) = block_case();
         let parts = PartShapes::new(&body, false);
         // Axis +Z, the holder (radius 20, 50–90 mm above the tip) beside the face x = 10.
         for (gap, hit) in [(0.02, false), (-0.01, true)] {
@@ -391,13 +397,7 @@ mod tests {
     /// along a sweep that approaches, enters (shank and holder) and leaves a block design.
     #[test]
     fn cached_check_equals_full_check() {
-        let design = BoxDesign {
-            min: [-10.0, -10.0, 0.0],
-            max: [10.0, 10.0, 20.0],
-            sample_spacing: 2.0,
-        };
-        let collider = DesignCollider::new(&design.triangle_mesh()).unwrap();
-        let body = ToolBody::new(&workload_cutter());
+        let (design, collider, body) = block_case();
         for rapid in [false, true] {
             let parts = PartShapes::new(&body, rapid);
             let mut cache = ClearanceCache::new();
