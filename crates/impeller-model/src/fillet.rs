@@ -448,13 +448,24 @@ impl Wedge {
     /// it. The quadrilateral keeps the bound tight beside a wall above the fillet (a ball
     /// riding a blade side well above the hub), where the sector, as wide as the corner is
     /// far, reaches into the wall up to `r_out` from the spine.
+    #[cfg(test)]
     fn distance(&self, p: &Vector3<f64>, inner: f64) -> f64 {
+        self.distance_below(p, inner, f64::INFINITY)
+    }
+
+    /// [`Self::distance`] where only values below `limit` matter: the sector's alone when it
+    /// already reaches `limit` (the quadrilateral could only raise it).
+    #[inline]
+    fn distance_below(&self, p: &Vector3<f64>, inner: f64, limit: f64) -> f64 {
         let w = p - self.s;
         let tau = w.dot(&self.n);
         let (x, y) = (w.dot(&self.a), w.dot(&self.e));
-        let d2 = self
-            .sector_distance_2d(x, y, inner)
-            .max(self.kite_distance_2d(x, y));
+        let ds = self.sector_distance_2d(x, y, inner);
+        let sector = (tau * tau + ds * ds).sqrt();
+        if sector >= limit {
+            return sector;
+        }
+        let d2 = ds.max(self.kite_distance_2d(x, y));
         (tau * tau + d2 * d2).sqrt()
     }
 
@@ -573,7 +584,8 @@ impl FilletPiece {
                     best,
                     |b, best| {
                         for k in &w.wedges[b.range.0..b.range.1] {
-                            *best = best.min(k.distance(p, inner) - k.delta);
+                            let d = k.distance_below(p, inner, *best + k.delta);
+                            *best = best.min(d - k.delta);
                         }
                     },
                 )
