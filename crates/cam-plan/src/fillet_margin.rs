@@ -166,6 +166,10 @@ impl FilletMargin {
         if f1 < floor {
             return Err(1.0);
         }
+        // Most motions settle as a whole (far from every fillet): no stack for them.
+        if 0.5 * (f0 + f1 - length(0.0, 1.0)) >= floor - tol {
+            return Ok(());
+        }
         let mut queries = 2;
         let mut stack = vec![(0.0, f0, 1.0, f1)];
         while let Some((s0, f0, s1, f1)) = stack.pop() {
