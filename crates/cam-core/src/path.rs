@@ -13,8 +13,23 @@ pub enum MoveKind {
     Plunge,
     /// Cutting move at the programmed feed.
     Feed,
+    /// A move at the programmed feed that joins two cutting runs without leaving the
+    /// material (the step of a zig-zag from one line to the next, a join of two pieces on a
+    /// roughing level): it may cut and runs like [`MoveKind::Feed`], but it belongs to no
+    /// cutting run, so a change of direction of the rotary axes across it lies at a link,
+    /// not inside a cut (`postproc_kinematics::rotary_motion`). G-code and CLDATA do not
+    /// carry the difference: a program read back has feed moves there.
+    Link,
     /// Exit from material along the tool axis.
     Retract,
+}
+
+impl MoveKind {
+    /// Whether the move runs at the cutting feed in the material: a cut ([`MoveKind::Feed`])
+    /// or a link between two cutting runs ([`MoveKind::Link`]).
+    pub fn at_cutting_feed(self) -> bool {
+        matches!(self, MoveKind::Feed | MoveKind::Link)
+    }
 }
 
 /// One move of a tool path: the target cutter location and how to get there from the
@@ -42,6 +57,15 @@ impl Move {
     pub fn feed(cl: CutterLocation) -> Self {
         Self {
             kind: MoveKind::Feed,
+            cl,
+            feed_mm_per_min: None,
+        }
+    }
+    /// A link at the default feed to `cl`, the first location of the next cutting run
+    /// ([`MoveKind::Link`]).
+    pub fn link(cl: CutterLocation) -> Self {
+        Self {
+            kind: MoveKind::Link,
             cl,
             feed_mm_per_min: None,
         }
@@ -128,7 +152,9 @@ impl ToolPath {
                 let rate = match kind {
                     MoveKind::Rapid => rates.rapid_mm_per_min,
                     MoveKind::Plunge => feed.unwrap_or(rates.plunge_mm_per_min),
-                    MoveKind::Feed | MoveKind::Retract => feed.unwrap_or(rates.feed_mm_per_min),
+                    MoveKind::Feed | MoveKind::Link | MoveKind::Retract => {
+                        feed.unwrap_or(rates.feed_mm_per_min)
+                    }
                 };
                 if rate > 0.0 {
                     60.0 * len / rate

@@ -678,7 +678,7 @@ impl Linker {
                 axis: first.cl.axis,
             }));
         }
-        if first.kind == MoveKind::Feed {
+        if matches!(first.kind, MoveKind::Feed | MoveKind::Link) {
             head.push(Move {
                 kind: MoveKind::Plunge,
                 cl: first.cl,

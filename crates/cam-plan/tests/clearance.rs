@@ -363,7 +363,7 @@ fn rotational_copy_of_a_whole_planned_operation_is_exact() {
         let cuts: Vec<&Move> = c
             .moves
             .iter()
-            .filter(|m| m.kind == cam_core::MoveKind::Feed)
+            .filter(|m| m.kind.at_cutting_feed())
             .collect();
         let at = joined
             .moves

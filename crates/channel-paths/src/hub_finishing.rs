@@ -585,7 +585,7 @@ impl Planner<'_> {
                     if (last.cl.tip - first.cl.tip).norm() <= near
                         && self.motion_clear(&prev, first)
                     {
-                        path.moves.push(Move::feed(first.cl));
+                        path.moves.push(Move::link(first.cl));
                         at_feed += 1;
                     } else {
                         path.moves

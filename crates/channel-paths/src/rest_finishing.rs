@@ -633,7 +633,7 @@ impl Planner<'_> {
                 None => path.moves.push(Move::feed(first.cl)),
                 Some(l) => {
                     if (l.centre - first.centre).norm() <= near && self.motion_clear(&l, first) {
-                        path.moves.push(Move::feed(first.cl));
+                        path.moves.push(Move::link(first.cl));
                         joined += 1;
                     } else {
                         path.moves

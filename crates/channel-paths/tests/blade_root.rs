@@ -194,7 +194,7 @@ fn blunt_trailing_edge_stops_the_path_at_the_edge_start() {
     let mut balls = 0;
     for path in planned.paths.iter().filter(|p| p.name.ends_with(" #0")) {
         for m in &path.moves {
-            if !matches!(m.kind, MoveKind::Feed | MoveKind::Plunge) {
+            if !matches!(m.kind, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge) {
                 continue;
             }
             balls += 1;

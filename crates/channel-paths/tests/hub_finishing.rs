@@ -41,7 +41,7 @@ fn impeller_8_8_hub_balls_sit_on_the_offset_hub_clear_of_the_blades() {
     let feeds = planned
         .paths
         .iter()
-        .map(|p| p.moves.iter().filter(|m| m.kind == MoveKind::Feed).count())
+        .map(|p| p.moves.iter().filter(|m| m.kind.at_cutting_feed()).count())
         .sum::<usize>();
     assert!(feeds > 8 * 20, "{feeds} feed moves");
     let r = 1.0;
@@ -94,7 +94,7 @@ fn hub_axes_stay_within_the_machines_reach() {
         p.paths
             .iter()
             .flat_map(|path| path.moves.iter())
-            .filter(|m| m.kind == MoveKind::Feed)
+            .filter(|m| m.kind.at_cutting_feed())
             .map(|m| m.cl.axis.z.clamp(-1.0, 1.0).acos())
             .collect()
     };
@@ -211,7 +211,7 @@ fn impeller_8_8_hub_is_finished_within_its_scallop_target() {
         let mut prev: Option<nalgebra::Vector3<f64>> = None;
         for m in &path.moves {
             let c = m.cl.tip.coords + m.cl.axis.into_inner() * r;
-            if m.kind == MoveKind::Feed {
+            if m.kind.at_cutting_feed() {
                 if let Some(a) = prev {
                     let k = ((c - a).norm() / 0.05).ceil().max(1.0) as usize;
                     for i in 1..=k {

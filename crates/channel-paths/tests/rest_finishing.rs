@@ -42,7 +42,7 @@ fn centres(planned: &cam_plan::PlannedOperation, r: f64) -> Vec<Vector3<f64>> {
         .paths
         .iter()
         .flat_map(|p| p.moves.iter())
-        .filter(|m| m.kind == cam_core::MoveKind::Feed)
+        .filter(|m| m.kind.at_cutting_feed())
         .map(|m| m.cl.tip.coords + m.cl.axis.into_inner() * r)
         .collect()
 }

@@ -2,7 +2,7 @@
 //! Channel roughing on the default impeller (impeller-8+8, splitters: paper 003's three
 //! areas), planned through the `Operation` trait with a hand-built context.
 
-use cam_core::{Cutter, CutterShape, HolderSegment, MoveKind, Tolerances};
+use cam_core::{Cutter, CutterShape, HolderSegment, Tolerances};
 use cam_plan::{
     ClearanceOptions, DesignClearance, Linker, OperationSpec, PartSet, PlanContext, Process,
     SafetySurface, Tool,
@@ -204,7 +204,7 @@ fn rough_tapered_ball_trimmed_to_where_the_cutter_fits() {
     let allowance_min = proc_.blade_allowance_mm - 0.5 * tol.machining_tol;
     let mut feeds = 0;
     for mv in &plan.paths[0].moves {
-        if mv.kind != MoveKind::Feed {
+        if !mv.kind.at_cutting_feed() {
             continue;
         }
         feeds += 1;

@@ -637,7 +637,7 @@ pub fn plan_rows(
                     };
                     if clear {
                         direct += 1;
-                        path.moves.push(cam_core::Move::feed(*first));
+                        path.moves.push(cam_core::Move::link(*first));
                     } else {
                         linked += 1;
                         let link = ctx

@@ -8,7 +8,7 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use cam_core::{Cutter, CutterLocation, CutterShape, HolderSegment, MoveKind, Tolerances};
+use cam_core::{Cutter, CutterLocation, CutterShape, HolderSegment, Tolerances};
 use cam_plan::{
     ClearanceOptions, DesignClearance, LinkStats, Linker, OperationSpec, PassCheck, PlanContext,
     Point3, Process, Row, SafetySurface, Tool,
@@ -175,7 +175,7 @@ fn splitter_rows_are_planned() {
         .paths
         .iter()
         .flat_map(|path| path.moves.iter())
-        .filter(|m| m.kind == MoveKind::Feed)
+        .filter(|m| m.kind.at_cutting_feed())
         .map(|m| &m.cl)
         .collect();
     let touching = feed

@@ -95,7 +95,8 @@ type Block = (Joints, Point3, Option<f64>, Part);
 
 fn part(kind: MoveKind) -> Part {
     match kind {
-        MoveKind::Feed | MoveKind::Plunge => Part::Cutting,
+        // A link at feed runs in the material at the cutting feed, as the cut it joins.
+        MoveKind::Feed | MoveKind::Link | MoveKind::Plunge => Part::Cutting,
         MoveKind::Retract => Part::Link,
         MoveKind::Rapid => Part::Rapid,
     }

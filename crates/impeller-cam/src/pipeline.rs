@@ -796,14 +796,14 @@ fn tool_of_cutter(cutter: Cutter, number: Option<u32>) -> Tool {
 }
 
 /// Programs the process row's rates on every non-rapid move that has no feed of its own:
-/// cutting and retract moves at the cutting feed, plunges at the plunge feed.
+/// cutting moves, links at feed and retracts at the cutting feed, plunges at the plunge feed.
 fn set_feeds(path: &mut ToolPath, rates: &Rates) {
     for m in &mut path.moves {
         if m.feed_mm_per_min.is_none() {
             m.feed_mm_per_min = match m.kind {
                 MoveKind::Rapid => None,
                 MoveKind::Plunge => Some(rates.plunge_mm_per_min),
-                MoveKind::Feed | MoveKind::Retract => Some(rates.feed_mm_per_min),
+                MoveKind::Feed | MoveKind::Link | MoveKind::Retract => Some(rates.feed_mm_per_min),
             };
         }
     }
@@ -1089,7 +1089,11 @@ pub fn post(
         post.blocks += m.blocks;
     }
     for p in &assembled.operations {
-        post.operations.push(PostOperationReport::of(p));
+        let mut r = PostOperationReport::of(p);
+        let planned = report.operations.iter().find(|o| o.name == p.name);
+        r.account_with(planned.map(|o| &o.metrics));
+        post.reverse_motions_cutting_unaccounted += r.reverse_motions_cutting_unaccounted;
+        post.operations.push(r);
         report.add_displacement_plots(p);
     }
     post.program = program_path.display().to_string();

@@ -62,6 +62,11 @@ pub struct PostReport {
     /// tool axis no longer determines C ([`postproc_kinematics::rotary_motion`]).
     #[serde(default)]
     pub reverse_motions_cutting_near_pole: usize,
+    /// Summed over the operations: the reversals inside cuts that neither lie at the pole nor
+    /// are covered by the count of direction changes the operation's planner kept with a
+    /// reason ([`PostOperationReport::reverse_motions_cutting_unaccounted`]).
+    #[serde(default)]
+    pub reverse_motions_cutting_unaccounted: usize,
     /// Of `reverse_motions_before`, the reversals at path ends and links (harmless).
     pub reverse_motions_links_before: usize,
     /// Of `reverse_motions_after`, the reversals at path ends and links.
@@ -147,6 +152,20 @@ pub struct PostOperationReport {
     /// Of `reverse_motions_cutting_rotate`, those within 1° of the pole.
     #[serde(default)]
     pub reverse_motions_cutting_near_pole: usize,
+    /// The direction changes of the tool-axis angles that the operation's planner left inside
+    /// its cutting runs, each with a reason (the operation's `axis_reversals_after`, split by
+    /// reason in its `axis_reversals_kept_*`; `null` when the planner does not smooth its
+    /// axes, as for imported CL data).
+    pub reverse_motions_kept_by_planner: Option<usize>,
+    /// The reversals inside cuts that the post finds beyond those near the pole and those the
+    /// planner kept: `max(0, cutting_after − near_pole − kept_by_planner)` (all of the ones
+    /// away from the pole when the planner keeps no count). On a table-table or head-table
+    /// machine whose C turns about the impeller axis the machine's tilt and C follow the
+    /// planner's polar angle and azimuth, so each reversal the post counts is one of the
+    /// planner's or lies at the pole (where C is not determined by the tool axis); a positive
+    /// figure is a reversal nothing explains (a join the planner did not mark as a link, a
+    /// post that changed the motion, another kinematic chain).
+    pub reverse_motions_cutting_unaccounted: usize,
     /// Smallest reversing step of the reversals inside cuts (deg; 0 without one).
     pub reversal_step_min_deg: f64,
     /// Largest reversing step of the reversals inside cuts (deg).
@@ -168,6 +187,20 @@ pub struct PostOperationReport {
 }
 
 impl PostOperationReport {
+    /// Sets [`Self::reverse_motions_kept_by_planner`] from the planned operation's metrics
+    /// (`axis_reversals_after`) and the unaccounted reversals from it.
+    pub fn account_with(&mut self, planned: Option<&cam_plan::Metrics>) {
+        self.reverse_motions_kept_by_planner = planned
+            .and_then(|m| m.get("axis_reversals_after"))
+            .and_then(|v| v.as_f64())
+            .map(|v| v as usize);
+        let away = self
+            .reverse_motions_cutting_after
+            .saturating_sub(self.reverse_motions_cutting_near_pole);
+        self.reverse_motions_cutting_unaccounted =
+            away.saturating_sub(self.reverse_motions_kept_by_planner.unwrap_or(0));
+    }
+
     /// The figures of one posted operation.
     pub fn of(p: &gcode_emit::assemble::PostedOperation) -> Self {
         let m = &p.metrics;

@@ -175,6 +175,7 @@ pub fn collision_text(c: &machining_sim::Collision) -> String {
     let what = match c.move_kind {
         cam_core::MoveKind::Rapid => "a rapid",
         cam_core::MoveKind::Feed => "a cutting move",
+        cam_core::MoveKind::Link => "a link at feed",
         cam_core::MoveKind::Plunge => "a plunge",
         cam_core::MoveKind::Retract => "a retract",
     };

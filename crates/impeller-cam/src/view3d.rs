@@ -459,7 +459,8 @@ fn kind_code(k: MoveKind) -> u8 {
     match k {
         MoveKind::Rapid => 0,
         MoveKind::Plunge => 1,
-        MoveKind::Feed => 2,
+        // A link at feed is drawn with the cut it joins (the view colours by rate).
+        MoveKind::Feed | MoveKind::Link => 2,
         MoveKind::Retract => 3,
     }
 }

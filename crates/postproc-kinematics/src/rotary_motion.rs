@@ -8,11 +8,14 @@
 //! [`REVERSE_DEAD_BAND_RAD`]) are followed over the whole block list; a reversal is a step `k`
 //! whose sign differs from that of the previous non-negligible step `p`
 //! ([`crate::reverse_motion::count_reverse_motions`] counts the same places per cutting run).
-//! It lies *inside a cut* when the moves into every block from `p` to `k` are feed moves and
-//! the tool tip keeps its direction of travel over them: no two consecutive tip displacements
-//! (longer than [`TIP_STILL_MM`]) of those moves turn by more than [`PATH_CORNER_RAD`]. Otherwise it
-//! lies *at a path end or link*: a rapid, plunge or retract takes part, or the tip path turns
-//! a corner (the end of a zig-zag line and the feed step to the next line). The *step* of a
+//! It lies *inside a cut* when the moves into every block from `p` to `k` are feed moves
+//! ([`MoveKind::Feed`]) and the tool tip keeps its direction of travel over them: no two
+//! consecutive tip displacements (longer than [`TIP_STILL_MM`]) of those moves turn by more
+//! than [`PATH_CORNER_RAD`]. Otherwise it lies *at a path end or link*: a rapid, plunge,
+//! retract or link at feed ([`MoveKind::Link`], which the planner puts between two cutting
+//! runs it joins without leaving the material) takes part, or the tip path turns a corner
+//! (the end of a zig-zag line and the feed step to the next line, in a path whose planner
+//! did not mark its links, such as imported CL data). The *step* of a
 //! reversal is `|Δ|` of its reversing step `k`. A reversal of the rotate axis inside a cut
 //! lies *near the pole* when the tilt comes within [`POLE_TILT_RAD`] of 0 over the blocks
 //! `p..=k`: there the rotate axis is all but undetermined by the tool axis (a change `δ` of
@@ -324,6 +327,25 @@ mod tests {
         assert_eq!((near.cutting, near.cutting_near_pole), (2, 2), "{near:?}");
         let away = line(2f64.to_radians());
         assert_eq!((away.cutting, away.cutting_near_pole), (2, 0), "{away:?}");
+    }
+
+    /// A link at feed between two cutting runs makes a reversal across it a link, even where
+    /// the tip keeps its direction (two pieces of a roughing level joined end to end); the same
+    /// moves as plain feed moves make it a reversal inside a cut.
+    #[test]
+    fn reversal_across_a_link_at_feed_is_a_link() {
+        let path = |join: MoveKind| {
+            vec![
+                block(0.0, 0.0, 0.0, MoveKind::Feed),
+                block(1.0, 0.0, 0.1, MoveKind::Feed),
+                block(2.0, 0.0, 0.05, join),
+                block(3.0, 0.0, 0.0, MoveKind::Feed),
+            ]
+        };
+        let r = axis_reversals(&path(MoveKind::Link), AxisId::Rotate);
+        assert_eq!((r.cutting, r.links), (0, 1), "{r:?}");
+        let r = axis_reversals(&path(MoveKind::Feed), AxisId::Rotate);
+        assert_eq!((r.cutting, r.links), (1, 0), "{r:?}");
     }
 
     /// A retract between two cuts makes the reversal a link.

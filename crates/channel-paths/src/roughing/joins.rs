@@ -44,16 +44,35 @@ pub(super) struct Chunk {
 }
 
 impl Chunk {
-    /// Whether the chunk may be cut backwards: only cutting moves (a lifted one-way link is
-    /// not reversed).
+    /// Whether the chunk may be cut backwards: only cutting moves and links at feed (a lifted
+    /// one-way link is not reversed).
     fn reversible(&self) -> bool {
-        self.moves.iter().all(|m| m.kind == MoveKind::Feed)
+        self.moves
+            .iter()
+            .all(|m| matches!(m.kind, MoveKind::Feed | MoveKind::Link))
     }
 
-    /// The chunk cut backwards (same locations, same certified motions, reverse order).
+    /// The chunk cut backwards (same locations, same certified motions, reverse order): the
+    /// motion into a location of the reversed chunk is the one that left it, so it keeps that
+    /// move's kind (a link stays a link).
     fn reversed(&self) -> Self {
+        let n = self.moves.len();
+        let moves = (0..n)
+            .rev()
+            .map(|i| {
+                let kind = match self.moves.get(i + 1) {
+                    Some(next) if next.kind == MoveKind::Link => MoveKind::Link,
+                    _ => MoveKind::Feed,
+                };
+                Move {
+                    kind,
+                    cl: self.moves[i].cl,
+                    feed_mm_per_min: None,
+                }
+            })
+            .collect();
         Self {
-            moves: self.moves.iter().rev().map(|m| Move::feed(m.cl)).collect(),
+            moves,
             first_q: self.last_q,
             last_q: self.first_q,
         }

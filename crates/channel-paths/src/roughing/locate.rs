@@ -687,7 +687,7 @@ impl ChannelRoughing {
                                 &l[1..l.len() - 1],
                                 &mut out,
                             )?
-                            .map(|ps| ps.into_iter().map(|p| Move::feed(p.0)).collect::<Vec<_>>()),
+                            .map(|ps| ps.into_iter().map(|p| Move::link(p.0)).collect::<Vec<_>>()),
                         (Some(l), Linking::OneWay, Some(c)) => {
                             loc.one_way_link(&axes, l, &c.last.1 .0, &first_p.0)?
                         }
@@ -719,7 +719,13 @@ impl ChannelRoughing {
                     // A one-way link ends with the plunge onto the run's first point.
                     let dup = i == 0 && c.moves.last().is_some_and(|m| m.cl == *cl);
                     if !dup {
-                        c.moves.push(Move::feed(*cl));
+                        // The move onto the first point of a run that continues the chunk
+                        // ends the zig-zag link into it.
+                        c.moves.push(if i == 0 && !c.moves.is_empty() {
+                            Move::link(*cl)
+                        } else {
+                            Move::feed(*cl)
+                        });
                     }
                 }
                 if let (Some(&q), Some(&p)) = (run.q.last(), run.postures.last()) {
@@ -790,8 +796,15 @@ impl ChannelRoughing {
                     tips.push(c.first.1 .0.tip.coords);
                     out.level_link_len += polyline_len(tips.into_iter());
                     out.level_links += 1;
-                    prev.moves.extend(ps.into_iter().map(|p| Move::feed(p.0)));
-                    prev.moves.extend(c.moves);
+                    prev.moves.extend(ps.into_iter().map(|p| Move::link(p.0)));
+                    let mut moves = c.moves;
+                    // The move onto the joined chunk's first point ends the join.
+                    if let Some(m) = moves.first_mut() {
+                        if m.kind == MoveKind::Feed {
+                            m.kind = MoveKind::Link;
+                        }
+                    }
+                    prev.moves.extend(moves);
                     prev.last = c.last;
                 }
                 None => joined.push(c),
