@@ -242,6 +242,36 @@ fn rough_tapered_ball_trimmed_to_where_the_cutter_fits() {
     .map(|r| get(&format!("axis_reversals_kept_{r}")))
     .sum();
     assert_eq!(kept, after);
+    // The written paths, cut into cutting runs wherever a move is not a cut (a link at feed
+    // between two located runs, a plunge, retract or rapid), change the direction of their
+    // axis angles exactly as often as the planner reports: every link it joins runs with is
+    // marked as one (cam_core::MoveKind::Link), so the post counts a reversal across it as
+    // at a link, and what it counts inside cuts is the planner's kept reversals.
+    let mut written = 0;
+    for path in &plan.paths {
+        let mut run: Vec<cam_core::CutterLocation> = Vec::new();
+        let mut flush = |run: &mut Vec<cam_core::CutterLocation>| {
+            let angles = cam_plan::axis_smoothing::spherical_angles(run);
+            for pick in [|a: &(f64, f64)| a.0, |a: &(f64, f64)| a.1] {
+                let x: Vec<f64> = angles.iter().map(pick).collect();
+                written += cam_plan::axis_smoothing::reversal_indices(&x).len();
+            }
+            run.clear();
+        };
+        for m in &path.moves {
+            match m.kind {
+                cam_core::MoveKind::Feed => run.push(m.cl),
+                cam_core::MoveKind::Link | cam_core::MoveKind::Plunge => {
+                    flush(&mut run);
+                    run.push(m.cl);
+                }
+                cam_core::MoveKind::Rapid | cam_core::MoveKind::Retract => flush(&mut run),
+            }
+        }
+        flush(&mut run);
+    }
+    assert!(get("in_lane_links") > 0.0);
+    assert_eq!(written as f64, after);
     assert!(get("axis_smoothing_runs_smoothed") >= 1.0);
     assert!(get("axis_smoothing_max_centre_shift_mm") <= 1e-6);
     assert!(get("saving_ratio") > 0.0);
