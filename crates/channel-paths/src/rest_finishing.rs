@@ -58,8 +58,16 @@
 //! included) the margin along the motion (centre linear, axis turned at constant rate) is a
 //! Lipschitz function with constant `|Δc| + |h − r|·Δθ`, bisected until each interval's lower
 //! bound `(f₀ + f₁)/2 − L·Δs/2` clears the floor (at most 2¹⁴ pieces). A motion that fails
-//! splits the pass; passes are joined at feed where that motion certifies, else linked over
-//! the safety surface ([`cam_plan::PlanContext::link`]).
+//! splits the pass; passes are joined at feed where that motion certifies (a link at feed,
+//! [`cam_core::MoveKind::Link`]), else linked over the safety surface
+//! ([`cam_plan::PlanContext::link`]).
+//!
+//! Once a region's runs are placed, their axes are smoothed about the ball centres by the
+//! shared step [`cam_plan::axis_smoothing`] (issue 37: the ring search picks neighbouring
+//! axes that alternate, and the rotary axes would chatter inside the cut): a turned posture
+//! keeps the floors above, and the motions touching it certify, or the planned posture
+//! stays (`axis_reversals_*` and `axis_smoothing_*` metrics; a plot of the run with the most
+//! direction changes).
 //!
 //! # Measured
 //! `residual_before_max_mm`, `target_area_mm2`: from the stock read. `residual_after_max_mm`:
@@ -269,6 +277,8 @@ struct RegionResult {
     fillet_blocked: usize,
     split: usize,
     max_overcut: f64,
+    /// The axis smoothing of the runs ([`cam_plan::axis_smoothing`]).
+    smoothing: cam_plan::SmoothingSummary,
 }
 
 impl Planner<'_> {
@@ -612,7 +622,26 @@ impl Planner<'_> {
             pass_done(k + 1, n_across);
         }
         res.max_overcut = res.max_overcut.max(0.0);
+        self.smooth_axes(&mut res);
         res
+    }
+
+    /// The shared axis smoothing ([`cam_plan::axis_smoothing`]) of every run: each posture
+    /// turns about its ball centre (the ball, so every contact and the residual it leaves,
+    /// stays where it was placed), a turned posture is kept only when the machine reaches its
+    /// axis and the tool keeps this planner's floors ([`Self::posture_margin`]), and every
+    /// motion touching one is certified as the planned ones are ([`Self::motion_clear`]).
+    fn smooth_axes(&self, res: &mut RegionResult) {
+        let opts = cam_plan::AxisSmoothing::ball_end(self.r);
+        for run in &mut res.runs {
+            let cls: Vec<CutterLocation> = run.iter().map(|s| s.cl).collect();
+            let out = cam_plan::axis_smoothing::smooth_run(&cls, &opts, self);
+            res.smoothing.add(&out);
+            for (s, cl) in run.iter_mut().zip(out.postures) {
+                s.axis = cl.axis.into_inner();
+                s.cl = cl;
+            }
+        }
     }
 
     /// The runs of one region as a closed path: consecutive runs joined at feed where the
@@ -750,6 +779,32 @@ fn bilinear(g: &RestGrid, fi: f64, fj: f64) -> Option<Vector3<f64>> {
     }
     // The present samples carry no weight here (a corner of the cell): the nearest of them.
     corners.iter().filter_map(|(q, _)| *q).next()
+}
+
+impl cam_plan::PostureCheck for Planner<'_> {
+    type Clear = ();
+    fn posture_clear(&self, _: usize, cl: &CutterLocation) -> Option<()> {
+        let axis = cl.axis.into_inner();
+        let c = cl.tip.coords + axis * self.r;
+        (self.ctx.reaches(&axis) && self.posture_margin(&c, &axis) >= 0.0).then_some(())
+    }
+    fn planned_clear(&self, _: usize, _: &CutterLocation) -> Option<()> {
+        // Planned postures passed the same check when they were chosen.
+        Some(())
+    }
+    fn motion_clear(
+        &self,
+        _: usize,
+        (a, _): (&CutterLocation, &()),
+        (b, _): (&CutterLocation, &()),
+    ) -> bool {
+        let station = |cl: &CutterLocation| Station {
+            centre: cl.tip.coords + cl.axis.into_inner() * self.r,
+            axis: cl.axis.into_inner(),
+            cl: *cl,
+        };
+        self.motion_clear(&station(a), &station(b))
+    }
 }
 
 impl Operation for RestFinishing {
@@ -914,6 +969,7 @@ impl Operation for RestFinishing {
             sum.fillet_blocked += res.fillet_blocked;
             sum.split += res.split;
             sum.max_overcut = sum.max_overcut.max(res.max_overcut);
+            sum.smoothing.merge(&res.smoothing);
         }
         let stations = centres.len();
         let mut metrics = Metrics::new();
@@ -936,6 +992,7 @@ impl Operation for RestFinishing {
             .count("split_motions", sum.split)
             .number("step_over_mm", step)
             .number("max_overcut_mm", sum.max_overcut);
+        sum.smoothing.add_metrics(&mut metrics);
         let mut notes = vec![format!(
             "{} regions above {threshold} mm after {} ({target_points} samples, {area:.2} mm²; largest residual {before_max:.3} mm): {} passes, {stations} ball stations, {joined} pass-to-pass steps at feed; largest residual left at the stations {after_max:.3} mm",
             regions.len(),
@@ -955,12 +1012,15 @@ impl Operation for RestFinishing {
                 sum.skipped, self.params.max_tilt_deg, sum.unsettled, sum.fillet_blocked, sum.split
             ));
         }
+        if sum.smoothing.runs > 0 {
+            notes.push(sum.smoothing.note());
+        }
         if regions.is_empty() {
             notes.push(format!(
                 "nothing above {threshold} mm is left: no rest to machine"
             ));
         }
-        let plots = vec![Plot {
+        let mut plots = vec![Plot {
             title: "Rest finishing, meridional view: targets, what is left, ball centres".into(),
             kind: PlotKind::Lines {
                 x_label: "radius (mm)".into(),
@@ -992,6 +1052,7 @@ impl Operation for RestFinishing {
                 equal_aspect: true,
             },
         }];
+        plots.extend(sum.smoothing.plot());
         Ok(PlannedOperation {
             paths,
             metrics,

@@ -17,8 +17,8 @@
 //! (the end of a zig-zag line and the feed step to the next line, in a path whose planner
 //! did not mark its links, such as imported CL data). The *step* of a
 //! reversal is `|Δ|` of its reversing step `k`. A reversal of the rotate axis inside a cut
-//! lies *near the pole* when the tilt comes within [`POLE_TILT_RAD`] of 0 over the blocks
-//! `p..=k`: there the rotate axis is all but undetermined by the tool axis (a change `δ` of
+//! lies *near the pole* when the tool axis comes within [`POLE_TILT_RAD`] of the rotate
+//! axis (the workpiece's ±Z) over the blocks `p..=k`: there the rotate axis is all but undetermined by the tool axis (a change `δ` of
 //! the axis turns it by up to `δ / sin(tilt)`, so a wiggle of the planned axis within its
 //! accuracy turns it by degrees), and where the path crosses the pole the rotate axis must
 //! swing whatever the plan.
@@ -128,6 +128,15 @@ fn tip_keeps_direction(blocks: &[PostedBlock], from: usize, to: usize) -> bool {
     true
 }
 
+/// Whether the block's tool axis lies within [`POLE_TILT_RAD`] of the rotate axis (module
+/// docs). Every kinematic chain of [`crate::Machine`] turns C about the workpiece frame's Z
+/// (a table C under the part, or a head C about the machine's Z), so that is the workpiece
+/// axis ±Z, whatever tilt angle reaches it (0 on a table-table machine, ±90° on a
+/// horizontal-spindle turn-mill head).
+fn near_pole(b: &PostedBlock) -> bool {
+    b.cl.axis.z.abs() >= POLE_TILT_RAD.cos()
+}
+
 /// The reversals of one axis over a block list (module docs).
 pub fn axis_reversals(blocks: &[PostedBlock], axis: AxisId) -> AxisReversals {
     let mut out = AxisReversals {
@@ -152,11 +161,7 @@ pub fn axis_reversals(blocks: &[PostedBlock], axis: AxisId) -> AxisReversals {
                 let all_feed = blocks[p..=k].iter().all(|b| b.kind == MoveKind::Feed);
                 if all_feed && tip_keeps_direction(blocks, p, k) {
                     out.cutting += 1;
-                    if axis == AxisId::Rotate
-                        && blocks[p..=k]
-                            .iter()
-                            .any(|b| b.joints.tilt.abs() <= POLE_TILT_RAD)
-                    {
+                    if axis == AxisId::Rotate && blocks[p..=k].iter().any(near_pole) {
                         out.cutting_near_pole += 1;
                     }
                     out.cutting_step_min = out.cutting_step_min.min(d.abs());
@@ -256,6 +261,11 @@ mod tests {
     use crate::joints::Joints;
     use cam_core::{CutterLocation, Point3, Vector3};
 
+    /// The tool axis of a table-table machine at tilt `t`, C `c`: `t` from +Z.
+    fn axis_at(t: f64, c: f64) -> Vector3 {
+        Vector3::new(t.sin() * c.cos(), t.sin() * c.sin(), t.cos())
+    }
+
     fn block(x: f64, y: f64, c: f64, kind: MoveKind) -> PostedBlock {
         PostedBlock {
             joints: Joints {
@@ -265,7 +275,7 @@ mod tests {
                 tilt: 0.3,
                 rotate: c,
             },
-            cl: CutterLocation::new(Point3::new(x, y, 0.0), Vector3::z()).unwrap(),
+            cl: CutterLocation::new(Point3::new(x, y, 0.0), axis_at(0.3, c)).unwrap(),
             kind,
             feed_mm_per_min: Some(600.0),
             inverse_time_feed: Some(600.0),
@@ -320,12 +330,43 @@ mod tests {
                 .collect();
             for (blk, t) in b.iter_mut().zip(tilts) {
                 blk.joints.tilt = t;
+                blk.cl = CutterLocation::new(blk.cl.tip, axis_at(t, blk.joints.rotate)).unwrap();
             }
             axis_reversals(&b, AxisId::Rotate)
         };
         let near = line(0.5f64.to_radians());
         assert_eq!((near.cutting, near.cutting_near_pole), (2, 2), "{near:?}");
         let away = line(2f64.to_radians());
+        assert_eq!((away.cutting, away.cutting_near_pole), (2, 0), "{away:?}");
+    }
+
+    /// On a horizontal-spindle turn-mill head the pole lies at a tilt of 90°: the tool axis
+    /// along the workpiece's Z decides, not the tilt angle.
+    #[test]
+    fn the_pole_is_where_the_tool_axis_meets_the_rotate_axis() {
+        let cs = [0.0, 0.02, 0.04, 0.03, 0.05, 0.07];
+        let line = |off_pole_deg: f64| {
+            let b: Vec<PostedBlock> = cs
+                .iter()
+                .enumerate()
+                .map(|(i, c)| {
+                    let mut blk = block(i as f64, 0.0, *c, MoveKind::Feed);
+                    let t = if (2..4).contains(&i) {
+                        off_pole_deg.to_radians()
+                    } else {
+                        0.3
+                    };
+                    // u = Rz(−C)·Ry(B)·x̂ with B = 90° − t: the axis t from +Z.
+                    blk.joints.tilt = std::f64::consts::FRAC_PI_2 - t;
+                    blk.cl = CutterLocation::new(blk.cl.tip, axis_at(t, -c)).unwrap();
+                    blk
+                })
+                .collect();
+            axis_reversals(&b, AxisId::Rotate)
+        };
+        let near = line(0.5);
+        assert_eq!((near.cutting, near.cutting_near_pole), (2, 2), "{near:?}");
+        let away = line(2.0);
         assert_eq!((away.cutting, away.cutting_near_pole), (2, 0), "{away:?}");
     }
 
