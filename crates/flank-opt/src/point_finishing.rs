@@ -180,11 +180,14 @@ impl BladePointFinishing {
             passes_along: p.passes_along,
             // Finishing: a flank region must leave no more than the flank tolerance.
             flank_residual_mm: Some(p.flank_tol_mm.unwrap_or(tol)),
-            // The flank regions of this operation keep their planned axes (their smoothing
-            // was measured on semi-finishing only); the point-milling runs are smoothed
-            // (`PointSettings::smooth_axes`). The 0.062 mm tip reading once blamed on that was
-            // the verifier's depth at a tip edge (machining-sim, fixed).
-            smooth_flank_axes: false,
+            // Issue 37: the flank regions' axes are smoothed within the flank tolerance's
+            // slack, their residual kept within the flank tolerance
+            // (`regions::smooth_flank_region`), as the point-milling runs are
+            // (`PointSettings::smooth_axes`). Before, they kept their planned axes and their
+            // direction changes went uncounted: on impeller-5-freeform the post found 40
+            // reversals inside cuts beyond the operation's reported 280 (3 + 3 + 2 per blade,
+            // its three flank strips).
+            smooth_flank_axes: true,
             point: PointSettings {
                 ball_radius: ball_radius(&shape),
                 half_angle,

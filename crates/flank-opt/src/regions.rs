@@ -370,7 +370,8 @@ pub struct SmoothedFlank {
 /// `check`, the smoothed pass's envelope ([`crate::semi::pass_envelope`]) measured again over
 /// the strip ([`measure_flank`]) and accepted only when its overcut does not grow (the
 /// allowance left to finishing is not eaten further; [`NO_WORSE_MM`] for rounding) and its
-/// residual grows by at most the slack. Otherwise the planned pass stays and every
+/// residual grows by at most the slack, and stays within the operation's residual limit
+/// where it has one (finishing: `flank_residual_mm`). Otherwise the planned pass stays and every
 /// direction change of its axis is reported with [`cam_plan::KeptReason::Accuracy`]. Cost: up to two
 /// smoothings and two envelope measurements.
 pub fn smooth_flank_region(
@@ -393,7 +394,11 @@ pub fn smooth_flank_region(
             pass.upper_mm,
         )?;
         let (o2, r2) = measure_flank(blade, side, strip, &env, st.point.allowance_mm)?;
-        Ok((o2 <= over + NO_WORSE_MM && r2 <= residual + slack).then_some((o2, r2)))
+        let r_max = match st.flank_residual_mm {
+            Some(limit) => (residual + slack).min(limit.max(residual)),
+            None => residual + slack,
+        };
+        Ok((o2 <= over + NO_WORSE_MM && r2 <= r_max).then_some((o2, r2)))
     })?;
     Ok(match accepted {
         Some((run, (over, residual))) => SmoothedFlank {
