@@ -680,6 +680,53 @@ impl Report {
         write(&dir.join("report.html"), self.html().as_bytes())
     }
 
+    /// The table of rotary reversals inside cuts per operation, with what explains them: the
+    /// pole, and the direction changes the operation's planner kept, by reason.
+    fn reversal_table(&self, h: &mut String) {
+        h.push_str(
+            "<h3>Rotary reversals inside cuts</h3><p>Counted on the posted blocks (both rotary \
+             axes); a reversal across a link, plunge, retract or rapid is at a path end or \
+             link. Each one inside a cut lies at the pole (the tool axis within 1° of C, which \
+             it no longer determines) or is one the operation's planner kept, by reason; \
+             <em>unaccounted</em> counts the rest.</p><table><tr><th>operation</th>\
+             <th>inside cuts</th><th>at path ends and links</th><th>at the pole</th>\
+             <th>planner kept: clearance</th><th>angle limit</th><th>near pole</th><th>fit budget</th>\
+             <th>accuracy</th><th>unaccounted</th><th>steps (deg)</th></tr>",
+        );
+        for o in &self.post.operations {
+            let planned = self.operations.iter().find(|p| p.name == o.name);
+            let kept = |reason: &str| -> String {
+                planned
+                    .and_then(|p| p.metrics.get(&format!("axis_reversals_kept_{reason}")))
+                    .and_then(|v| v.as_f64())
+                    .map_or_else(|| "–".to_string(), |v| format!("{v}"))
+            };
+            let _ = write!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                esc(&o.name),
+                o.reverse_motions_cutting_after,
+                o.reverse_motions_links_after,
+                o.reverse_motions_cutting_near_pole,
+                kept("clearance"),
+                kept("angle_limit"),
+                kept("near_pole"),
+                kept("budget"),
+                kept("accuracy"),
+                o.reverse_motions_cutting_unaccounted,
+                if o.reverse_motions_cutting_after > 0 {
+                    format!(
+                        "{:.4}–{:.4}",
+                        o.reversal_step_min_deg, o.reversal_step_max_deg
+                    )
+                } else {
+                    "–".to_string()
+                },
+            );
+        }
+        h.push_str("</table>");
+    }
+
     fn html(&self) -> String {
         let mut h = String::new();
         let _ = write!(
@@ -760,6 +807,7 @@ impl Report {
                 );
             }
             h.push_str("</table>");
+            self.reversal_table(&mut h);
         }
         if let Some(t) = &self.post.cycle_time {
             h.push_str(&crate::cycle::html(t));

@@ -520,3 +520,35 @@ fn verification_lists_and_plots_the_residual_of_every_surface_group() {
         assert!(html.contains(&name.replace('_', " ")), "no series {name}");
     }
 }
+
+/// Issue 37: the post-processing section tabulates the rotary reversals inside cuts of every
+/// operation with what explains them, the same figures as report.json.
+#[test]
+fn post_processing_tabulates_the_reversals_inside_cuts_by_reason() {
+    let dir = common::scratch("impeller-cam-view3d", "reversal-table");
+    let out = run_small_view_job(&dir, &[]);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert!(html.contains("<h3>Rotary reversals inside cuts</h3>"));
+    let ops = report["post"]["operations"].as_array().unwrap();
+    assert!(!ops.is_empty());
+    for o in ops {
+        let planned = report["operations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == o["name"])
+            .unwrap();
+        let row = format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
+            o["name"].as_str().unwrap(),
+            o["reverse_motions_cutting_after"],
+            o["reverse_motions_links_after"],
+            o["reverse_motions_cutting_near_pole"],
+            planned["axis_reversals_kept_clearance"],
+        );
+        assert!(html.contains(&row), "no row {row}");
+        assert_eq!(o["reverse_motions_cutting_unaccounted"], 0);
+    }
+}

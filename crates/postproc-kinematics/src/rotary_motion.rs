@@ -18,7 +18,9 @@
 //! did not mark its links, such as imported CL data). The *step* of a
 //! reversal is `|Δ|` of its reversing step `k`. A reversal of the rotate axis inside a cut
 //! lies *near the pole* when the tool axis comes within [`POLE_TILT_RAD`] of the rotate
-//! axis (the workpiece's ±Z) over the blocks `p..=k`: there the rotate axis is all but undetermined by the tool axis (a change `δ` of
+//! axis (the workpiece's ±Z) over the motion of its two steps, blocks `p − 1..=k` (the
+//! first step starts at `p − 1`: a C that swings through the pole and then stands still
+//! reverses after the pole, at blocks clear of it): there the rotate axis is all but undetermined by the tool axis (a change `δ` of
 //! the axis turns it by up to `δ / sin(tilt)`, so a wiggle of the planned axis within its
 //! accuracy turns it by degrees), and where the path crosses the pole the rotate axis must
 //! swing whatever the plan.
@@ -161,7 +163,9 @@ pub fn axis_reversals(blocks: &[PostedBlock], axis: AxisId) -> AxisReversals {
                 let all_feed = blocks[p..=k].iter().all(|b| b.kind == MoveKind::Feed);
                 if all_feed && tip_keeps_direction(blocks, p, k) {
                     out.cutting += 1;
-                    if axis == AxisId::Rotate && blocks[p..=k].iter().any(near_pole) {
+                    if axis == AxisId::Rotate
+                        && blocks[p.saturating_sub(1)..=k].iter().any(near_pole)
+                    {
                         out.cutting_near_pole += 1;
                     }
                     out.cutting_step_min = out.cutting_step_min.min(d.abs());
@@ -338,6 +342,29 @@ mod tests {
         assert_eq!((near.cutting, near.cutting_near_pole), (2, 2), "{near:?}");
         let away = line(2f64.to_radians());
         assert_eq!((away.cutting, away.cutting_near_pole), (2, 0), "{away:?}");
+    }
+
+    /// C swings through the pole, stands still, then turns back a little once the axis is
+    /// clear of the pole: the reversal's first step starts at the pole, so it lies near the
+    /// pole though every block from that step's end on is clear of it (hub finishing on the
+    /// turn-mill: the one reversal the planner's count did not cover).
+    #[test]
+    fn a_swing_through_the_pole_counts_at_the_pole() {
+        let tilts = [0.3, 0.1, 0.005, 0.1, 0.2, 0.3, 0.4];
+        let cs = [0.0, 0.01, 0.02, 3.0, 3.0, 3.0, 2.99];
+        let b: Vec<PostedBlock> = cs
+            .iter()
+            .zip(tilts)
+            .enumerate()
+            .map(|(i, (c, t))| {
+                let mut blk = block(i as f64, 0.0, *c, MoveKind::Feed);
+                blk.joints.tilt = t;
+                blk.cl = CutterLocation::new(blk.cl.tip, axis_at(t, *c)).unwrap();
+                blk
+            })
+            .collect();
+        let r = axis_reversals(&b, AxisId::Rotate);
+        assert_eq!((r.cutting, r.cutting_near_pole), (1, 1), "{r:?}");
     }
 
     /// On a horizontal-spindle turn-mill head the pole lies at a tilt of 90°: the tool axis
