@@ -712,6 +712,20 @@ impl SmoothingSummary {
         }
     }
 
+    /// The direction changes an operation's metrics report as kept, over every reason (the
+    /// sum of its `axis_reversals_kept_*`, which [`Self::add_metrics`] writes); `None` when
+    /// one of them is missing.
+    pub fn kept_in(m: &Metrics) -> Option<usize> {
+        KeptReason::ALL
+            .iter()
+            .map(|r| {
+                m.get(&format!("axis_reversals_kept_{}", r.name()))
+                    .and_then(|v| v.as_f64())
+                    .map(|v| v as usize)
+            })
+            .sum()
+    }
+
     /// One note: what was smoothed and why reversals stay.
     pub fn note(&self) -> String {
         let reasons: Vec<String> = KeptReason::ALL

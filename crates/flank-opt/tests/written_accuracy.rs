@@ -203,16 +203,7 @@ fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
     }
     assert!(runs >= 1);
     let after = count("axis_reversals_after");
-    let kept: usize = [
-        "clearance",
-        "angle_limit",
-        "near_pole",
-        "budget",
-        "accuracy",
-    ]
-    .iter()
-    .map(|r| count(&format!("axis_reversals_kept_{r}")))
-    .sum();
+    let kept = cam_plan::SmoothingSummary::kept_in(&planned.metrics).unwrap();
     assert_eq!(kept, after, "every reversal left has its reason");
     // The pass is copied to every main blade: one blade's pass holds 1/blades of them.
     let blades = imp.main().count();
