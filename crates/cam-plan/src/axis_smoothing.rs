@@ -184,6 +184,11 @@ impl KeptReason {
         KeptReason::Budget,
         KeptReason::Accuracy,
     ];
+    /// The operation metric that counts the direction changes kept for this reason
+    /// (`axis_reversals_kept_<name>`).
+    pub fn metric(self) -> String {
+        format!("axis_reversals_kept_{}", self.name())
+    }
     /// Snake-case name for metrics.
     pub fn name(self) -> &'static str {
         match self {
@@ -708,7 +713,7 @@ impl SmoothingSummary {
                 self.max_centre_shift_mm,
             );
         for (r, k) in KeptReason::ALL.iter().zip(self.kept) {
-            m.count(&format!("axis_reversals_kept_{}", r.name()), k);
+            m.count(&r.metric(), k);
         }
     }
 
@@ -719,7 +724,7 @@ impl SmoothingSummary {
         KeptReason::ALL
             .iter()
             .map(|r| {
-                m.get(&format!("axis_reversals_kept_{}", r.name()))
+                m.get(&r.metric())
                     .and_then(|v| v.as_f64())
                     .map(|v| v as usize)
             })

@@ -689,30 +689,31 @@ impl Report {
              link. Each one inside a cut lies at the pole (the tool axis within 1° of C, which \
              it no longer determines) or is one the operation's planner kept, by reason; \
              <em>unaccounted</em> counts the rest.</p><table><tr><th>operation</th>\
-             <th>inside cuts</th><th>at path ends and links</th><th>at the pole</th>\
-             <th>planner kept: clearance</th><th>angle limit</th><th>near pole</th><th>fit budget</th>\
-             <th>accuracy</th><th>unaccounted</th><th>steps (deg)</th></tr>",
+             <th>inside cuts</th><th>at path ends and links</th><th>at the pole</th>",
         );
+        for (i, r) in cam_plan::KeptReason::ALL.iter().enumerate() {
+            let prefix = if i == 0 { "planner kept: " } else { "" };
+            let _ = write!(h, "<th>{prefix}{}</th>", r.name().replace('_', " "));
+        }
+        h.push_str("<th>unaccounted</th><th>steps (deg)</th></tr>");
         for o in &self.post.operations {
             let planned = self.operations.iter().find(|p| p.name == o.name);
-            let kept = |reason: &str| -> String {
-                planned
-                    .and_then(|p| p.metrics.get(&format!("axis_reversals_kept_{reason}")))
-                    .and_then(|v| v.as_f64())
-                    .map_or_else(|| "–".to_string(), |v| format!("{v}"))
-            };
+            let kept: String = cam_plan::KeptReason::ALL
+                .iter()
+                .map(|r| {
+                    let v = planned
+                        .and_then(|p| p.metrics.get(&r.metric()))
+                        .and_then(|v| v.as_f64());
+                    v.map_or_else(|| "<td>–</td>".to_string(), |v| format!("<td>{v}</td>"))
+                })
+                .collect();
             let _ = write!(
                 h,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td>{kept}<td>{}</td><td>{}</td></tr>",
                 esc(&o.name),
                 o.reverse_motions_cutting_after,
                 o.reverse_motions_links_after,
                 o.reverse_motions_cutting_near_pole,
-                kept("clearance"),
-                kept("angle_limit"),
-                kept("near_pole"),
-                kept("budget"),
-                kept("accuracy"),
                 o.reverse_motions_cutting_unaccounted,
                 if o.reverse_motions_cutting_after > 0 {
                     format!(

@@ -20,8 +20,9 @@
 //! lies *near the pole* when the tool axis comes within [`POLE_TILT_RAD`] of the rotate
 //! axis (the workpiece's ±Z) over the motion of its two steps, blocks `p − 1..=k` (the
 //! first step starts at `p − 1`: a C that swings through the pole and then stands still
-//! reverses after the pole, at blocks clear of it): there the rotate axis is all but undetermined by the tool axis (a change `δ` of
-//! the axis turns it by up to `δ / sin(tilt)`, so a wiggle of the planned axis within its
+//! reverses after the pole, at blocks clear of it). There the rotate axis is all but
+//! undetermined by the tool axis (a change `δ` of the axis turns it by up to `δ / sin(γ)`,
+//! `γ` the angle between the tool axis and C, so a wiggle of the planned axis within its
 //! accuracy turns it by degrees), and where the path crosses the pole the rotate axis must
 //! swing whatever the plan.
 //!
@@ -52,7 +53,9 @@ pub const PATH_CORNER_RAD: f64 = std::f64::consts::FRAC_PI_4;
 /// Tip displacements shorter than this (mm) carry no direction of travel.
 pub const TIP_STILL_MM: f64 = 1e-6;
 
-/// Tilt (rad) within which a reversal of the rotate axis counts as near the pole: 1°.
+/// Angle (rad) between the tool axis and the rotate axis within which a reversal of the
+/// rotate axis counts as near the pole: 1° (the name keeps the table-table reading, where
+/// that angle is the tilt).
 pub const POLE_TILT_RAD: f64 = 0.017_453_292_519_943_295;
 
 /// Shortest block time (s) used for the acceleration estimate: shorter blocks are merged
