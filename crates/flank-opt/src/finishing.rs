@@ -717,7 +717,7 @@ impl FlankFinishing {
         let mut dense_points = 0usize;
         let mut uncertified = 0usize;
         let mut uncertified_over = 0.0f64;
-        let mut worst_at: Option<(Side, crate::measure::DensePoint)> = None;
+        let mut worst_at: Option<(Row, Side, crate::measure::DensePoint)> = None;
         let mut whole_tool_misses: Vec<String> = Vec::new();
         let mut hub_lifts = 0usize;
         let mut hub_lift_max = 0.0f64;
@@ -887,7 +887,7 @@ impl FlankFinishing {
             uncertified_over = uncertified_over.max(dense.uncertified_max_overcut_mm);
             if let Some(w) = dense.worst_overcut {
                 if dense.max_overcut_mm > over {
-                    worst_at = Some((side, w));
+                    worst_at = Some((row, side, w));
                 }
             }
             over = over.max(dense.max_overcut_mm);
@@ -1046,7 +1046,7 @@ impl FlankFinishing {
         .iter()
         .filter(|(_, v, t, _)| v.is_nan() || *v > t * (1.0 + 1e-9) + 1e-12)
         .map(|(what, v, t, u)| match (*what, worst_at) {
-            ("overcut", Some((side, w))) => format!(
+            ("overcut", Some((_, side, w))) => format!(
                 "{what} {v:.4} {u} > {t} {u} (dense measurement of the written pass, {side:?} \
                  side at ({:.3}, {:.3}, {:.3}), {:.3} mm above the hub)",
                 w.point.x, w.point.y, w.point.z, w.hub_height_mm
@@ -1073,10 +1073,16 @@ impl FlankFinishing {
         if !misses.is_empty() {
             return Err(FlankError::NotAccurate(format!(
                 "the optimised path misses its tolerances after {iterations} SLP iteration(s) \
-                 ({}): {}; try more iterations (max_slp_iterations), a larger trust region \
-                 (trust_radius_mm) or another initial path (initial_path)",
+                 ({}): {}; {}try more iterations (max_slp_iterations), a larger trust region \
+                 (trust_radius_mm) or another initial path (initial_path), or finish the \
+                 blades with blade_point_finishing (method = \"auto\": one flank pass where a \
+                 side is ruled within the strip tolerance, sub-ruled strips or point milling \
+                 elsewhere)",
                 termination.as_str(),
-                misses.join(", ")
+                misses.join(", "),
+                worst_at
+                    .and_then(|(row, side, _)| ruled_deviation_note(ctx.impeller, row, side, pr))
+                    .unwrap_or_default()
             )));
         }
         for (row, one_path) in &row_paths {
@@ -1200,4 +1206,34 @@ const APPROACH_MM: f64 = 5.0;
 
 fn ball_radius_of(r: &PathResult) -> f64 {
     r.x[0]
+}
+
+/// Why a side may be beyond one flank pass: its largest distance from the ruled surface
+/// between its hub and shroud edges ([`impeller_model::ruled::ruled_approximation`]), said
+/// when it exceeds the overcut and undercut tolerances together (the band a pass's envelope
+/// may lie in). A conical cutter's envelope is not a ruled surface, so this is a diagnosis,
+/// not a proof. `None` when within that band or when the approximation cannot be built.
+fn ruled_deviation_note(
+    impeller: &impeller_model::Impeller,
+    row: Row,
+    side: Side,
+    pr: &ProblemSettings,
+) -> Option<String> {
+    let set = rows::blade_set(impeller, row).ok()?;
+    let blade = set.blade();
+    let v_range = match blade.design() {
+        Some(_) => blade.hub_shroud_v(side),
+        None => impeller.span_v_range(blade, side).ok()?,
+    };
+    let ruled = impeller_model::ruled::ruled_approximation(blade, side, v_range).ok()?;
+    let band = pr.overcut_tol + pr.undercut_tol;
+    (ruled.max_deviation_mm > band).then(|| {
+        format!(
+            "the {} blade's {side:?} side lies up to {:.4} mm from the ruled surface between \
+             its hub and shroud edges, more than the {band} mm band the tolerances allow a \
+             pass: a single flank pass is unlikely to follow it; ",
+            rows::label(row),
+            ruled.max_deviation_mm
+        )
+    })
 }

@@ -906,7 +906,8 @@ pub fn link_for_machine(
         travel.extend(links.travel.clone());
         op.metrics
             .count("machine_links", links.rerouted)
-            .count("swinging_rapids_left", links.remaining);
+            .count("swinging_rapids_left", links.remaining)
+            .count("swinging_rapids_on_surface", links.on_surface);
         if links.remaining > 0 {
             notes.push(format!(
                 "{}: {} rapid(s) inside the safety surface change the solution branch or swing \
@@ -914,6 +915,16 @@ pub fn link_for_machine(
                  verification)",
                 op.cl.path.name,
                 links.remaining,
+                machine.name()
+            ));
+        }
+        if links.on_surface > 0 {
+            notes.push(format!(
+                "{}: {} rapid(s) on the safety surface change the solution branch or swing a \
+                 rotary axis on {}; they are written as they are (a detour would start and end \
+                 where they do) and the verification of the written program judges them",
+                op.cl.path.name,
+                links.on_surface,
                 machine.name()
             ));
         }

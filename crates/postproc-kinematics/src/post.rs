@@ -805,8 +805,38 @@ fn follows_sweep(
     b: &Joints,
 ) -> bool {
     let arrives = |e: Option<Joints>| e.is_some_and(|e| e.rotary_travel(b) < 1e-6);
-    arrives(sweep_end(machine, tool_length, cla, a, clb))
-        || arrives(sweep_end_on_branch(machine, tool_length, cla, a, clb))
+    let sweeps = |a: &Joints| {
+        arrives(sweep_end(machine, tool_length, cla, a, clb))
+            || arrives(sweep_end_on_branch(machine, tool_length, cla, a, clb))
+    };
+    if sweeps(a) {
+        return true;
+    }
+    // At a singular end (tool axis along the rotary axis) the rotate angle is free: the move
+    // turns it there, tip and axis fixed (a pure table or head turn, which
+    // `linearise::subdivide` linearises first), and sweeps with it held. The continuation
+    // from the singular end with its own rotate angle cannot leave the pole (every first
+    // step turns the rotate axis by the whole difference), so it starts from the turned one.
+    let singular = |cl: &CutterLocation| {
+        let u = cl.axis.into_inner();
+        u.x.hypot(u.y) < machine.singularity_tol().sin()
+    };
+    if singular(cla) && !singular(clb) {
+        let turned = machine.joints_for_angles(&cla.tip, tool_length, a.tilt, b.rotate);
+        return sweeps(&turned);
+    }
+    if singular(clb) && !singular(cla) {
+        // The sweep ends on the pole with some rotate angle; the turn to `b`'s is the pure
+        // turn at the end.
+        let ends = |e: Option<Joints>| {
+            e.is_some_and(|e| {
+                (e.tilt - b.tilt).abs() < 1e-6 && singular(&machine.forward(&e, tool_length))
+            })
+        };
+        return ends(sweep_end(machine, tool_length, cla, a, clb))
+            || ends(sweep_end_on_branch(machine, tool_length, cla, a, clb));
+    }
+    false
 }
 
 /// The posture at `clb` reached by continuing the exact inverse kinematics from `a` along the

@@ -822,6 +822,55 @@ fn swinging_rapids_name_a_branch_change() {
     assert!(swinging_rapids(&m, &p).is_empty());
 }
 
+/// The linker's turn on the safety surface: the tool stands vertical at the top edge of the
+/// safety cylinder (the rotary table's axis: C is free there, and stays where the path left
+/// it) and turns, tip fixed, to an approach axis tilted 95° (past horizontal, A = −95°) whose
+/// C differs by 40°. That is one continuous sweep of the axis (C turned at the pole, then A),
+/// not a branch change: the post linearises it and `swinging_rapids` does not name it. Before,
+/// the continuation from the pole with the old C could not leave the pole, the 95° step
+/// counted as a reconfiguration and the rapid was written as one joint-interpolated block,
+/// whose tip passed 30 mm inside a part below (a rest-finishing approach on a backswept
+/// 8 + 8 variant cut 0.35 mm into a blade's top). Dense sampling: the tip stays within the
+/// tolerance of its (zero-length) line.
+#[test]
+fn a_turn_from_the_pole_past_horizontal_is_linearised() {
+    let m = fixture("xyzac-trt");
+    let tl = 0.0;
+    let tip = Point3::new(-15.0, 46.0, 53.0);
+    let vertical = CutterLocation::vertical(tip);
+    let tilted = CutterLocation::new(tip, axis_from_angles(&m, -95.0, 40.0)).unwrap();
+    let moves = vec![
+        Move::rapid(CutterLocation::vertical(Point3::new(15.0, 46.0, 53.0))),
+        Move::rapid(vertical),
+        Move::rapid(tilted),
+    ];
+    let opts = PostOptions {
+        tool_length: tl,
+        linearisation_tol: Some(0.005),
+        linearise_rapids: true,
+        initial: Some(m.joints_for_angles(&vertical.tip, tl, 0.0, 0.0)),
+        ..Default::default()
+    };
+    let p = post_path(&m, &moves, &opts).unwrap();
+    let last = p.blocks.last().unwrap();
+    assert!(
+        (last.joints.tilt.to_degrees() + 95.0).abs() < 1e-6,
+        "{:?}",
+        last.joints
+    );
+    assert!(swinging_rapids(&m, &p).is_empty());
+    let mut worst: f64 = 0.0;
+    for w in p.blocks.windows(2).filter(|w| w[1].source_index == 2) {
+        for k in 1..100 {
+            let at = m
+                .forward(&w[0].joints.lerp(&w[1].joints, k as f64 / 100.0), tl)
+                .tip;
+            worst = worst.max((at - tip).norm());
+        }
+    }
+    assert!(worst <= 0.005 * 1.0001, "dense deviation {worst} mm");
+}
+
 /// Hub finishing of impeller-8+8 near the inlet: the tool axis comes within 0.03° of the
 /// table's axis (two postures there) and tilts to 1.4° on the far side, the sweep passing
 /// the pole at about 0.03°. The nearest posture changes the tilt's sign through the pole

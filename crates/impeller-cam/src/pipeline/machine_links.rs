@@ -43,6 +43,12 @@ pub struct MachineLinks {
     /// Swinging rapids still inside the safety surface after the last pass (their ends allow
     /// no retract along the tool axis, or the passes ran out).
     pub remaining: usize,
+    /// Swinging rapids with both ends on or outside the safety surface after the last pass.
+    /// They are left as they are: a detour would start and end where they do. A rotate axis
+    /// about the impeller axis keeps a tool outside the capped cylinder outside it, but a
+    /// tilting axis (A or B) swings the part about a horizontal line, which can bring the tool
+    /// into it; the verification of the written program judges them.
+    pub on_surface: usize,
     /// The last posture of the operation as posted (the next operation starts from it).
     pub last: Option<Joints>,
     /// The blocks of the operation as posted that leave the machine's travel.
@@ -96,8 +102,9 @@ fn framed(path: &ToolPath, retract_mm: f64) -> Vec<Move> {
 /// ([`Linker::connect`], approach `approach_mm` above the next posture); a rapid that already
 /// starts on the surface (an approach) becomes a plunge-feed move instead, so the post's
 /// posture group — whose branch it chooses at the group's first rapid — begins at the rapid
-/// that reaches the surface and the swing happens there (table machines turn the part about
-/// Z, which keeps a tool outside the capped cylinder outside it); `post` are the
+/// that reaches the surface and the swing happens there (a rotate axis turns the part about
+/// Z, which keeps a tool outside the capped cylinder outside it; a swing of the tilting axis
+/// there is counted in [`MachineLinks::on_surface`]); `post` are the
 /// options of the real post (tool length, initial posture, unwinding), `retract_mm` the
 /// approach/retract distance the assembly adds at the operation's ends. A rapid whose ends
 /// allow no retract along the tool axis is left and counted in
@@ -136,13 +143,17 @@ pub fn reroute_swinging_rapids(
                 .get(i)
                 .is_some_and(|m| inside_surface(linker, &m.cl))
         };
-        let flagged: Vec<usize> = swinging_rapids(machine, &posted)
+        let swinging: Vec<usize> = swinging_rapids(machine, &posted)
             .into_iter()
             .filter_map(|k| k.checked_sub(1))
-            .filter(|&i| i >= 1 && i < path.moves.len() && (inside(i - 1) || inside(i)))
+            .filter(|&i| i >= 1 && i < path.moves.len())
             .collect();
+        let (flagged, on_surface): (Vec<usize>, Vec<usize>) = swinging
+            .into_iter()
+            .partition(|&i| inside(i - 1) || inside(i));
         if flagged.is_empty() || pass + 1 == MAX_RELINK_PASSES {
             out.remaining = flagged.len();
+            out.on_surface = on_surface.len();
             out.travel =
                 crate::travel::TravelViolations::of(&path.name, path.moves.len(), &posted.blocks);
             return Ok(out);
