@@ -921,8 +921,11 @@ pub fn link_for_machine(
         if links.on_surface > 0 {
             notes.push(format!(
                 "{}: {} rapid(s) on the safety surface change the solution branch or swing a \
-                 rotary axis on {}; they are written as they are (a detour would start and end \
-                 where they do) and the verification of the written program judges them",
+                 rotary axis on {}; each is written as one block (a detour would start and end \
+                 where it does): a tilting axis can swing the part into the tool there. The \
+                 verification reads a LinuxCNC program back and judges the joint motion; for \
+                 the other dialects it simulates the posted cutter locations (the tip on its \
+                 line, as tool-centre-point control moves it)",
                 op.cl.path.name,
                 links.on_surface,
                 machine.name()

@@ -47,7 +47,8 @@ pub struct MachineLinks {
     /// They are left as they are: a detour would start and end where they do. A rotate axis
     /// about the impeller axis keeps a tool outside the capped cylinder outside it, but a
     /// tilting axis (A or B) swings the part about a horizontal line, which can bring the tool
-    /// into it; the verification of the written program judges them.
+    /// into it. The verification judges their joint motion where it reads the program back
+    /// (LinuxCNC); for the other dialects it simulates the posted cutter locations.
     pub on_surface: usize,
     /// The last posture of the operation as posted (the next operation starts from it).
     pub last: Option<Joints>,
