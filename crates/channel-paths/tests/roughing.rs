@@ -12,7 +12,7 @@ use channel_paths::{build_channel_roughing, CHANNEL_ROUGHING};
 fn tool(shape: CutterShape) -> Tool {
     // Short tool and holder: the test runs in the dev profile, where each clearance query
     // costs its number of axis samples.
-    let mut cutter = Cutter::new("rough", shape, 25.0, 2.0, 32.0).unwrap();
+    let mut cutter = Cutter::new("rough", shape, 40.0, 2.0, 45.0).unwrap();
     cutter.holder = vec![HolderSegment {
         bottom_radius: 6.0,
         top_radius: 6.0,
@@ -80,6 +80,66 @@ fn plan_rough(
         .unwrap()
         .plan(&ctx)
         .unwrap()
+}
+
+/// The refusal of channel roughing with `tool` and `process` on the default impeller.
+fn rough_refusal(tool: &Tool, process: &Process) -> String {
+    let imp = impeller_model::fixtures::default_impeller().unwrap();
+    let tol = Tolerances::default();
+    let clearance = DesignClearance::new(&imp, tool, ClearanceOptions::default()).unwrap();
+    let stock = imp.stock();
+    let linker = Linker::new(SafetySurface::around_stock(stock, 10.0).unwrap());
+    let ctx = PlanContext {
+        impeller: &imp,
+        stock,
+        tool,
+        tolerances: &tol,
+        process,
+        clearance: &clearance,
+        linker: &linker,
+        links: &cam_plan::LinkStats::default(),
+        reach: None,
+        remaining: None,
+        progress: None,
+    };
+    match build_channel_roughing(&spec("scallop_mm = 0.5"))
+        .unwrap()
+        .plan(&ctx)
+    {
+        Ok(plan) => panic!(
+            "planned {} moves",
+            plan.paths.iter().map(|p| p.moves.len()).sum::<usize>()
+        ),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// A depth of cut deeper than the flutes is refused, naming the field and the tool: the
+/// shank would rub on every level's wall (and a tapered ball's blade offset, the cone's
+/// radius at that depth, grew until nothing fitted: 200 mm on impeller-8+8's Ø3 tapered ball
+/// planned no move, and the finishing tools then met the whole blank).
+#[test]
+fn a_depth_of_cut_beyond_the_flutes_is_refused() {
+    let tool = tool(CutterShape::BallEnd { radius: 1.0 });
+    let mut proc_ = process();
+    proc_.depth_of_cut_mm = Some(40.5);
+    let e = rough_refusal(&tool, &proc_);
+    assert!(
+        e.contains("depth_of_cut_mm") && e.contains("deeper than the flutes"),
+        "{e}"
+    );
+}
+
+/// A cutter that fits nowhere between the blades (a Ø16 ball in channels 4–13 mm wide) is
+/// refused: nothing would be roughed.
+#[test]
+fn a_cutter_that_fits_nowhere_is_refused() {
+    let tool = tool(CutterShape::BallEnd { radius: 8.0 });
+    let e = rough_refusal(&tool, &process());
+    assert!(
+        e.contains("fits nowhere") && e.contains("nothing is roughed"),
+        "{e}"
+    );
 }
 
 /// A ball end, one level on the hub offset (about 2 s in the dev profile): the scallop

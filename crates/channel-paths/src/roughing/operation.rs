@@ -243,6 +243,21 @@ impl ChannelRoughing {
                     "needed (> 0) for levels",
                 )
             })?;
+        // A level's wall is cut by the flutes over the whole depth of cut: deeper, the shank
+        // would rub on it (and the blade offset below would be the cone's radius at a height
+        // the cutter does not have).
+        let flutes = ctx.tool.cutter.flute_length;
+        if doc > flutes + 1e-9 {
+            return Err(PlanError::param(
+                &self.name,
+                "process.depth_of_cut_mm",
+                format!(
+                    "{doc} mm is deeper than the flutes of tool {} ({flutes} mm): the shank \
+                     would rub on every level's wall",
+                    self.tool
+                ),
+            ));
+        }
         // The blade offset is the cutter's largest radius within one level's slab: the
         // radius for ball and bull-nose ends; for a tapered ball end the ball radius or, when
         // the depth of cut reaches the cone, the cone's radius at that height.
@@ -499,6 +514,21 @@ impl ChannelRoughing {
             .fold((f64::INFINITY, 0.0f64), |(lo, hi), o| {
                 (lo.min(o), hi.max(o))
             });
+        if paths.iter().all(|p| p.moves.is_empty()) {
+            // Nothing roughed: every later operation would meet the whole blank.
+            return Err(self.geo(
+                "every level",
+                format!(
+                    "the cutter (blade offset {:.3}–{:.3} mm) fits nowhere between the blades \
+                     on the {n_levels} level(s) of ≤ {doc} mm ({:.0} mm² of levels, all \
+                     channels): nothing is roughed; a smaller cutter or a smaller depth of cut \
+                     may fit",
+                    offsets.0,
+                    offsets.1,
+                    area_mm2 * k,
+                ),
+            ));
+        }
         Ok(PlannedOperation {
             paths,
             metrics,
