@@ -556,7 +556,13 @@ pub fn minimax_measured(
         ..*run
     };
     let mut rounds = 0;
-    while (dense.max_overcut_mm > pr.overcut_tol || dense.max_undercut_mm > pr.undercut_tol)
+    // A run that stops at its iteration limit may end a hair outside the hub tangency band
+    // (0.0100x mm against 0.01 on impeller-8+8 without its fillet, whose accuracy was met):
+    // the refinement's narrower band (REFINE_HUB_MARGIN) brings it back inside.
+    let hub_out = |res: &PathResult| res.hub_error_mm > pr.hub_tol * (1.0 + 1e-9) + 1e-12;
+    while (dense.max_overcut_mm > pr.overcut_tol
+        || dense.max_undercut_mm > pr.undercut_tol
+        || hub_out(&res))
         && rounds < REFINE_ROUNDS
     {
         rounds += 1;
