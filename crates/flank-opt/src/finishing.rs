@@ -1053,11 +1053,15 @@ impl FlankFinishing {
         .filter(|(_, v, t, _)| v.is_nan() || *v > t * (1.0 + 1e-9) + 1e-12)
         .map(|(what, v, t, u)| match (*what, worst_at) {
             ("overcut", Some((_, side, w))) => format!(
-                "{what} {v:.4} {u} > {t} {u} (dense measurement of the written pass, {side:?} \
+                "{what} {} {u} > {t} {u} (dense measurement of the written pass, {side:?} \
                  side at ({:.3}, {:.3}, {:.3}), {:.3} mm above the hub)",
-                w.point.x, w.point.y, w.point.z, w.hub_height_mm
+                digits_above(*v, *t),
+                w.point.x,
+                w.point.y,
+                w.point.z,
+                w.hub_height_mm
             ),
-            _ => format!("{what} {v:.4} {u} > {t} {u}"),
+            _ => format!("{what} {} {u} > {t} {u}", digits_above(*v, *t)),
         })
         .chain(
             (uncertified_over > pr.overcut_tol * (1.0 + 1e-9) + 1e-12).then(|| {
@@ -1214,6 +1218,16 @@ fn ball_radius_of(r: &PathResult) -> f64 {
     r.x[0]
 }
 
+/// `v` with four decimals, or as many more (up to nine) as it takes to read above `limit`:
+/// a value a hair over its tolerance must not print as the tolerance itself ("0.0100 mm >
+/// 0.01 mm").
+fn digits_above(v: f64, limit: f64) -> String {
+    (4..=9)
+        .map(|d| format!("{v:.d$}"))
+        .find(|s| s.parse::<f64>().is_ok_and(|x| x > limit))
+        .unwrap_or_else(|| format!("{v:e}"))
+}
+
 /// Why a side may be beyond one flank pass: its largest distance from the ruled surface
 /// between its hub and shroud edges ([`impeller_model::ruled::ruled_approximation`]), said
 /// when it exceeds the overcut and undercut tolerances together (the band a pass's envelope
@@ -1242,4 +1256,17 @@ fn ruled_deviation_note(
             ruled.max_deviation_mm
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::digits_above;
+
+    /// A value a hair above its tolerance prints above it; one well above keeps four decimals.
+    #[test]
+    fn a_miss_prints_above_its_tolerance() {
+        assert_eq!(digits_above(0.010_003, 0.01), "0.010003");
+        assert_eq!(digits_above(0.0227, 0.01), "0.0227");
+        assert_eq!(digits_above(0.012_34, 0.01), "0.0123");
+    }
 }
