@@ -1273,6 +1273,10 @@ pub fn verify(
             "overcut_crosscheck": crosscheck,
         }),
     });
+    report.notes.push(removal_note(
+        &verifiable,
+        &rep.stats.removed_volume_by_operation_mm3,
+    ));
     report.add_map_plots(&rep.maps);
     if job.export_stock {
         // The lattice of `impeller-cam verify`'s stock.stl.
@@ -1283,6 +1287,38 @@ pub fn verify(
     }
     crate::view3d::add_verification(&mut report.view, &stock, &rep, job, limit);
     Ok(())
+}
+
+/// The note on the material each verified operation removed (the simulation's
+/// `removed_volume_by_operation_mm3`) and its mean cut cross-section: that volume over the
+/// length of the operation's moves in the material (feed, link and plunge moves, tip path).
+/// A finishing operation whose cross-section is far above its allowance times its cutter's
+/// width is cutting what an earlier operation left (a finishing ball slotting an unroughed
+/// channel touches no shank or holder: no collision, but a broken tool).
+fn removal_note(verifiable: &[(Cutter, ToolPath)], by_op: &[f64]) -> String {
+    let parts: Vec<String> = verifiable
+        .iter()
+        .zip(by_op)
+        .map(|((_, path), v)| {
+            let length: f64 = path
+                .moves
+                .windows(2)
+                .filter(|w| w[1].kind.at_cutting_feed() || w[1].kind == MoveKind::Plunge)
+                .map(|w| (w[1].cl.tip - w[0].cl.tip).norm())
+                .sum();
+            let section = if length > 0.0 {
+                format!("{:.3} mm² on average over {:.0} mm", v / length, length)
+            } else {
+                "no cutting moves".into()
+            };
+            format!("{} {:.0} mm³ ({section})", path.name, v)
+        })
+        .collect();
+    format!(
+        "verification: material removed per operation, with the mean cut cross-section (volume \
+         over the length of moves in the material): {}",
+        parts.join(", ")
+    )
 }
 
 /// The verifier's overcut re-measured on the exact swept envelopes of the verified paths:

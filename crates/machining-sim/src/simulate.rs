@@ -168,6 +168,12 @@ pub struct SimStats {
     pub stock_memory_bytes: usize,
     /// Material removed (mm³).
     pub removed_volume_mm3: f64,
+    /// Material removed by each operation, in program order (mm³; the three grids' mean,
+    /// as `removed_volume_mm3`). A finishing operation that removes far more than its
+    /// allowance band holds is cutting material an earlier operation should have taken (a
+    /// finishing ball slotting through an unroughed channel touches no shank or holder and
+    /// is no collision): the figure a programmer compares.
+    pub removed_volume_by_operation_mm3: Vec<f64>,
     /// Wall-clock time of the removal and stock collision checks (ms).
     pub removal_ms: f64,
     /// Wall-clock time of the design collision checks (ms).
@@ -270,6 +276,7 @@ pub fn cut(
         resolution_mm: cell,
         sweep_tol_mm: tol,
         rays: stock.ray_count(),
+        removed_volume_by_operation_mm3: vec![0.0; ops.len()],
         ..SimStats::default()
     };
     let cap = options.batch_positions.max(1);
@@ -286,8 +293,17 @@ pub fn cut(
                  acc: &mut Acc,
                  stats: &mut SimStats,
                  design_ms: &mut f64| {
+        if batch.is_empty() {
+            return;
+        }
         let out = apply_batch(stock, &bodies, batch, options.check_collisions, ctol);
         stats.removed_volume_mm3 += out.removed_volume;
+        // Every batch holds one operation's positions (flushed at each operation's end).
+        if let Some(&(op, _)) = meta.first() {
+            if let Some(v) = stats.removed_volume_by_operation_mm3.get_mut(op) {
+                *v += out.removed_volume;
+            }
+        }
         stats.positions += batch.len();
         for h in out.hits {
             let (op, mv) = meta[h.placement];
@@ -463,6 +479,16 @@ pub fn cut(
             }
         }
         emit(&mut run, &mut batch, &mut meta);
+        // The operation's last positions: batches never mix operations, so each one's removed
+        // volume is its own (the removal does not depend on where batches end).
+        flush(
+            &mut batch,
+            &mut meta,
+            stock,
+            &mut acc,
+            &mut stats,
+            &mut design_ms,
+        );
     }
     flush(
         &mut batch,

@@ -460,3 +460,41 @@ fn an_inflated_face_depth_is_capped_by_the_way_back_to_the_entry() {
     let e = rep.max_overcut.clone().unwrap();
     assert!((e.value_mm - 0.3).abs() < h, "{e:?}");
 }
+
+/// Two plunges of a Ø6 flat end, 4 mm then 2 mm deeper at the same place, as two operations,
+/// each batch of positions a few long: every operation gets the volume it removed (π r² 4 and
+/// π r² 2 within one cell over the cut's boundary), the two add up to the total, and the
+/// stock equals the one-operation run's with the default batches bit for bit.
+#[test]
+fn each_operation_gets_the_volume_it_removed() {
+    let h = 0.2;
+    let block = BoxStock::new([0.0, 0.0, 0.0], [20.0, 20.0, 10.0]).unwrap();
+    let r = 3.0;
+    let cutter = Cutter::new("f6", CutterShape::FlatEnd { radius: r }, 20.0, r, 40.0).unwrap();
+    let plunge = |z: f64| {
+        path(vec![
+            (MoveKind::Rapid, vertical(10.0, 10.0, 15.0)),
+            (MoveKind::Plunge, vertical(10.0, 10.0, z)),
+            (MoveKind::Retract, vertical(10.0, 10.0, 15.0)),
+        ])
+    };
+    let ops = [(cutter.clone(), plunge(6.0)), (cutter.clone(), plunge(4.0))];
+    let mut stock = TriDexel::from_shape(&block, h).unwrap();
+    let small = SimOptions {
+        batch_positions: 3,
+        ..SimOptions::default()
+    };
+    let out = cut(&mut stock, None, &ops, &small).unwrap();
+    let by_op = &out.stats.removed_volume_by_operation_mm3;
+    assert_eq!(by_op.len(), 2);
+    let bound =
+        |depth: f64| (2.0 * std::f64::consts::PI * r * depth + std::f64::consts::PI * r * r) * h;
+    let area = std::f64::consts::PI * r * r;
+    assert!((by_op[0] - area * 4.0).abs() < bound(4.0), "{by_op:?}");
+    assert!((by_op[1] - area * 2.0).abs() < bound(2.0), "{by_op:?}");
+    assert!((by_op[0] + by_op[1] - out.stats.removed_volume_mm3).abs() < 1e-9);
+    // The stock does not depend on where the batches end.
+    let mut whole = TriDexel::from_shape(&block, h).unwrap();
+    cut(&mut whole, None, &ops, &SimOptions::default()).unwrap();
+    assert_eq!(whole.volume().to_bits(), stock.volume().to_bits());
+}
