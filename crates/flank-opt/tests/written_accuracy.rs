@@ -40,13 +40,8 @@ fn cutter_distance(w: f64, z: f64) -> f64 {
     (w * w + (z - c) * (z - c)).sqrt() - (R + (c - R) * t.sin())
 }
 
-#[test]
-fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
-    let imp = impeller_model::load(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../fixtures/impeller-8+8/impeller.toml"
-    ))
-    .unwrap();
+/// Flank finishing of `imp` with the default job's T6 at `TOL`, with the kind's `params`.
+fn plan_finishing(imp: &impeller_model::Impeller, params: &str) -> cam_plan::PlannedOperation {
     let shape = CutterShape::TaperedBallEnd {
         ball_radius: R,
         half_angle: THETA_DEG.to_radians(),
@@ -72,10 +67,10 @@ fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
         machining_tol: TOL,
         ..Tolerances::default()
     };
-    let clearance = DesignClearance::new(&imp, &tool, ClearanceOptions::default()).unwrap();
+    let clearance = DesignClearance::new(imp, &tool, ClearanceOptions::default()).unwrap();
     let linker = Linker::new(SafetySurface::around_stock(imp.stock(), 10.0).unwrap());
     let ctx = PlanContext {
-        impeller: &imp,
+        impeller: imp,
         stock: imp.stock(),
         tool: &tool,
         tolerances: &tolerances,
@@ -92,13 +87,25 @@ fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
         kind: flank_opt::FLANK_FINISHING.into(),
         tool: "T6".into(),
         process,
-        params: toml::from_str(
-            "sides = \"pressure\"\nrows = [\"main\"]\noptimise_shape = false\ncompare_cylindrical = false",
-        )
-        .unwrap(),
+        params: toml::from_str(params).unwrap(),
     };
-    let op = flank_opt::build_flank_finishing(&spec).unwrap();
-    let planned = op.plan(&ctx).unwrap();
+    flank_opt::build_flank_finishing(&spec)
+        .unwrap()
+        .plan(&ctx)
+        .unwrap()
+}
+
+#[test]
+fn reported_overcut_is_the_written_pass_overcut_and_within_tolerance() {
+    let imp = impeller_model::load(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/impeller-8+8/impeller.toml"
+    ))
+    .unwrap();
+    let planned = plan_finishing(
+        &imp,
+        "sides = \"pressure\"\nrows = [\"main\"]\noptimise_shape = false\ncompare_cylindrical = false",
+    );
     let number = |k: &str| match planned.metrics.get(k) {
         Some(MetricValue::Number(v)) => *v,
         other => panic!("metric {k}: {other:?}"),
@@ -228,57 +235,7 @@ fn a_pass_ending_a_hair_outside_the_hub_band_is_refined_into_it() {
     .unwrap()
     .replace("fillet_radius_mm = 1.0", "fillet_radius_mm = 0.0");
     let imp = impeller_model::from_toml_str(&text, "impeller-8+8-no-fillet.toml").unwrap();
-    let shape = CutterShape::TaperedBallEnd {
-        ball_radius: R,
-        half_angle: THETA_DEG.to_radians(),
-    };
-    let tool = Tool {
-        number: 6,
-        cutter: Cutter::new("T6", shape, FLUTE, 6.0, 35.0).unwrap(),
-        teeth: 3,
-        tool_length_mm: 115.0,
-        plunge_edge_length_mm: None,
-    };
-    let process = Process {
-        spindle_rpm: 6000.0,
-        feed_per_tooth_mm: 0.1,
-        plunge_feed_per_tooth_mm: None,
-        depth_of_cut_mm: None,
-        width_of_cut_mm: None,
-        blade_allowance_mm: 0.0,
-        hub_allowance_mm: 0.0,
-        rapid_mm_per_min: 10000.0,
-    };
-    let tolerances = Tolerances {
-        machining_tol: TOL,
-        ..Tolerances::default()
-    };
-    let clearance = DesignClearance::new(&imp, &tool, ClearanceOptions::default()).unwrap();
-    let linker = Linker::new(SafetySurface::around_stock(imp.stock(), 10.0).unwrap());
-    let ctx = PlanContext {
-        impeller: &imp,
-        stock: imp.stock(),
-        tool: &tool,
-        tolerances: &tolerances,
-        process: &process,
-        clearance: &clearance,
-        linker: &linker,
-        links: &cam_plan::LinkStats::default(),
-        reach: None,
-        remaining: None,
-        progress: None,
-    };
-    let spec = OperationSpec {
-        name: "blade-finish".into(),
-        kind: flank_opt::FLANK_FINISHING.into(),
-        tool: "T6".into(),
-        process,
-        params: toml::from_str("optimise_shape = false\ncompare_cylindrical = false").unwrap(),
-    };
-    let planned = flank_opt::build_flank_finishing(&spec)
-        .unwrap()
-        .plan(&ctx)
-        .unwrap();
+    let planned = plan_finishing(&imp, "optimise_shape = false\ncompare_cylindrical = false");
     let hub = match planned.metrics.get("hub_tangency_error_mm") {
         Some(MetricValue::Number(v)) => *v,
         other => panic!("hub_tangency_error_mm: {other:?}"),

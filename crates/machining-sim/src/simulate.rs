@@ -480,7 +480,8 @@ pub fn cut(
         }
         emit(&mut run, &mut batch, &mut meta);
         // The operation's last positions: batches never mix operations, so each one's removed
-        // volume is its own (the removal does not depend on where batches end).
+        // volume is its own (the removal does not depend on where batches end); nothing is
+        // left for after the last operation.
         flush(
             &mut batch,
             &mut meta,
@@ -490,14 +491,6 @@ pub fn cut(
             &mut design_ms,
         );
     }
-    flush(
-        &mut batch,
-        &mut meta,
-        stock,
-        &mut acc,
-        &mut stats,
-        &mut design_ms,
-    );
     if let (Some(sink), Some((_, last))) = (&options.on_progress, ops.last()) {
         (sink.0)(SimProgress::Cutting {
             operation: &last.name,
