@@ -61,6 +61,19 @@ fn plan_rough(
     params: &str,
     progress: Option<&dyn cam_plan::PlanProgress>,
 ) -> cam_plan::PlannedOperation {
+    try_plan_rough(imp, tool, tol, process, clearance, params, progress).unwrap()
+}
+
+/// [`plan_rough`], the operation's refusal kept.
+fn try_plan_rough(
+    imp: &impeller_model::Impeller,
+    tool: &Tool,
+    tol: &Tolerances,
+    process: &Process,
+    clearance: &DesignClearance<'_>,
+    params: &str,
+    progress: Option<&dyn cam_plan::PlanProgress>,
+) -> Result<cam_plan::PlannedOperation, cam_plan::PlanError> {
     let stock = imp.stock();
     let linker = Linker::new(SafetySurface::around_stock(stock, 10.0).unwrap());
     let ctx = PlanContext {
@@ -76,10 +89,7 @@ fn plan_rough(
         remaining: None,
         progress,
     };
-    build_channel_roughing(&spec(params))
-        .unwrap()
-        .plan(&ctx)
-        .unwrap()
+    build_channel_roughing(&spec(params)).unwrap().plan(&ctx)
 }
 
 /// The refusal of channel roughing with `tool` and `process` on the default impeller.
@@ -87,25 +97,15 @@ fn rough_refusal(tool: &Tool, process: &Process) -> String {
     let imp = impeller_model::fixtures::default_impeller().unwrap();
     let tol = Tolerances::default();
     let clearance = DesignClearance::new(&imp, tool, ClearanceOptions::default()).unwrap();
-    let stock = imp.stock();
-    let linker = Linker::new(SafetySurface::around_stock(stock, 10.0).unwrap());
-    let ctx = PlanContext {
-        impeller: &imp,
-        stock,
+    match try_plan_rough(
+        &imp,
         tool,
-        tolerances: &tol,
+        &tol,
         process,
-        clearance: &clearance,
-        linker: &linker,
-        links: &cam_plan::LinkStats::default(),
-        reach: None,
-        remaining: None,
-        progress: None,
-    };
-    match build_channel_roughing(&spec("scallop_mm = 0.5"))
-        .unwrap()
-        .plan(&ctx)
-    {
+        &clearance,
+        "scallop_mm = 0.5",
+        None,
+    ) {
         Ok(plan) => panic!(
             "planned {} moves",
             plan.paths.iter().map(|p| p.moves.len()).sum::<usize>()
