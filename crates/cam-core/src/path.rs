@@ -133,13 +133,19 @@ impl ToolPath {
     /// Total tool-tip travel (mm) over all moves, rapid ones included, measured as straight
     /// segments between consecutive tip points. O(n).
     pub fn path_length_mm(&self) -> f64 {
-        self.segments().map(|(_, len, _)| len).sum()
+        self.length_of_mm(|_| true)
     }
 
     /// Tool-tip travel (mm) of the non-rapid moves only.
     pub fn cutting_length_mm(&self) -> f64 {
+        self.length_of_mm(|kind| kind != MoveKind::Rapid)
+    }
+
+    /// Tool-tip travel (mm) of the moves whose kind `kinds` accepts (straight segments from
+    /// the previous tip point). O(n).
+    pub fn length_of_mm(&self, kinds: impl Fn(MoveKind) -> bool) -> f64 {
         self.segments()
-            .filter(|(kind, _, _)| *kind != MoveKind::Rapid)
+            .filter(|(kind, _, _)| kinds(*kind))
             .map(|(_, len, _)| len)
             .sum()
     }

@@ -559,10 +559,9 @@ pub fn minimax_measured(
     // A run that stops at its iteration limit may end a hair outside the hub tangency band
     // (0.0100x mm against 0.01 on impeller-8+8 without its fillet, whose accuracy was met):
     // the refinement's narrower band (REFINE_HUB_MARGIN) brings it back inside.
-    let hub_out = |res: &PathResult| res.hub_error_mm > pr.hub_tol * (1.0 + 1e-9) + 1e-12;
     while (dense.max_overcut_mm > pr.overcut_tol
         || dense.max_undercut_mm > pr.undercut_tol
-        || hub_out(&res))
+        || exceeds(res.hub_error_mm, pr.hub_tol))
         && rounds < REFINE_ROUNDS
     {
         rounds += 1;
@@ -1050,7 +1049,7 @@ impl FlankFinishing {
             ("hub tangency error", hub, pr.hub_tol, "mm"),
         ]
         .iter()
-        .filter(|(_, v, t, _)| v.is_nan() || *v > t * (1.0 + 1e-9) + 1e-12)
+        .filter(|(_, v, t, _)| v.is_nan() || exceeds(*v, *t))
         .map(|(what, v, t, u)| match (*what, worst_at) {
             ("overcut", Some((_, side, w))) => format!(
                 "{what} {} {u} > {t} {u} (dense measurement of the written pass, {side:?} \
@@ -1091,7 +1090,7 @@ impl FlankFinishing {
                 termination.as_str(),
                 misses.join(", "),
                 worst_at
-                    .and_then(|(row, side, _)| ruled_deviation_note(ctx.impeller, row, side, pr))
+                    .and_then(|(row, side, _)| ruled_deviation_note(ctx, row, side, pr))
                     .unwrap_or_default()
             )));
         }
@@ -1218,6 +1217,11 @@ fn ball_radius_of(r: &PathResult) -> f64 {
     r.x[0]
 }
 
+/// Whether `v` misses its tolerance `t` (beyond rounding: a relative 1e-9 and 1e-12 mm).
+fn exceeds(v: f64, t: f64) -> bool {
+    v > t * (1.0 + 1e-9) + 1e-12
+}
+
 /// `v` with four decimals, or as many more (up to nine) as it takes to read above `limit`:
 /// a value a hair over its tolerance must not print as the tolerance itself ("0.0100 mm >
 /// 0.01 mm").
@@ -1234,17 +1238,14 @@ fn digits_above(v: f64, limit: f64) -> String {
 /// may lie in). A conical cutter's envelope is not a ruled surface, so this is a diagnosis,
 /// not a proof. `None` when within that band or when the approximation cannot be built.
 fn ruled_deviation_note(
-    impeller: &impeller_model::Impeller,
+    ctx: &PlanContext<'_>,
     row: Row,
     side: Side,
     pr: &ProblemSettings,
 ) -> Option<String> {
-    let set = rows::blade_set(impeller, row).ok()?;
+    let set = rows::blade_set(ctx.impeller, row).ok()?;
     let blade = set.blade();
-    let v_range = match blade.design() {
-        Some(_) => blade.hub_shroud_v(side),
-        None => impeller.span_v_range(blade, side).ok()?,
-    };
+    let v_range = crate::regions::side_v_range(ctx, blade, side).ok()?;
     let ruled = impeller_model::ruled::ruled_approximation(blade, side, v_range).ok()?;
     let band = pr.overcut_tol + pr.undercut_tol;
     (ruled.max_deviation_mm > band).then(|| {

@@ -1300,12 +1300,8 @@ fn removal_note(verifiable: &[(Cutter, ToolPath)], by_op: &[f64]) -> String {
         .iter()
         .zip(by_op)
         .map(|((_, path), v)| {
-            let length: f64 = path
-                .moves
-                .windows(2)
-                .filter(|w| w[1].kind.at_cutting_feed() || w[1].kind == MoveKind::Plunge)
-                .map(|w| (w[1].cl.tip - w[0].cl.tip).norm())
-                .sum();
+            let length =
+                path.length_of_mm(|kind| kind.at_cutting_feed() || kind == MoveKind::Plunge);
             let section = if length > 0.0 {
                 format!("{:.3} mm² on average over {:.0} mm", v / length, length)
             } else {

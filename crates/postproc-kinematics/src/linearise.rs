@@ -217,10 +217,7 @@ pub fn subdivide(
     // rotary change sits at the pole and no bisection can spread it. Turn the rotary axis at
     // the pole first (tip and axis fixed: a pure table/head turn), then sweep with it held
     // (or the reverse at a singular far end).
-    let singular = |cl: &CutterLocation| {
-        let a = cl.axis.into_inner();
-        a.x.hypot(a.y) < machine.singularity_tol().sin()
-    };
+    let singular = |cl: &CutterLocation| machine.is_singular(&cl.axis);
     let turn = (j1.rotate - j0.rotate).abs() > 1e-9;
     if turn && singular(cl0) && !singular(cl1) {
         let jp = machine.joints_for_angles(&cl0.tip, tool_length, j0.tilt, j1.rotate);

@@ -311,6 +311,11 @@ impl Machine {
     pub fn singularity_tol(&self) -> f64 {
         self.singularity_tol
     }
+    /// Whether the tool axis `axis` (workpiece frame) lies within [`Self::singularity_tol`]
+    /// of the C axis (the workpiece's ±Z), where C is free.
+    pub fn is_singular(&self, axis: &UnitVector3) -> bool {
+        axis.x.hypot(axis.y) < self.singularity_tol.sin()
+    }
     /// Tool change time, chip to chip (s), when the file gives one (`tool_change_s`).
     pub fn tool_change_s(&self) -> Option<f64> {
         self.tool_change_s

@@ -817,10 +817,7 @@ fn follows_sweep(
     // `linearise::subdivide` linearises first), and sweeps with it held. The continuation
     // from the singular end with its own rotate angle cannot leave the pole (every first
     // step turns the rotate axis by the whole difference), so it starts from the turned one.
-    let singular = |cl: &CutterLocation| {
-        let u = cl.axis.into_inner();
-        u.x.hypot(u.y) < machine.singularity_tol().sin()
-    };
+    let singular = |cl: &CutterLocation| machine.is_singular(&cl.axis);
     if singular(cla) && !singular(clb) {
         let turned = machine.joints_for_angles(&cla.tip, tool_length, a.tilt, b.rotate);
         return sweeps(&turned);

@@ -144,13 +144,10 @@ pub fn reroute_swinging_rapids(
                 .get(i)
                 .is_some_and(|m| inside_surface(linker, &m.cl))
         };
-        let swinging: Vec<usize> = swinging_rapids(machine, &posted)
+        let (flagged, on_surface): (Vec<usize>, Vec<usize>) = swinging_rapids(machine, &posted)
             .into_iter()
             .filter_map(|k| k.checked_sub(1))
             .filter(|&i| i >= 1 && i < path.moves.len())
-            .collect();
-        let (flagged, on_surface): (Vec<usize>, Vec<usize>) = swinging
-            .into_iter()
             .partition(|&i| inside(i - 1) || inside(i));
         if flagged.is_empty() || pass + 1 == MAX_RELINK_PASSES {
             out.remaining = flagged.len();
@@ -288,6 +285,49 @@ mod tests {
         let links = reroute_swinging_rapids(&mut kept, &m, &options, 10.0, &linker, 2.0).unwrap();
         assert_eq!(links.rerouted, 0);
         assert_eq!(kept.moves.len(), original.moves.len());
+    }
+
+    /// A rapid between two postures outside the safety surface on which the table-table
+    /// machine changes branch (A limited to [−100°, 50°]: an axis 60° from +Z is reached
+    /// only at A = −60° with C turned by 180°, from A = 40°): no detour can help (it would
+    /// start and end where the rapid does), so it is left and counted on the surface, not
+    /// as left inside it.
+    #[test]
+    fn a_swinging_rapid_outside_the_surface_is_counted_there() {
+        let m = Machine::from_file(format!(
+            "{}/../../fixtures/machines/xyzac-trt.toml",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap();
+        let cl = |a_deg: f64, x: f64| {
+            let axis = m
+                .tool_axis(a_deg.to_radians(), 30f64.to_radians())
+                .into_inner();
+            CutterLocation::new(Point3::new(x, 0.0, 40.0), axis).unwrap()
+        };
+        let mut path = ToolPath::new("flip", "t");
+        path.moves = vec![
+            Move::rapid(cl(40.0, 0.0)),
+            Move::feed(cl(40.0, 1.0)),
+            Move::rapid(cl(60.0, 5.0)),
+            Move::feed(cl(60.0, 6.0)),
+        ];
+        let original = path.clone();
+        // A blank far below: every posture is outside the surface.
+        let linker = Linker::new(SafetySurface {
+            radius_mm: 1.0,
+            top_z_mm: 10.0,
+        });
+        let options = PostOptions {
+            linearisation_tol: None,
+            ..PostOptions::default()
+        };
+        let links = reroute_swinging_rapids(&mut path, &m, &options, 10.0, &linker, 2.0).unwrap();
+        assert_eq!(
+            (links.rerouted, links.remaining, links.on_surface),
+            (0, 0, 1)
+        );
+        assert_eq!(path.moves, original.moves);
     }
 
     /// An approach from the safety surface (rounding puts the linker's exit points up to
